@@ -1,0 +1,24 @@
+# SPDX-License-Identifier: Apache-2.0
+"""
+Volumetric losses and effective speed of the hydraulic satellite motor.
+
+Pure numpy, SI at every interface. Implements the model of P. Śliwiński,
+"The influence of water and mineral oil on volumetric losses in a hydraulic
+motor", Polish Maritime Research 24 (2017): one function per equation in
+:mod:`.losses` and :mod:`.speed`, composed by :class:`MotorModel`.
+"""
+
+from satmotor_ros.model.coefficients import (CoefficientSet, Liquid, LossCoefficients,
+                                             MotorGeometry, ValidRange)
+from satmotor_ros.model.config import (default_config_path, liquid_from_mapping, load_motor,
+                                       MotorSpec)
+from satmotor_ros.model.errors import ConfigError, InvalidInputError, ModelError, UnitError
+from satmotor_ros.model.motor import (COMPONENTS, describe_status, INVALID, LossBreakdown,
+                                      MotorModel, OperatingPoints, PointStatus)
+
+__all__ = [
+    'COMPONENTS', 'CoefficientSet', 'ConfigError', 'INVALID', 'InvalidInputError', 'Liquid',
+    'LossBreakdown', 'LossCoefficients', 'ModelError', 'MotorGeometry', 'MotorModel',
+    'MotorSpec', 'OperatingPoints', 'PointStatus', 'UnitError', 'ValidRange',
+    'default_config_path', 'describe_status', 'liquid_from_mapping', 'load_motor',
+]

@@ -1,0 +1,12 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Array type aliases shared by the model."""
+
+from __future__ import annotations
+
+from typing import TypeAlias, Union
+
+import numpy as np
+import numpy.typing as npt
+
+FloatArray: TypeAlias = npt.NDArray[np.float64]
+ArrayLike: TypeAlias = Union[float, npt.ArrayLike]

@@ -1,0 +1,175 @@
+# SPDX-License-Identifier: Apache-2.0
+"""
+Liquids, motor geometry and loss coefficients as frozen, validated records.
+
+Geometry and liquids are SI. The loss coefficients are the empirical fits of
+Śliwiński (2017), Table 1, and only mean something in the unit system they
+were fitted in; each field states that system (PAPER_MODEL.md, "Units"). The
+equation functions in :mod:`satmotor_ros.model.losses` take SI arrays and do
+the conversion, so no caller ever sees the paper's units.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, fields
+import math
+
+from satmotor_ros.model.errors import ConfigError
+
+
+class FieldError(ConfigError):
+    """One field of a record holds a value outside its range."""
+
+    def __init__(self, owner: str, field: str, detail: str) -> None:
+        """Keep the field and the detail apart so a loader can re-prefix the key path."""
+        super().__init__(f'{owner}.{field} = {detail}')
+        self.field = field
+        self.detail = detail
+
+
+def _check(owner: str, name: str, value: float, low: float, high: float,
+           closed_low: bool = False) -> None:
+    ok = math.isfinite(value) and value < high and (value >= low if closed_low else value > low)
+    if not ok:
+        bracket = '[' if closed_low else '('
+        raise FieldError(owner, name, f'{value!r} is outside {bracket}{low}, {high})')
+
+
+@dataclass(frozen=True)
+class Liquid:
+    """A working liquid, described by the three properties the model uses."""
+
+    name: str
+    kinematic_viscosity: float  # nu [m^2/s]
+    density: float  # rho [kg/m^3]
+    bulk_modulus: float  # K, isothermal secant bulk modulus [Pa]; beta_l = 1/K, eq. (6)
+
+    def __post_init__(self) -> None:
+        """Reject non-physical properties, naming the field."""
+        _check(self.name, 'kinematic_viscosity', self.kinematic_viscosity, 0.0, 1.0)
+        _check(self.name, 'density', self.density, 0.0, 1.0e5)
+        _check(self.name, 'bulk_modulus', self.bulk_modulus, 0.0, 1.0e12)
+
+    @property
+    def dynamic_viscosity(self) -> float:
+        """Dynamic viscosity mu = rho * nu, [Pa*s]."""
+        return self.density * self.kinematic_viscosity
+
+
+@dataclass(frozen=True)
+class MotorGeometry:
+    """Geometry of a satellite motor (SM-0,75/25 by default)."""
+
+    displacement: float  # q_t, theoretical displacement [m^3/rad]
+    module: float  # m, tooth module [m]
+    height: float  # H, height of the working mechanism [m]
+    clearance_rotor: float  # h_R, axial clearance of the rotor [m]
+    clearance_satellites: float  # h_S, axial clearance of the satellites [m]
+    commutation_diameter: float  # D_o of eq. (5) [m]; assumed, not given in the paper
+
+    def __post_init__(self) -> None:
+        """Reject non-physical dimensions, naming the field."""
+        for name, high in (('displacement', 1.0), ('module', 0.1), ('height', 1.0),
+                           ('clearance_rotor', 1.0e-3), ('clearance_satellites', 1.0e-3),
+                           ('commutation_diameter', 1.0)):
+            _check('geometry', name, getattr(self, name), 0.0, high)
+
+    @property
+    def m2h(self) -> float:
+        """
+        Return m^2*H as the paper uses it in eqs. (11)-(14), (33) and (40).
+
+        The paper evaluates m^2*H with m and H in mm and reads the number as
+        cm^3 (0.75^2 * 25 = 14.0625 "cm^3"); the fitted C and C_id only
+        reproduce its results that way (PAPER_MODEL.md, "Units").
+        """
+        return (self.module * 1.0e3) ** 2 * (self.height * 1.0e3)
+
+    @property
+    def displacement_cm3_per_rev(self) -> float:
+        """Theoretical displacement q_t in the paper's unit, [cm^3/rev]."""
+        return self.displacement * 2.0 * math.pi * 1.0e6
+
+
+@dataclass(frozen=True)
+class LossCoefficients:
+    """
+    Coefficients of the volumetric-loss model for one motor and one liquid.
+
+    Units are the paper's fitting units (PAPER_MODEL.md): pressure in MPa,
+    speed in rpm, flow in l/min, lengths in mm and um, viscosity in cSt.
+    """
+
+    a1: float  # A_1 of eq. (1) [-]
+    a2: float  # A_2 of eq. (1) [-]
+    k: float  # K of eq. (1) [-]
+    beta: float  # laminarity of the clearance flow, eq. (1) [-]
+    d_c: float  # D_C of eq. (2), stator compliance [um/(MPa*mm)]
+    d_k: float  # D_K of eq. (2), compensation-unit compliance [um/MPa]
+    c1: float  # C_1 of eq. (5) [-]
+    c2: float  # C_2 of eq. (5), exponent [-]
+    c3: float  # C_3 of eq. (5) [-]
+    gamma: float  # exponent of eq. (5) [-]
+    c: float  # C = C_fc*beta_l + C_dch + C_b of eq. (33) [1/(MPa*rev)]
+    c_id: float  # C_id of eqs. (14), (33) [1/(rev*min)^0.5]
+    c_t: float  # turbulent channel coefficient of eq. (35), Q in l/min -> Pa
+    c_l: float  # laminar channel coefficient of eq. (35), mu in mPa*s, Q in l/min -> Pa
+    c1_39: float  # C_1 of the empirical eq. (39), dq in cm^3/rev
+    c2_39: float  # C_2 of the empirical eq. (39) [-]
+    compressed_volume_fraction: float  # C'_fc of eq. (9): share of q_t compressed per rev [-]
+    deformation_share: float  # share of C - C_fc*beta_l given to C_dch (rest: C_b) [-]
+    external_leakage: float = 0.0  # lumped C_ex of eq. (24): Q_ex = k * p [m^3/(s*Pa)]
+
+    def __post_init__(self) -> None:
+        """Reject coefficients the equations cannot use, naming the field."""
+        owner = 'coefficients'
+        for name in ('a1', 'a2', 'k', 'c1', 'c3', 'gamma', 'c1_39'):
+            _check(owner, name, getattr(self, name), 0.0, 1.0e12)
+        _check(owner, 'beta', self.beta, 0.0, 2.0)
+        for name in ('c', 'c_id', 'c_t', 'c_l', 'c2_39', 'compressed_volume_fraction',
+                     'external_leakage'):
+            _check(owner, name, getattr(self, name), 0.0, 1.0e12, closed_low=True)
+        for name in ('d_c', 'd_k', 'c2'):
+            _check(owner, name, getattr(self, name), -1.0e12, 1.0e12)
+        _check(owner, 'deformation_share', self.deformation_share, 0.0, 1.0 + 1e-12,
+               closed_low=True)
+
+
+@dataclass(frozen=True)
+class ValidRange:
+    """Operating range over which a coefficient set was validated by measurement."""
+
+    dp_max: float  # largest chamber pressure drop measured [Pa]
+    speed_max: float  # largest shaft speed measured [rad/s]
+
+    def __post_init__(self) -> None:
+        """Reject an empty or non-finite range."""
+        _check('valid_range', 'dp_max', self.dp_max, 0.0, 1.0e10)
+        _check('valid_range', 'speed_max', self.speed_max, 0.0, 1.0e6)
+
+
+@dataclass(frozen=True)
+class CoefficientSet:
+    """Loss coefficients together with the liquid they were fitted on."""
+
+    name: str
+    liquid: Liquid
+    coefficients: LossCoefficients
+
+
+def field_names(record: type) -> tuple[str, ...]:
+    """
+    List the field names of one of the records above.
+
+    Parameters
+    ----------
+    record : type
+        A dataclass type from this module, [-]
+
+    Returns
+    -------
+    tuple of str
+        Field names in declaration order.
+
+    """
+    return tuple(f.name for f in fields(record))

@@ -1,0 +1,492 @@
+# SPDX-License-Identifier: Apache-2.0
+"""
+The motor model: loss breakdown, forward map Q(n, dp) and inverse map n(Q, dp).
+
+:class:`MotorModel` composes the equation functions of
+:mod:`~satmotor_ros.model.losses` and :mod:`~satmotor_ros.model.speed` for one
+motor, one coefficient set and one liquid. Every method is vectorised over
+arrays of operating points and screens its inputs element by element: with
+``errors='raise'`` (the default) the first bad element raises
+:class:`InvalidInputError` naming the argument, index and value; with
+``errors='mask'`` bad elements come back as NaN and are flagged in
+``status`` (see :class:`PointStatus`) while the rest of the batch is computed.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, fields
+import enum
+from typing import Literal
+
+import numpy as np
+import numpy.typing as npt
+
+from satmotor_ros.model import losses as eq
+from satmotor_ros.model._typing import ArrayLike, FloatArray
+from satmotor_ros.model.coefficients import (CoefficientSet, Liquid, MotorGeometry,
+                                             ValidRange)
+from satmotor_ros.model.config import load_motor, MotorSpec
+from satmotor_ros.model.errors import InvalidInputError, ModelError
+from satmotor_ros.model.solve import solve_increasing
+from satmotor_ros.model.speed import effective_speed, speed_loss
+from satmotor_ros.model.units import MPA
+
+Errors = Literal['raise', 'mask']
+DisplacementLaw = Literal['eq33', 'eq39']
+
+
+class PointStatus(enum.IntFlag):
+    """Per-element outcome of a model evaluation; flags combine."""
+
+    OK = 0
+    STALLED = 1  # the leakage takes all the flow: n = 0 (a physical result)
+    CHANNEL_LIMITED = 2  # dp_ich >= dp: the chamber drop dp_i is clipped to 0
+    EXTRAPOLATED = 4  # beyond the coefficient set's validated range (computed)
+    NOT_FINITE = 8  # NaN or inf input (invalid: output NaN)
+    NEGATIVE = 16  # negative flow, speed or pressure drop (invalid: output NaN)
+    BEYOND_LIMIT = 32  # where the equations stop being physical (invalid: output NaN)
+
+
+INVALID = PointStatus.NOT_FINITE | PointStatus.NEGATIVE | PointStatus.BEYOND_LIMIT
+"""The flags that make an element invalid (its outputs are NaN)."""
+
+COMPONENTS = ('flat_clearance', 'commutation', 'compressibility', 'deformation', 'backlash',
+              'inertia', 'external', 'total')
+"""Loss component names, as on the ``losses/<component>`` topics."""
+
+
+@dataclass(frozen=True)
+class LossBreakdown:
+    """The volumetric losses of eq. (31), by component, [m^3/s]."""
+
+    flat_clearance: FloatArray  # Q_Lfg, eq. (1)
+    commutation: FloatArray  # Q_C, eq. (5)
+    compressibility: FloatArray  # Delta Q_fc, eq. (11)
+    deformation: FloatArray  # Delta Q_dch, eq. (12)
+    backlash: FloatArray  # Delta Q_b, eq. (13)
+    inertia: FloatArray  # Delta Q_id, eq. (14)
+    external: FloatArray  # Q_ex, eq. (24)
+    total: FloatArray  # Q_vl, eq. (31)
+
+    def as_dict(self) -> dict[str, FloatArray]:
+        """Return the components by name, in :data:`COMPONENTS` order."""
+        return {f.name: getattr(self, f.name) for f in fields(self)}
+
+
+@dataclass(frozen=True)
+class OperatingPoints:
+    """Operating points of the motor and their losses, all SI."""
+
+    flow: FloatArray  # absorbency Q [m^3/s]
+    speed: FloatArray  # effective shaft speed n [rad/s]
+    dp: FloatArray  # pressure drop between the ports [Pa]
+    dp_i: FloatArray  # pressure drop in the working chambers [Pa]
+    speed_loss: FloatArray  # n_i of eq. (41) [rad/s]
+    losses: LossBreakdown
+    status: npt.NDArray[np.uint8]  # PointStatus flags per element
+
+    @property
+    def invalid(self) -> npt.NDArray[np.bool_]:
+        """Mask of the elements whose outputs are NaN."""
+        return (self.status & int(INVALID)) != 0
+
+
+def describe_status(code: int) -> str:
+    """
+    Spell out a status code.
+
+    Parameters
+    ----------
+    code : int
+        A :class:`PointStatus` value, [-]
+
+    Returns
+    -------
+    str
+        Flag names joined by ``|``, or ``'OK'``.
+
+    Examples
+    --------
+    >>> describe_status(PointStatus.STALLED | PointStatus.EXTRAPOLATED)
+    'STALLED|EXTRAPOLATED'
+
+    """
+    names = [flag.name for flag in PointStatus if flag and code & flag]
+    return '|'.join(n for n in names if n) or 'OK'
+
+
+def _screen(name: str, unit: str, value: FloatArray, errors: Errors) -> npt.NDArray[np.uint8]:
+    not_finite = ~np.isfinite(value)
+    negative = value < 0.0
+    if errors == 'raise':
+        if not_finite.any():
+            _raise_first(name, unit, value, not_finite, 'not finite')
+        if negative.any():
+            _raise_first(name, unit, value, negative, 'negative')
+    return (not_finite * np.uint8(PointStatus.NOT_FINITE)
+            | negative * np.uint8(PointStatus.NEGATIVE)).astype(np.uint8)
+
+
+def _raise_first(name: str, unit: str, value: FloatArray, bad: npt.NDArray[np.bool_],
+                 why: str) -> None:
+    first = int(np.flatnonzero(bad)[0])
+    index = ', '.join(str(i) for i in np.unravel_index(first, value.shape))
+    where = f'{name}[{index}]' if value.ndim else name
+    tail = f' ({int(bad.sum())} of {value.size} elements)' if value.size > 1 else ''
+    msg = f'{where} = {value.flat[first]!r} {unit}: {why}{tail}'
+    raise InvalidInputError(msg)
+
+
+class MotorModel:
+    """
+    The volumetric-loss and speed model of one satellite motor on one liquid.
+
+    Parameters
+    ----------
+    geometry : MotorGeometry
+        Motor geometry, [-]
+    coefficient_set : CoefficientSet
+        Loss coefficients and the liquid they were fitted on, [-]
+    valid_range : ValidRange
+        Range the coefficients were validated over, [-]
+    liquid : Liquid, optional
+        Working liquid; the set's own liquid when omitted. Another liquid keeps
+        the set's fitted coefficients and changes nu, rho and the
+        compressibility share of C (eqs. 9-11), [-]
+    displacement_law : {'eq33', 'eq39'}
+        Delta q from the physical eq. (33) (default) or the empirical eq. (39), [-]
+
+    Examples
+    --------
+    >>> from satmotor_ros.model.units import LPM, MPA, RPM
+    >>> oil = MotorModel.default('oil')
+    >>> op = oil.speed(5 * LPM, dp_i=25 * MPA)
+    >>> round(float(op.speed) / RPM, 1)
+    133.2
+
+    """
+
+    def __init__(self, geometry: MotorGeometry, coefficient_set: CoefficientSet,
+                 valid_range: ValidRange, liquid: Liquid | None = None,
+                 displacement_law: DisplacementLaw = 'eq33') -> None:
+        """Derive the liquid-dependent coefficients once."""
+        if displacement_law not in ('eq33', 'eq39'):
+            msg = f"displacement_law = {displacement_law!r}: use 'eq33' or 'eq39'"
+            raise ModelError(msg)
+        self.geometry = geometry
+        self.coefficient_set = coefficient_set
+        self.valid_range = valid_range
+        self.liquid = liquid if liquid is not None else coefficient_set.liquid
+        self.displacement_law = displacement_law
+        coef = self.coef = coefficient_set.coefficients
+        c_fc_ref = eq.compressibility_coefficient(coefficient_set.liquid.bulk_modulus,
+                                                  geometry, coef)
+        self.c_fc_beta = eq.compressibility_coefficient(self.liquid.bulk_modulus, geometry, coef)
+        rest = coef.c - c_fc_ref
+        self.c_dch = coef.deformation_share * rest
+        self.c_b = rest - self.c_dch
+        self.c = self.c_fc_beta + rest
+        slope = -float(eq.clearance_height(1.0, geometry, coef) - eq.clearance_height(0.0,
+                                                                                     geometry,
+                                                                                     coef))
+        h0 = float(eq.clearance_height(0.0, geometry, coef))
+        # Q_Lfg ~ (h^3 dp)^e rises with dp only while h + 3 h' dp > 0, i.e. dp < h0 / (4 slope)
+        self.dp_limit = h0 / (4.0 * slope) if slope > 0.0 else np.inf
+
+    @classmethod
+    def from_spec(cls, spec: MotorSpec, coefficients: str = 'oil', liquid: Liquid | None = None,
+                  displacement_law: DisplacementLaw = 'eq33') -> MotorModel:
+        """
+        Build a model from a loaded :class:`MotorSpec`.
+
+        Parameters
+        ----------
+        spec : MotorSpec
+            The motor, [-]
+        coefficients : str
+            Name of the coefficient set, e.g. ``'oil'`` or ``'water'``, [-]
+        liquid : Liquid, optional
+            A user liquid run on that set, [-]
+        displacement_law : {'eq33', 'eq39'}
+            Law for Delta q, [-]
+
+        Returns
+        -------
+        MotorModel
+            The model.
+
+        """
+        if coefficients not in spec.sets:
+            msg = (f'coefficient set {coefficients!r} is not in {spec.source} '
+                   f'(has: {", ".join(spec.sets)})')
+            raise ModelError(msg)
+        return cls(spec.geometry, spec.sets[coefficients], spec.valid_range, liquid,
+                   displacement_law)
+
+    @classmethod
+    def default(cls, coefficients: str = 'oil',
+                displacement_law: DisplacementLaw = 'eq33') -> MotorModel:
+        """
+        Build the packaged SM-0,75/25 model for oil or water.
+
+        Parameters
+        ----------
+        coefficients : str
+            ``'oil'`` or ``'water'``, [-]
+        displacement_law : {'eq33', 'eq39'}
+            Law for Delta q, [-]
+
+        Returns
+        -------
+        MotorModel
+            The model.
+
+        """
+        return cls.from_spec(load_motor(), coefficients, None, displacement_law)
+
+    # -- building blocks ------------------------------------------------------------------
+
+    def _leakage(self, dp_i: FloatArray, p_ex: FloatArray) -> tuple[FloatArray, ...]:
+        nu, rho = self.liquid.kinematic_viscosity, self.liquid.density
+        h = eq.clearance_height(dp_i, self.geometry, self.coef)
+        q_lfg = eq.flat_clearance_leakage(dp_i, h, nu, rho, self.geometry, self.coef)
+        q_c = eq.commutation_leakage(dp_i, nu, rho, self.geometry, self.coef)
+        q_ex = eq.external_leakage(p_ex, self.coef)
+        return q_lfg, q_c, q_ex
+
+    def _displacement_loss(self, speed: FloatArray, dp_i: FloatArray) -> FloatArray:
+        if self.displacement_law == 'eq39':
+            return eq.displacement_loss_empirical(dp_i, speed, self.coef)
+        return eq.displacement_loss(dp_i, speed, self.c, self.coef.c_id, self.geometry)
+
+    def _breakdown(self, speed: FloatArray, dp_i: FloatArray, q_lfg: FloatArray,
+                   q_c: FloatArray, q_ex: FloatArray) -> LossBreakdown:
+        g = self.geometry
+        parts = [eq.compressibility_loss(dp_i, speed, self.c_fc_beta, g),
+                 eq.deformation_loss(dp_i, speed, self.c_dch, g),
+                 eq.backlash_loss(dp_i, speed, self.c_b, g),
+                 eq.inertia_loss(speed, self.coef.c_id, g)]
+        if self.displacement_law == 'eq39':
+            # eq. (39) has no physical split: share its Delta Q_vl in eq. (33)'s proportions
+            physical = parts[0] + parts[1] + parts[2] + parts[3]
+            scale = np.divide(eq.displacement_loss_empirical(dp_i, speed, self.coef), physical,
+                              out=np.zeros_like(physical), where=physical > 0.0)
+            parts = [p * scale for p in parts]
+        total = q_lfg + q_c + q_ex + parts[0] + parts[1] + parts[2] + parts[3]
+        return LossBreakdown(q_lfg, q_c, *parts, q_ex, total)
+
+    def _prepare(self, named: dict[str, tuple[ArrayLike, str]],
+                 errors: Errors) -> tuple[list[FloatArray], npt.NDArray[np.uint8]]:
+        if errors not in ('raise', 'mask'):
+            msg = f"errors = {errors!r}: use 'raise' or 'mask'"
+            raise ModelError(msg)
+        arrays = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v, _ in named.values()))
+        status = np.zeros(arrays[0].shape, dtype=np.uint8)
+        for (name, (_, unit)), value in zip(named.items(), arrays):
+            status |= _screen(name, unit, value, errors)
+        if status.any():
+            bad = status != 0
+            arrays = [np.where(bad, 0.0, a) for a in arrays]
+        return arrays, status
+
+    def _channel_drop(self, flow: FloatArray) -> FloatArray:
+        return eq.channel_pressure_drop(flow, self.liquid.kinematic_viscosity,
+                                        self.liquid.density, self.coef)
+
+    def _chamber_drop(self, dp: FloatArray, flow: FloatArray,
+                      status: npt.NDArray[np.uint8]) -> FloatArray:
+        dp_i = eq.chamber_pressure_drop(dp, self._channel_drop(flow))
+        clipped = dp_i < 0.0
+        status |= clipped * np.uint8(PointStatus.CHANNEL_LIMITED)
+        return np.maximum(dp_i, 0.0) if clipped.any() else dp_i
+
+    def _check_limits(self, dp_i: FloatArray, dp_name: str, dp_value: FloatArray,
+                      status: npt.NDArray[np.uint8], errors: Errors) -> FloatArray:
+        beyond = dp_i > self.dp_limit
+        if beyond.any():
+            if errors == 'raise':
+                _raise_first(dp_name, 'Pa', dp_value, beyond,
+                             f'chamber pressure drop beyond the model limit '
+                             f'{self.dp_limit / MPA:.1f} MPa, where eq. (2) closes the clearance'
+                             f' so fast that eq. (1) would fall with pressure')
+            status |= beyond * np.uint8(PointStatus.BEYOND_LIMIT)
+            dp_i = np.where(beyond, 0.0, dp_i)
+        return dp_i
+
+    def _finish(self, flow: FloatArray, speed: FloatArray, dp: FloatArray, dp_i: FloatArray,
+                losses: LossBreakdown, status: npt.NDArray[np.uint8]) -> OperatingPoints:
+        status |= ((dp_i > self.valid_range.dp_max) | (speed > self.valid_range.speed_max)) \
+            * np.uint8(PointStatus.EXTRAPOLATED)
+        n_i = speed_loss(flow, speed, self.geometry)
+        invalid = (status & int(INVALID)) != 0
+        if invalid.any():
+            def nan(a: FloatArray) -> FloatArray:
+                return np.where(invalid, np.nan, a)
+            losses = LossBreakdown(*(nan(v) for v in losses.as_dict().values()))
+            flow, speed, dp, dp_i, n_i = map(nan, (flow, speed, dp, dp_i, n_i))
+        return OperatingPoints(flow, speed, dp, dp_i, n_i, losses, status)
+
+    # -- public maps -----------------------------------------------------------------------
+
+    def speed(self, flow: ArrayLike, dp: ArrayLike | None = None, *,
+              dp_i: ArrayLike | None = None, p_ex: ArrayLike = 0.0, errors: Errors = 'raise',
+              method: Literal['auto', 'iterative'] = 'auto') -> OperatingPoints:
+        """
+        Compute the effective speed and losses from flow and pressure (inverse map).
+
+        With eq. (33) this is the closed form of eq. (40); with eq. (39), or
+        with ``method='iterative'``, eq. (36) is solved for n numerically.
+
+        Parameters
+        ----------
+        flow : float or ndarray
+            Flow into the motor Q, [m^3/s]
+        dp : float or ndarray, optional
+            Pressure drop between the ports; eqs. (34)-(35) give dp_i, [Pa]
+        dp_i : float or ndarray, optional
+            Pressure drop in the working chambers, instead of `dp`, [Pa]
+        p_ex : float or ndarray
+            Pressure driving the external leakage, eq. (24), [Pa]
+        errors : {'raise', 'mask'}
+            Raise on the first invalid element, or return it as NaN, [-]
+        method : {'auto', 'iterative'}
+            Force the numerical solver even where eq. (40) applies, [-]
+
+        Returns
+        -------
+        OperatingPoints
+            Speed, speed loss, losses and status per element.
+
+        """
+        dp_name, dp_value = self._which_dp(dp, dp_i)
+        (q, dpv, pex), status = self._prepare(
+            {'flow': (flow, 'm^3/s'), dp_name: (dp_value, 'Pa'), 'p_ex': (p_ex, 'Pa')}, errors)
+        chamber = dpv if dp is None else self._chamber_drop(dpv, q, status)
+        chamber = self._check_limits(chamber, dp_name, dpv, status, errors)
+        q_lfg, q_c, q_ex = self._leakage(chamber, pex)
+        leak = q_lfg + q_c + q_ex
+        if self.displacement_law == 'eq33' and method == 'auto':
+            n = effective_speed(q, chamber, leak, self.c, self.coef.c_id, self.geometry)
+        else:
+            n = self._solve_speed(q, chamber, leak)
+        status |= (n == 0.0) * np.uint8(PointStatus.STALLED)
+        losses = self._breakdown(n, chamber, q_lfg, q_c, q_ex)
+        port = dpv if dp is not None else chamber + self._channel_drop(q)
+        return self._finish(q, n, port, chamber, losses, status)
+
+    def _solve_speed(self, flow: FloatArray, dp_i: FloatArray, leak: FloatArray) -> FloatArray:
+        qt = self.geometry.displacement
+        hi = np.maximum(flow - leak, 0.0) / qt
+        lo = (eq.empirical_speed_floor(dp_i, self.coef) if self.displacement_law == 'eq39'
+              else np.zeros_like(hi))
+
+        def residual(n: FloatArray) -> FloatArray:
+            return qt * n + self._displacement_loss(n, dp_i) + leak - flow
+
+        f_lo = residual(lo)
+        moving = (f_lo < 0.0) & (hi > lo)
+        lo, hi = np.where(moving, lo, 0.0), np.where(moving, hi, 0.0)
+        f_lo = np.where(moving, f_lo, -1.0)
+        f_hi = np.where(moving, residual(hi), 1.0)
+        n, _ = solve_increasing(residual, lo, hi, f_lo, f_hi, xtol=1e-13 * hi + 1e-15)
+        return np.where(moving, n, 0.0)
+
+    def absorbency(self, speed: ArrayLike, dp: ArrayLike | None = None, *,
+                   dp_i: ArrayLike | None = None, p_ex: ArrayLike = 0.0,
+                   errors: Errors = 'raise') -> OperatingPoints:
+        """
+        Compute the flow the motor absorbs at a speed and pressure (forward map).
+
+        With `dp_i` this is eq. (36) directly. With port `dp`, the channel drop
+        of eq. (35) depends on the very flow being computed, so eq. (36) and
+        eq. (34) are solved together numerically.
+
+        Parameters
+        ----------
+        speed : float or ndarray
+            Shaft speed n, [rad/s]
+        dp : float or ndarray, optional
+            Pressure drop between the ports, [Pa]
+        dp_i : float or ndarray, optional
+            Pressure drop in the working chambers, instead of `dp`, [Pa]
+        p_ex : float or ndarray
+            Pressure driving the external leakage, eq. (24), [Pa]
+        errors : {'raise', 'mask'}
+            Raise on the first invalid element, or return it as NaN, [-]
+
+        Returns
+        -------
+        OperatingPoints
+            Absorbency, losses and status per element.
+
+        """
+        dp_name, dp_value = self._which_dp(dp, dp_i)
+        (n, dpv, pex), status = self._prepare(
+            {'speed': (speed, 'rad/s'), dp_name: (dp_value, 'Pa'), 'p_ex': (p_ex, 'Pa')}, errors)
+        if dp is None:
+            chamber = self._check_limits(dpv, dp_name, dpv, status, errors)
+        else:
+            q = self._solve_flow(n, dpv, pex)
+            chamber = self._chamber_drop(dpv, q, status)
+            chamber = self._check_limits(chamber, dp_name, dpv, status, errors)
+        if self.displacement_law == 'eq39':
+            floor = eq.empirical_speed_floor(chamber, self.coef)
+            below = (n > 0.0) & (n < floor)
+            if below.any():
+                if errors == 'raise':
+                    _raise_first('speed', 'rad/s', n, below,
+                                 'below the floor of eq. (39), where its loss diverges')
+                status |= below * np.uint8(PointStatus.BEYOND_LIMIT)
+        q_lfg, q_c, q_ex = self._leakage(chamber, pex)
+        losses = self._breakdown(n, chamber, q_lfg, q_c, q_ex)
+        flow = self.geometry.displacement * n + losses.total
+        port = dpv if dp is not None else chamber + self._channel_drop(flow)
+        return self._finish(flow, n, port, chamber, losses, status)
+
+    def _solve_flow(self, speed: FloatArray, dp: FloatArray, p_ex: FloatArray) -> FloatArray:
+        qt = self.geometry.displacement
+        dp_cap = np.minimum(dp, self.dp_limit)
+
+        def absorbed(flow: FloatArray) -> FloatArray:
+            dp_i = np.maximum(dp_cap - self._channel_drop(flow), 0.0)
+            q_lfg, q_c, q_ex = self._leakage(dp_i, p_ex)
+            return qt * speed + self._displacement_loss(speed, dp_i) + q_lfg + q_c + q_ex
+
+        # absorbed() falls as flow rises (more channel drop, less chamber drop), so the flow
+        # without channel drop and its image bracket the fixed point flow = absorbed(flow).
+        upper = absorbed(np.zeros_like(speed))
+        lower = absorbed(upper)
+        flow, _ = solve_increasing(lambda f: f - absorbed(f), lower, upper,
+                                   lower - absorbed(lower), upper - lower,
+                                   xtol=1e-13 * upper + 1e-18)
+        return flow
+
+    @staticmethod
+    def _which_dp(dp: ArrayLike | None, dp_i: ArrayLike | None) -> tuple[str, ArrayLike]:
+        if (dp is None) == (dp_i is None):
+            raise ModelError('give exactly one of dp (between the ports) and dp_i (chambers)')
+        return ('dp', dp) if dp is not None else ('dp_i', dp_i)
+
+    def breakdown(self, speed: ArrayLike, dp_i: ArrayLike, p_ex: ArrayLike = 0.0,
+                  errors: Errors = 'raise') -> LossBreakdown:
+        """
+        Compute the loss components at given speed and chamber pressure drop, eq. (31).
+
+        Parameters
+        ----------
+        speed : float or ndarray
+            Shaft speed n, [rad/s]
+        dp_i : float or ndarray
+            Pressure drop in the working chambers, [Pa]
+        p_ex : float or ndarray
+            Pressure driving the external leakage, eq. (24), [Pa]
+        errors : {'raise', 'mask'}
+            Raise on the first invalid element, or return it as NaN, [-]
+
+        Returns
+        -------
+        LossBreakdown
+            Every component of eq. (31) and their total, [m^3/s]
+
+        """
+        return self.absorbency(speed, dp_i=dp_i, p_ex=p_ex, errors=errors).losses

@@ -1,0 +1,110 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Absorbency, effective speed and speed loss: eqs. (36), (40) and (41) of Śliwiński (2017)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from satmotor_ros.model._typing import ArrayLike, FloatArray
+from satmotor_ros.model.coefficients import MotorGeometry
+from satmotor_ros.model.units import MPA, RPM
+
+_CM3_PER_MIN = 1.0e-6 / 60.0  # one cm^3/min in m^3/s
+
+
+def absorbency(speed: ArrayLike, dq: ArrayLike, leakage: ArrayLike,
+               geometry: MotorGeometry) -> FloatArray:
+    r"""
+    Compute the flow a motor absorbs at a given speed, eq. (36).
+
+    .. math:: Q = q_t\,n + \Delta q\,n + Q_{Lfg} + Q_C + Q_{ex}
+
+    Parameters
+    ----------
+    speed : float or ndarray
+        Shaft speed n, [rad/s]
+    dq : float or ndarray
+        Change of displacement Delta q, eq. (33) or (39), [m^3/rad]
+    leakage : float or ndarray
+        Speed-independent losses Q_Lfg + Q_C + Q_ex, [m^3/s]
+    geometry : MotorGeometry
+        Motor geometry (q_t), [-]
+
+    Returns
+    -------
+    ndarray
+        Absorbency Q, [m^3/s]
+
+    """
+    speed = np.asarray(speed, dtype=float)
+    return (geometry.displacement + np.asarray(dq, dtype=float)) * speed + leakage
+
+
+def effective_speed(flow: ArrayLike, dp_i: ArrayLike, leakage: ArrayLike, c: float,
+                    c_id: float, geometry: MotorGeometry) -> FloatArray:
+    r"""
+    Compute the effective shaft speed from flow and pressure, eq. (40).
+
+    .. math::
+        n = \left(\frac{\sqrt{b^2 + 4ac} - b}{2a}\right)^2,\quad
+        a = q_t + C\,\Delta p_i\,m^2 H,\ b = C_{id}\,m^2 H,\
+        c = Q - Q_{Lfg} - Q_C - Q_{ex}
+
+    Parameters
+    ----------
+    flow : float or ndarray
+        Flow into the motor Q, [m^3/s]
+    dp_i : float or ndarray
+        Pressure drop in the working chambers, [Pa]
+    leakage : float or ndarray
+        Speed-independent losses Q_Lfg + Q_C + Q_ex, [m^3/s]
+    c : float
+        Lumped coefficient C of eq. (33), [1/(MPa*rev)]
+    c_id : float
+        Inertia coefficient C_id, [1/(rev*min)^0.5]
+    geometry : MotorGeometry
+        Motor geometry (q_t, m, H), [-]
+
+    Returns
+    -------
+    ndarray
+        Effective speed n >= 0, [rad/s]; 0 where the leakage takes all the flow.
+
+    Notes
+    -----
+    Evaluated in the paper's units (cm^3, rpm) and in the cancellation-free
+    form ``n = (2c / (sqrt(b^2 + 4ac) + b))^2``, which equals eq. (40).
+
+    """
+    m2h = geometry.m2h
+    a = geometry.displacement_cm3_per_rev + (c * m2h / MPA) * np.asarray(dp_i, dtype=float)
+    b = c_id * m2h
+    cc = np.maximum(np.asarray(flow, dtype=float) - leakage, 0.0) * (1.0 / _CM3_PER_MIN)
+    if b == 0.0:
+        return cc / a * RPM
+    root = 2.0 * cc / (np.sqrt(b * b + 4.0 * a * cc) + b)
+    return root * root * RPM
+
+
+def speed_loss(flow: ArrayLike, speed: ArrayLike, geometry: MotorGeometry) -> FloatArray:
+    r"""
+    Compute the loss of speed against the theoretical speed, eq. (41).
+
+    .. math:: n_i = \frac{Q}{q_t} - n
+
+    Parameters
+    ----------
+    flow : float or ndarray
+        Flow into the motor Q, [m^3/s]
+    speed : float or ndarray
+        Effective shaft speed n, [rad/s]
+    geometry : MotorGeometry
+        Motor geometry (q_t), [-]
+
+    Returns
+    -------
+    ndarray
+        Speed loss n_i, [rad/s]
+
+    """
+    return np.asarray(flow, dtype=float) / geometry.displacement - np.asarray(speed, dtype=float)
