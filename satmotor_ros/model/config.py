@@ -83,7 +83,7 @@ def default_config_path(name: str = DEFAULT_MOTOR) -> Path:
                                                  PackageNotFoundError)
         try:
             candidates.append(Path(get_package_share_directory('satmotor_ros')) / 'config' / name)
-        except PackageNotFoundError:
+        except (PackageNotFoundError, OSError):  # OSError: AMENT_PREFIX_PATH not set
             pass
     except ImportError:
         pass

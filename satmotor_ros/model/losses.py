@@ -521,10 +521,10 @@ def channel_pressure_drop(flow: ArrayLike, nu: ArrayLike, rho: ArrayLike,
     1.76
 
     """
-    q_lpm = np.asarray(flow, dtype=float) / LPM
     rho = np.asarray(rho, dtype=float)
     mu_mpas = rho * np.asarray(nu, dtype=float) * 1.0e3
-    return (coef.c_t * rho * q_lpm + coef.c_l * mu_mpas) * q_lpm
+    flow = np.asarray(flow, dtype=float)
+    return ((coef.c_t / (LPM * LPM)) * rho * flow + (coef.c_l / LPM) * mu_mpas) * flow
 
 
 def chamber_pressure_drop(dp: ArrayLike, dp_ich: ArrayLike) -> FloatArray:

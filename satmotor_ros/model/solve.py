@@ -12,7 +12,7 @@ from satmotor_ros.model._typing import FloatArray
 
 def solve_increasing(func: Callable[[FloatArray], FloatArray], lo: FloatArray, hi: FloatArray,
                      f_lo: FloatArray, f_hi: FloatArray, xtol: FloatArray,
-                     maxiter: int = 100) -> tuple[FloatArray, FloatArray]:
+                     ftol: FloatArray = 0.0, maxiter: int = 100) -> tuple[FloatArray, FloatArray]:
     """
     Find x in [lo, hi] with func(x) = 0, element by element (Illinois method).
 
@@ -30,6 +30,8 @@ def solve_increasing(func: Callable[[FloatArray], FloatArray], lo: FloatArray, h
         func(lo) <= 0 and func(hi) >= 0, [f]
     xtol : ndarray or float
         An element is done once its bracket is narrower than this, [x]
+    ftol : ndarray or float
+        ... or once its residual is this small in magnitude, [f]
     maxiter : int
         Iteration limit, [-]
 
@@ -70,5 +72,5 @@ def solve_increasing(func: Callable[[FloatArray], FloatArray], lo: FloatArray, h
         b, fb = np.where(above | exact, x, b), np.where(above | exact, fx, fb)
         a, fa = np.where(below | exact, x, a), np.where(below | exact, fx, fa)
         side = np.where(above, 1, np.where(below, -1, side)).astype(np.int8)
-        done = done | exact | (b - a <= xtol)
+        done = done | exact | (b - a <= xtol) | (np.abs(fx) <= ftol)
     return x, done

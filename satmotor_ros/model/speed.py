@@ -76,14 +76,18 @@ def effective_speed(flow: ArrayLike, dp_i: ArrayLike, leakage: ArrayLike, c: flo
     form ``n = (2c / (sqrt(b^2 + 4ac) + b))^2``, which equals eq. (40).
 
     """
+    # n [rad/s] = RPM (2c / (sqrt(b^2 + 4ac) + b))^2 with c in cm^3/min. With x = 2 sqrt(RPM) c
+    # that is (x / (sqrt(b^2 + (2a / sqrt(RPM)) x) + b))^2: the constants fold into two scalars.
     m2h = geometry.m2h
-    a = geometry.displacement_cm3_per_rev + (c * m2h / MPA) * np.asarray(dp_i, dtype=float)
     b = c_id * m2h
-    cc = np.maximum(np.asarray(flow, dtype=float) - leakage, 0.0) * (1.0 / _CM3_PER_MIN)
+    k = 2.0 / np.sqrt(RPM)
+    two_a = k * geometry.displacement_cm3_per_rev + (k * c * m2h / MPA) * np.asarray(dp_i,
+                                                                                    dtype=float)
+    x = np.maximum(np.asarray(flow, dtype=float) - leakage, 0.0) * (4.0 / (k * _CM3_PER_MIN))
     if b == 0.0:
-        return cc / a * RPM
-    root = 2.0 * cc / (np.sqrt(b * b + 4.0 * a * cc) + b)
-    return root * root * RPM
+        return x / two_a
+    root = x / (np.sqrt(two_a * x + b * b) + b)
+    return root * root
 
 
 def speed_loss(flow: ArrayLike, speed: ArrayLike, geometry: MotorGeometry) -> FloatArray:

@@ -1,0 +1,57 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Argument parsing for ``satmotor``; each subcommand is a typed function returning an exit code."""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Sequence
+import sys
+
+from satmotor_ros import __version__
+from satmotor_ros.cli import characteristics, operating_point
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """
+    Build the ``satmotor`` argument parser.
+
+    Returns
+    -------
+    argparse.ArgumentParser
+        Parser with one subparser per subcommand.
+
+    """
+    parser = argparse.ArgumentParser(
+        prog='satmotor',
+        description='Volumetric losses and speed of the hydraulic satellite motor '
+                    '(Śliwiński 2017 model).')
+    parser.add_argument('--version', action='version', version=f'%(prog)s {__version__}')
+    sub = parser.add_subparsers(dest='subcommand', required=True, metavar='COMMAND')
+    for module in (operating_point, characteristics):
+        module.add_parser(sub)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """
+    Run ``satmotor``.
+
+    Parameters
+    ----------
+    argv : sequence of str, optional
+        Arguments without the program name; ``sys.argv[1:]`` when omitted, [-]
+
+    Returns
+    -------
+    int
+        Exit code: 0 on success, 1 on an error the command reports, 2 on bad usage.
+
+    """
+    args = vars(build_parser().parse_args(argv))
+    args.pop('subcommand')
+    command = args.pop('command')
+    return command(**args)
+
+
+if __name__ == '__main__':
+    sys.exit(main())

@@ -1,0 +1,139 @@
+# SPDX-License-Identifier: Apache-2.0
+"""``satmotor operating-point``: speed, speed loss and loss breakdown at one flow and pressure."""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+from satmotor_ros.cli._common import add_model_options, build_model, CliError, fail, quantity
+from satmotor_ros.model import (COMPONENTS, describe_status, ModelError, MotorModel,
+                                OperatingPoints, PointStatus)
+from satmotor_ros.model.units import LPM, MPA, RPM
+
+_LABELS = {
+    'flat_clearance': 'flat clearances Q_Lfg, eq. (1)',
+    'commutation': 'commutation unit Q_C, eq. (5)',
+    'compressibility': 'compressibility dQ_fc, eq. (11)',
+    'deformation': 'deformation dQ_dch, eq. (12)',
+    'backlash': 'backlash dQ_b, eq. (13)',
+    'inertia': 'inertia dQ_id, eq. (14)',
+    'external': 'external Q_ex, eq. (24)',
+    'total': 'total Q_vl, eq. (31)',
+}
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    """
+    Register the subcommand.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The ``satmotor`` subparsers, [-]
+
+    """
+    parser = sub.add_parser(
+        'operating-point', help='speed and losses at one flow and pressure drop',
+        description='Effective speed (eq. 40), speed loss (eq. 41) and the volumetric-loss '
+                    'breakdown (eq. 31) at one operating point. Quantities take an optional '
+                    'unit: --flow 8.3e-5m^3/s, --dp 250bar.')
+    parser.add_argument('--flow', required=True, help='flow into the motor (default l/min)')
+    drop = parser.add_mutually_exclusive_group(required=True)
+    drop.add_argument('--dp', help='pressure drop between the ports (default MPa); the '
+                                   'internal-channel drop of eqs. (34)-(35) is subtracted')
+    drop.add_argument('--dp-i', help='pressure drop in the working chambers (default MPa), '
+                                     'as in the paper\'s figures')
+    parser.add_argument('--p-ex', default='0', help='pressure driving the external leakage, '
+                                                    'eq. (24) (default MPa; default 0)')
+    parser.add_argument('--json', action='store_true', dest='as_json',
+                        help='print one JSON object')
+    add_model_options(parser)
+    parser.set_defaults(command=command)
+
+
+def command(flow: str, dp: str | None, dp_i: str | None, p_ex: str, as_json: bool, liquid: str,
+            motor: str | None, law: str, viscosity: str | None, density: str | None,
+            bulk_modulus: str | None) -> int:
+    """
+    Print the operating point.
+
+    Parameters
+    ----------
+    flow : str
+        Flow as typed, [l/min by default]
+    dp, dp_i : str or None
+        Port or chamber pressure drop as typed (exactly one), [MPa by default]
+    p_ex : str
+        Pressure driving the external leakage as typed, [MPa by default]
+    as_json : bool
+        Print JSON instead of a table, [-]
+    liquid, motor, law, viscosity, density, bulk_modulus : str or None
+        Model options, see :func:`satmotor_ros.cli._common.build_model`, [-]
+
+    Returns
+    -------
+    int
+        0 on success, 1 on an error (one line on stderr).
+
+    """
+    try:
+        model = build_model(liquid, motor, law, viscosity, density, bulk_modulus)
+        q = quantity('--flow', flow, 'flow', 'l/min')
+        pex = quantity('--p-ex', p_ex, 'pressure', 'MPa')
+        if dp is not None:
+            op = model.speed(q, quantity('--dp', dp, 'pressure', 'MPa'), p_ex=pex)
+        else:
+            op = model.speed(q, dp_i=quantity('--dp-i', dp_i, 'pressure', 'MPa'), p_ex=pex)
+    except (CliError, ModelError) as err:
+        return fail(err)
+    result = _result(model, op)
+    print(json.dumps(result, indent=2) if as_json else _table(result))
+    return 0
+
+
+def _result(model: MotorModel, op: OperatingPoints) -> dict:
+    status = int(op.status)
+    return {
+        'motor': model.name,
+        'coefficients': model.coefficient_set.name,
+        'liquid': model.liquid.name,
+        'displacement_law': model.displacement_law,
+        'flow_lpm': float(op.flow) / LPM,
+        'dp_MPa': float(op.dp) / MPA,
+        'dp_i_MPa': float(op.dp_i) / MPA,
+        'speed_rpm': float(op.speed) / RPM,
+        'speed_rad_s': float(op.speed),
+        'speed_loss_rpm': float(op.speed_loss) / RPM,
+        'losses_lpm': {name: float(getattr(op.losses, name)) / LPM for name in COMPONENTS},
+        'status': describe_status(status),
+        'warnings': _warnings(status),
+    }
+
+
+def _warnings(status: int) -> list[str]:
+    notes = []
+    if status & PointStatus.STALLED:
+        notes.append('the leakage takes all the flow: the shaft does not turn (n = 0)')
+    if status & PointStatus.CHANNEL_LIMITED:
+        notes.append('the internal channels take the whole pressure drop: dp_i set to 0')
+    if status & PointStatus.EXTRAPOLATED:
+        notes.append('outside the range the coefficients were measured over (extrapolated)')
+    return notes
+
+
+def _table(r: dict) -> str:
+    lines = [
+        f'{r["motor"]} on {r["liquid"]} ({r["coefficients"]} coefficients), '
+        f'displacement law {r["displacement_law"]}',
+        f'  flow Q               {r["flow_lpm"]:10.3f} l/min',
+        f'  dp between ports     {r["dp_MPa"]:10.3f} MPa',
+        f'  dp_i in chambers     {r["dp_i_MPa"]:10.3f} MPa',
+        f'  speed n              {r["speed_rpm"]:10.2f} rpm  ({r["speed_rad_s"]:.3f} rad/s)',
+        f'  speed loss n_i       {r["speed_loss_rpm"]:10.2f} rpm  (eq. 41)',
+        '  volumetric losses [l/min]',
+    ]
+    lines += [f'    {_LABELS[name]:34s} {value:10.4f}' for name, value in r['losses_lpm'].items()]
+    lines.append(f'  status: {r["status"]}')
+    lines += [f'  warning: {note}' for note in r['warnings']]
+    return '\n'.join(lines)
