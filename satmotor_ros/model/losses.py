@@ -414,7 +414,7 @@ def displacement_loss_empirical(dp_i: ArrayLike, speed: ArrayLike,
     dp_i : float or ndarray
         Pressure drop in the working chambers, [Pa]
     speed : float or ndarray
-        Shaft speed n, [rad/s]; 0 gives 0 (no revolution, no displacement loss)
+        Shaft speed n; 0 gives 0 (no revolution, no displacement loss), [rad/s]
     coef : LossCoefficients
         Coefficient set (C_1, C_2 of eq. 39), [-]
 

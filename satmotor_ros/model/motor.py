@@ -366,6 +366,7 @@ class MotorModel:
         n_i = speed_loss(flow, speed, self.geometry)
         invalid = (status & int(INVALID)) != 0 if status.any() else None
         if invalid is not None and invalid.any():
+            status &= np.where(invalid, np.uint8(INVALID), np.uint8(0xFF))  # no STALLED etc.
             def nan(a: FloatArray) -> FloatArray:
                 return np.where(invalid, np.nan, a)
             losses = LossBreakdown(*(nan(v) for v in losses.as_dict().values()))

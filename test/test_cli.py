@@ -1,0 +1,110 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The ``satmotor`` command: operating points, characteristics and one-line errors."""
+
+import csv
+import json
+
+import pytest
+
+from satmotor_ros.cli import main
+
+
+def _run(capsys, *argv):
+    code = main(list(argv))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_operating_point_json_has_speed_loss_and_breakdown(capsys):
+    code, out, _ = _run(capsys, 'operating-point', '--liquid', 'water', '--flow', '5',
+                        '--dp-i', '25', '--json')
+    assert code == 0
+    result = json.loads(out)
+    assert result['speed_rpm'] == pytest.approx(74.6, abs=0.05)
+    assert result['speed_loss_rpm'] == pytest.approx(5000 / 32.94 - 74.6, abs=0.05)
+    losses = result['losses_lpm']
+    assert set(losses) == {'flat_clearance', 'commutation', 'compressibility', 'deformation',
+                           'backlash', 'inertia', 'external', 'total'}
+    assert losses['total'] == pytest.approx(sum(v for k, v in losses.items() if k != 'total'))
+    assert result['status'] == 'OK'
+
+
+@pytest.mark.parametrize(('flow', 'dp'), [('5', '25'), ('8.333333333e-5m^3/s', '250bar'),
+                                          ('5 l/min', '25000 kPa')])
+def test_operating_point_accepts_units(capsys, flow, dp):
+    code, out, _ = _run(capsys, 'operating-point', '--flow', flow, '--dp', dp, '--json')
+    assert code == 0
+    assert json.loads(out)['dp_MPa'] == pytest.approx(25.0)
+    assert json.loads(out)['flow_lpm'] == pytest.approx(5.0)
+
+
+def test_operating_point_table_names_every_component(capsys):
+    code, out, _ = _run(capsys, 'operating-point', '--flow', '20', '--dp', '10')
+    assert code == 0
+    for label in ('speed n', 'speed loss n_i', 'Q_Lfg, eq. (1)', 'Q_C, eq. (5)',
+                  'dQ_fc, eq. (11)', 'dQ_dch, eq. (12)', 'dQ_b, eq. (13)', 'dQ_id, eq. (14)',
+                  'Q_ex, eq. (24)', 'Q_vl, eq. (31)'):
+        assert label in out
+
+
+def test_operating_point_with_user_liquid(capsys):
+    _, ref, _ = _run(capsys, 'operating-point', '--flow', '10', '--dp', '10', '--json')
+    code, out, _ = _run(capsys, 'operating-point', '--flow', '10', '--dp', '10', '--json',
+                        '--viscosity', '15', '--density', '860', '--bulk-modulus', '1.4GPa')
+    assert code == 0
+    assert json.loads(out)['speed_rpm'] < json.loads(ref)['speed_rpm']
+    assert json.loads(out)['liquid'].startswith('user liquid')
+
+
+def test_stalled_point_warns(capsys):
+    code, out, _ = _run(capsys, 'operating-point', '--flow', '0.01', '--dp', '25')
+    assert code == 0
+    assert 'STALLED' in out and 'does not turn' in out
+
+
+@pytest.mark.parametrize(('argv', 'message'), [
+    (['--flow', '-5', '--dp', '2'], "--flow '-5': must be a finite value >= 0"),
+    (['--flow', 'nan', '--dp', '2'], "--flow 'nan': 'nan' is not a number"),
+    (['--flow', '5', '--dp', '2kg'], "--dp '2kg': unit 'kg' is not a pressure unit"),
+    (['--flow', '5', '--dp', '80'], 'dp = 80000000.0 Pa: chamber pressure drop beyond'),
+    (['--flow', '5', '--dp', '2', '--liquid', 'glycol'], "--liquid 'glycol': not a coefficient"),
+    (['--flow', '5', '--dp', '2', '--viscosity', '0'], "--viscosity '0': must be a finite value"),
+    (['--flow', '5', '--dp', '2', '--motor', '/nonexistent.yaml'], 'cannot read motor config'),
+])
+def test_bad_input_exits_1_with_one_line_naming_the_field(capsys, argv, message):
+    code, out, err = _run(capsys, 'operating-point', *argv)
+    assert code == 1
+    assert out == ''
+    assert err.count('\n') == 1 and message in err
+
+
+def test_characteristics_writes_png_and_csv(tmp_path, capsys):
+    code, out, _ = _run(capsys, 'characteristics', '--liquid', 'oil', '--out', str(tmp_path),
+                        '--points', '12')
+    assert code == 0
+    names = ('constant_flow', 'constant_speed', 'displacement_change', 'speed_loss',
+             'water_oil_ratio')
+    for name in names:
+        png = tmp_path / f'{name}.png'
+        assert png.read_bytes()[:8] == b'\x89PNG\r\n\x1a\n'
+        assert png.stat().st_size > 10_000
+        with (tmp_path / f'{name}.csv').open(encoding='utf-8') as stream:
+            rows = list(csv.reader(stream))
+        assert all('[' in header for header in rows[0])
+        assert len(rows) == 1 + 4 * 12
+    with (tmp_path / 'water_oil_ratio.csv').open(encoding='utf-8') as stream:
+        rows = [r for r in csv.DictReader(stream) if r['Q [l/min]'] == '5']
+    assert float(rows[-1]['n_w/n_o [-]']) == pytest.approx(0.560, abs=0.001)
+
+
+def test_characteristics_refuses_an_unwritable_directory(tmp_path, capsys):
+    blocker = tmp_path / 'file'
+    blocker.write_text('x')
+    code, _, err = _run(capsys, 'characteristics', '--out', str(blocker / 'sub'))
+    assert code == 1 and '--out' in err
+
+
+def test_usage_errors_exit_2(capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(['operating-point', '--flow', '5'])
+    assert exc.value.code == 2

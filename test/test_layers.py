@@ -1,0 +1,38 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The physics layers never pull in ROS, and every equation function documents itself."""
+
+import inspect
+import re
+import subprocess
+import sys
+
+import pytest
+
+from satmotor_ros.model import losses, speed
+
+
+@pytest.mark.parametrize('module', ['satmotor_ros.model', 'satmotor_ros.cli'])
+def test_layer_imports_without_rclpy(module):
+    code = f'import sys, {module}; assert "rclpy" not in sys.modules, "rclpy imported"'
+    subprocess.run([sys.executable, '-c', code], check=True)
+
+
+EQUATION_MODULES = [losses, speed]
+
+
+def _public_functions():
+    for module in EQUATION_MODULES:
+        for name, fn in inspect.getmembers(module, inspect.isfunction):
+            if not name.startswith('_') and fn.__module__ == module.__name__:
+                yield f'{module.__name__}.{name}', fn
+
+
+@pytest.mark.parametrize(('name', 'fn'), list(_public_functions()))
+def test_equation_function_cites_its_equation_and_units(name, fn):
+    doc = inspect.getdoc(fn)
+    assert re.search(r'eqs?\. \(\d+\)', doc), f'{name} cites no equation'
+    params = [p for p in inspect.signature(fn).parameters]
+    section = doc.split('Parameters\n----------\n', 1)[1].split('\n\n', 1)[0]
+    for param in params:
+        line = re.search(rf'^{param}\b.*\n\s+.*\[.*\]\s*$', section, re.MULTILINE)
+        assert line, f'{name}: parameter {param!r} lacks a [unit]'

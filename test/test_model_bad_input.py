@@ -1,0 +1,111 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Bad operating points get a defined answer: a named error or a flagged physical result."""
+
+import numpy as np
+import pytest
+
+from satmotor_ros.model import (describe_status, InvalidInputError, ModelError, MotorModel,
+                                PointStatus)
+from satmotor_ros.model.units import LPM, MPA, RPM
+
+
+@pytest.fixture(scope='module')
+def oil():
+    return MotorModel.default('oil')
+
+
+@pytest.mark.parametrize(('kwargs', 'match'), [
+    ({'flow': np.nan, 'dp': 10 * MPA}, r'^flow = nan m\^3/s: not finite$'),
+    ({'flow': np.inf, 'dp': 10 * MPA}, r'^flow = inf m\^3/s: not finite$'),
+    ({'flow': -1e-4, 'dp': 10 * MPA}, r'^flow = -0.0001 m\^3/s: negative$'),
+    ({'flow': 1e-4, 'dp': -1.0}, r'^dp = -1.0 Pa: negative$'),
+    ({'flow': 1e-4, 'dp_i': np.nan}, r'^dp_i = nan Pa: not finite$'),
+    ({'flow': 1e-4, 'dp': 1e6, 'p_ex': -5.0}, r'^p_ex = -5.0 Pa: negative$'),
+    ({'flow': 1e-4, 'dp': 80 * MPA}, r'^dp = 80000000.0 Pa: chamber pressure drop beyond'),
+])
+def test_speed_raises_naming_argument_and_value(oil, kwargs, match):
+    with pytest.raises(InvalidInputError, match=match):
+        oil.speed(**kwargs)
+
+
+def test_batch_error_names_the_first_bad_index_and_the_count(oil):
+    flow = np.full(100, 5 * LPM)
+    flow[[17, 40, 41]] = np.nan
+    with pytest.raises(InvalidInputError, match=r'^flow\[17\] = nan .*\(3 elements of this kind\)'):
+        oil.speed(flow, 10 * MPA)
+
+
+def test_batch_error_index_is_global_across_chunks(oil):
+    flow = np.full(100_000, 5 * LPM)
+    dp = np.full(100_000, 10 * MPA)
+    dp[70_001] = 90 * MPA
+    with pytest.raises(InvalidInputError, match=r'^dp\[70001\] = 90000000.0 Pa'):
+        oil.speed(flow, dp)
+
+
+def test_mask_mode_keeps_the_batch_and_reports_which_elements_are_invalid(oil):
+    flow = np.array([5, np.nan, -1, 5, 5, 0.0]) * LPM
+    dp = np.array([10, 10, 10, np.inf, 80, 10]) * MPA
+    op = oil.speed(flow, dp, errors='mask')
+    assert op.invalid.tolist() == [False, True, True, True, True, False]
+    assert np.isnan(op.speed[op.invalid]).all()
+    assert np.isnan(op.losses.total[op.invalid]).all()
+    assert op.speed[0] == pytest.approx(oil.speed(5 * LPM, 10 * MPA).speed)
+    assert describe_status(op.status[1]) == 'NOT_FINITE'
+    assert describe_status(op.status[2]) == 'NEGATIVE'
+    assert describe_status(op.status[3]) == 'NOT_FINITE'
+    assert describe_status(op.status[4]) == 'BEYOND_LIMIT'
+    assert op.status[5] & PointStatus.STALLED
+
+
+def test_zero_flow_and_flow_swallowed_by_leakage_give_zero_speed(oil):
+    op = oil.speed(np.array([0.0, 0.05, 0.2]) * LPM, 25 * MPA)
+    assert op.speed[:2].tolist() == [0.0, 0.0]
+    assert op.speed[2] > 0.0
+    assert (op.status[:2] & PointStatus.STALLED).all()
+    assert not op.status[2] & PointStatus.STALLED
+    for law in ('eq33', 'eq39'):
+        assert float(MotorModel.default('water', law).speed(0.1 * LPM, dp=25 * MPA).speed) == 0.0
+
+
+def test_zero_pressure_drop_is_a_valid_unloaded_point(oil):
+    op = oil.speed(5 * LPM, 0.0)
+    assert 0.0 < float(op.speed) < 5 * LPM / oil.geometry.displacement
+    assert op.status == PointStatus.CHANNEL_LIMITED  # 5 l/min need some channel drop
+    assert float(op.dp_i) == 0.0
+
+
+def test_beyond_validated_range_is_computed_and_flagged_extrapolated(oil):
+    op = oil.speed(np.array([20, 20]) * LPM, np.array([20, 30]) * MPA)
+    assert op.status.tolist() == [0, PointStatus.EXTRAPOLATED]
+    assert np.isfinite(op.speed).all()
+    fast = oil.absorbency(2000 * RPM, dp_i=10 * MPA)
+    assert fast.status & PointStatus.EXTRAPOLATED
+
+
+def test_forward_map_rejects_negative_speed_and_eq39_below_its_floor():
+    with pytest.raises(InvalidInputError, match=r'^speed = -1.0 rad/s: negative$'):
+        MotorModel.default('oil').absorbency(-1.0, dp_i=1e6)
+    with pytest.raises(InvalidInputError, match='below the floor of eq. \\(39\\)'):
+        MotorModel.default('oil', 'eq39').absorbency(1e-4, dp_i=25 * MPA)
+    assert float(MotorModel.default('oil', 'eq39').absorbency(0.0, dp_i=25 * MPA).flow) > 0.0
+
+
+def test_bad_call_arguments_are_model_errors(oil):
+    with pytest.raises(ModelError, match='exactly one of dp'):
+        oil.speed(1e-4)
+    with pytest.raises(ModelError, match='exactly one of dp'):
+        oil.speed(1e-4, 1e6, dp_i=1e6)
+    with pytest.raises(ModelError, match="errors = 'ignore'"):
+        oil.speed(1e-4, 1e6, errors='ignore')
+    with pytest.raises(ModelError, match="displacement_law = 'eq7'"):
+        MotorModel.default('oil', 'eq7')
+
+
+@pytest.mark.parametrize('shape', [(), (1,), (7,), (3, 4)])
+def test_scalar_and_array_inputs_keep_their_shape(oil, shape):
+    op = oil.speed(np.full(shape, 10 * LPM), 10 * MPA)
+    assert op.speed.shape == shape
+    assert op.losses.total.shape == shape
+    assert op.status.shape == shape
+    np.testing.assert_allclose(op.speed, float(oil.speed(10 * LPM, 10 * MPA).speed))
