@@ -31,7 +31,7 @@ def _public_functions():
 def test_equation_function_cites_its_equation_and_units(name, fn):
     doc = inspect.getdoc(fn)
     assert re.search(r'eqs?\. \(\d+\)', doc), f'{name} cites no equation'
-    params = [p for p in inspect.signature(fn).parameters]
+    params = list(inspect.signature(fn).parameters)
     section = doc.split('Parameters\n----------\n', 1)[1].split('\n\n', 1)[0]
     for param in params:
         line = re.search(rf'^{param}\b.*\n\s+.*\[.*\]\s*$', section, re.MULTILINE)

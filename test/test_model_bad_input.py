@@ -31,7 +31,8 @@ def test_speed_raises_naming_argument_and_value(oil, kwargs, match):
 def test_batch_error_names_the_first_bad_index_and_the_count(oil):
     flow = np.full(100, 5 * LPM)
     flow[[17, 40, 41]] = np.nan
-    with pytest.raises(InvalidInputError, match=r'^flow\[17\] = nan .*\(3 elements of this kind\)'):
+    with pytest.raises(InvalidInputError,
+                       match=r'^flow\[17\] = nan .*\(3 elements of this kind\)'):
         oil.speed(flow, 10 * MPA)
 
 

@@ -47,7 +47,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     """
     parser = sub.add_parser(
         'characteristics', help='write characteristic plots (PNG) and their data (CSV)',
-        description='Characteristics of the paper\'s Figs. 8-16 kind over the chamber pressure '
+        description="Characteristics of the paper's Figs. 8-16 kind over the chamber pressure "
                     'drop: losses at constant flow and at constant speed, change of '
                     'displacement, speed loss, and water against oil.')
     parser.add_argument('--out', required=True, metavar='DIR', help='output directory')

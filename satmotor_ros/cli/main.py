@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Argument parsing for ``satmotor``; each subcommand is a typed function returning an exit code."""
+"""Argument parsing for ``satmotor``; each subcommand is a function returning an exit code."""
 
 from __future__ import annotations
 

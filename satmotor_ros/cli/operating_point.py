@@ -43,7 +43,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     drop.add_argument('--dp', help='pressure drop between the ports (default MPa); the '
                                    'internal-channel drop of eqs. (34)-(35) is subtracted')
     drop.add_argument('--dp-i', help='pressure drop in the working chambers (default MPa), '
-                                     'as in the paper\'s figures')
+                                     "as in the paper's figures")
     parser.add_argument('--p-ex', default='0', help='pressure driving the external leakage, '
                                                     'eq. (24) (default MPa; default 0)')
     parser.add_argument('--json', action='store_true', dest='as_json',

@@ -17,13 +17,12 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
-import yaml
-
 from satmotor_ros.model.coefficients import (CoefficientSet, field_names, FieldError, Liquid,
                                              LossCoefficients, MotorGeometry, ValidRange)
 from satmotor_ros.model.errors import ConfigError, UnitError
 from satmotor_ros.model.losses import compressibility_coefficient
 from satmotor_ros.model.units import parse_quantity
+import yaml
 
 DEFAULT_MOTOR = 'sm075_25.yaml'
 """File name of the packaged SM-0,75/25 specification."""
@@ -242,7 +241,8 @@ def _values(doc: Mapping[str, Any], where: str, names: tuple[str, ...],
             kinds: Mapping[str, tuple[str, str]]) -> dict[str, float]:
     unknown = sorted(set(doc) - set(names))
     if unknown:
-        msg = f'{where} has unknown key(s): {", ".join(map(str, unknown))} (known: {", ".join(names)})'
+        msg = (f'{where} has unknown key(s): {", ".join(map(str, unknown))} '
+               f'(known: {", ".join(names)})')
         raise ConfigError(msg)
     return {key: _number(value, f'{where}.{key}', kinds.get(key))
             for key, value in doc.items()}

@@ -11,6 +11,7 @@ References
 ----------
 .. [1] P. Śliwiński, "The influence of water and mineral oil on volumetric
    losses in a hydraulic motor", Polish Maritime Research 24 (2017).
+
 """
 
 from __future__ import annotations

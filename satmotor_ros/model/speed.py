@@ -81,8 +81,8 @@ def effective_speed(flow: ArrayLike, dp_i: ArrayLike, leakage: ArrayLike, c: flo
     m2h = geometry.m2h
     b = c_id * m2h
     k = 2.0 / np.sqrt(RPM)
-    two_a = k * geometry.displacement_cm3_per_rev + (k * c * m2h / MPA) * np.asarray(dp_i,
-                                                                                    dtype=float)
+    dp_i = np.asarray(dp_i, dtype=float)
+    two_a = k * geometry.displacement_cm3_per_rev + (k * c * m2h / MPA) * dp_i
     x = np.maximum(np.asarray(flow, dtype=float) - leakage, 0.0) * (4.0 / (k * _CM3_PER_MIN))
     if b == 0.0:
         return x / two_a

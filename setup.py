@@ -1,0 +1,51 @@
+"""Packaging for satmotor_ros (ament_python: colcon and pip use the same file)."""
+
+from glob import glob
+import os
+
+from setuptools import find_packages
+from setuptools import setup
+
+package_name = 'satmotor_ros'
+
+# The canonical coefficient sets and parameter files live in the top-level config/ directory.
+# colcon installs them to share/<pkg>/config (data_files).  For pip installs the same files
+# are shipped as package data of a virtual subpackage `satmotor_ros.config` whose directory is
+# mapped onto config/ (package_dir), so importlib.resources.files('satmotor_ros.config')
+# finds them.
+config_files = sorted(glob(os.path.join('config', '*.yaml')))
+
+setup(
+    name=package_name,
+    version='0.1.0',
+    # include= rather than exclude=['test']: it also keeps bench/ and config/ (should it ever
+    # get an __init__.py) from being installed as top-level packages.
+    packages=[
+        *find_packages(include=[package_name, package_name + '.*']),
+        package_name + '.config',
+    ],
+    package_dir={package_name + '.config': 'config'},
+    package_data={
+        package_name: ['py.typed'],
+        package_name + '.config': ['*.yaml'],
+    },
+    data_files=[
+        ('share/ament_index/resource_index/packages', ['resource/' + package_name]),
+        ('share/' + package_name, ['package.xml']),
+        ('share/' + package_name + '/config', config_files),
+    ],
+    python_requires='>=3.10',
+    install_requires=['numpy', 'pyyaml', 'matplotlib'],
+    zip_safe=False,
+    maintainer='satmotor_ros developers',
+    maintainer_email='satmotor_ros@example.com',
+    description='Volumetric losses and shaft speed of a hydraulic satellite motor, '
+                'a virtual motor plant, calibration tools and rclpy nodes.',
+    license='Apache-2.0',
+    tests_require=['pytest'],
+    entry_points={
+        'console_scripts': [
+            'satmotor = satmotor_ros.cli:main',
+        ],
+    },
+)
