@@ -30,7 +30,7 @@ from satmotor_ros.model.config import load_motor, MotorSpec
 from satmotor_ros.model.errors import InvalidInputError, ModelError
 from satmotor_ros.model.solve import solve_increasing
 from satmotor_ros.model.speed import effective_speed, speed_loss
-from satmotor_ros.model.units import MPA
+from satmotor_ros.model.units import LPM, MPA, RPM
 
 Errors = Literal['raise', 'mask']
 DisplacementLaw = Literal['eq33', 'eq39']
@@ -118,6 +118,9 @@ def describe_status(code: int) -> str:
 
 _CHUNK = 8192
 """Elements evaluated at once: temporaries of this size stay in cache (about 2x faster)."""
+
+_RTOL = 1e-11
+"""Relative tolerance of the iterative maps, far below the model's own accuracy (~1 %)."""
 
 At = tuple[int, tuple[int, ...]]
 """Where a chunk sits in the batch: flat offset and the batch's shape (for error messages)."""
@@ -283,6 +286,31 @@ class MotorModel:
             return eq.displacement_loss_empirical(dp_i, speed, self.coef)
         return eq.displacement_loss(dp_i, speed, self.c, self.coef.c_id, self.geometry)
 
+    def _displacement_loss_slopes(self, speed: FloatArray, dp_i: FloatArray,
+                                  loss: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """Return d(Delta Q_vl)/dn and d(Delta Q_vl)/d(dp_i) of eq. (33) or (39) at `loss`."""
+        with np.errstate(divide='ignore', invalid='ignore'):
+            if self.displacement_law == 'eq39':
+                # Delta Q_vl = C_1 s exp(a / s) with s = sqrt(n [rpm]), a = C_2 ln(dp_i [MPa])
+                inv_s = 1.0 / np.sqrt(speed / RPM)
+                log_dp = np.log(dp_i / MPA)
+                d_speed = loss * (1.0 - self.coef.c2_39 * log_dp * inv_s) / (2.0 * speed)
+                return d_speed, loss * self.coef.c2_39 * inv_s / dp_i
+            # Delta Q_vl = k_p dp_i n + k_i sqrt(n)
+            k_p = float(eq.compressibility_loss(1.0, 1.0, self.c, self.geometry))
+            k_i = float(eq.inertia_loss(1.0, self.coef.c_id, self.geometry))
+            return k_p * dp_i + 0.5 * k_i / np.sqrt(speed), k_p * speed
+
+    def _leakage_slope(self, dp_i: FloatArray, q_lfg: FloatArray,
+                       q_c: FloatArray) -> FloatArray:
+        """Return d(Q_Lfg + Q_C)/d(dp_i) of eqs. (1), (2) and (5) at the given leakages."""
+        h = eq.clearance_height(dp_i, self.geometry, self.coef)
+        h_slope = float(eq.clearance_height(1.0, self.geometry, self.coef)) - (
+            float(eq.clearance_height(0.0, self.geometry, self.coef)))  # dh/d(dp_i) [m/Pa]
+        e = 1.0 / (2.0 - self.coef.beta)
+        with np.errstate(divide='ignore', invalid='ignore'):
+            return q_lfg * e * (1.0 / dp_i + 3.0 * h_slope / h) + q_c * self.coef.gamma / dp_i
+
     def _breakdown(self, speed: FloatArray, dp_i: FloatArray, q_lfg: FloatArray,
                    q_c: FloatArray, q_ex: FloatArray) -> dict[str, FloatArray]:
         g = self.geometry
@@ -437,21 +465,21 @@ class MotorModel:
         return self._run(core, arrays, status, given)
 
     def _solve_speed(self, flow: FloatArray, dp_i: FloatArray, leak: FloatArray) -> FloatArray:
+        """Solve eq. (36) for n at given flow and dp_i (Newton, bracketed)."""
         qt = self.geometry.displacement
-        hi = np.maximum(flow - leak, 0.0) / qt
+        hi = np.maximum(flow - leak, 0.0) / qt  # all of it through the displacement
         lo = (eq.empirical_speed_floor(dp_i, self.coef) if self.displacement_law == 'eq39'
               else np.zeros_like(hi))
+        moving = (qt * lo + self._displacement_loss(lo, dp_i) + leak < flow) & (hi > lo)
 
-        def residual(n: FloatArray) -> FloatArray:
-            return qt * n + self._displacement_loss(n, dp_i) + leak - flow
+        def residual(n: FloatArray) -> tuple[FloatArray, FloatArray]:
+            loss = self._displacement_loss(n, dp_i)
+            return qt * n + loss + leak - flow, qt + self._displacement_loss_slopes(
+                n, dp_i, loss)[0]
 
-        f_lo = residual(lo)
-        moving = (f_lo < 0.0) & (hi > lo)
         lo, hi = np.where(moving, lo, 0.0), np.where(moving, hi, 0.0)
-        f_lo = np.where(moving, f_lo, -1.0)
-        f_hi = np.where(moving, residual(hi), 1.0)
-        n, _ = solve_increasing(residual, lo, hi, f_lo, f_hi, xtol=1e-13 * hi + 1e-15,
-                                ftol=1e-12 * flow)
+        n, _ = solve_increasing(residual, lo, hi, hi, xtol=_RTOL * hi + 1e-15,
+                                ftol=_RTOL * flow)
         return np.where(moving, n, 0.0)
 
     def absorbency(self, speed: ArrayLike, dp: ArrayLike | None = None, *,
@@ -516,21 +544,28 @@ class MotorModel:
             status |= below * np.uint8(PointStatus.BEYOND_LIMIT)
 
     def _solve_flow(self, speed: FloatArray, dp: FloatArray, p_ex: FloatArray) -> FloatArray:
+        """Solve eqs. (34)-(36) together for Q at given n and port dp (Newton, bracketed)."""
         qt = self.geometry.displacement
         dp_cap = np.minimum(dp, self.dp_limit)
+        channel_a = self.coef.c_t * self.liquid.density / (LPM * LPM)  # eq. (35) as a Q^2 + b Q
+        channel_b = self.coef.c_l * self.liquid.dynamic_viscosity * 1e3 / LPM
 
-        def absorbed(flow: FloatArray) -> FloatArray:
+        def residual(flow: FloatArray) -> tuple[FloatArray, FloatArray]:
             dp_i = np.maximum(dp_cap - self._channel_drop(flow), 0.0)
             q_lfg, q_c, q_ex = self._leakage(dp_i, p_ex)
-            return qt * speed + self._displacement_loss(speed, dp_i) + q_lfg + q_c + q_ex
+            loss = self._displacement_loss(speed, dp_i)
+            absorbed = qt * speed + loss + q_lfg + q_c + q_ex
+            d_loss = self._displacement_loss_slopes(speed, dp_i, loss)[1]
+            d_absorbed = np.where(dp_i > 0.0, (self._leakage_slope(dp_i, q_lfg, q_c) + d_loss)
+                                  * (2.0 * channel_a * flow + channel_b), 0.0)
+            return flow - absorbed, 1.0 + d_absorbed
 
-        # absorbed() falls as flow rises (more channel drop, less chamber drop), so the flow
-        # without channel drop and its image bracket the fixed point flow = absorbed(flow).
-        upper = absorbed(np.zeros_like(speed))
-        lower = absorbed(upper)
-        flow, _ = solve_increasing(lambda f: f - absorbed(f), lower, upper,
-                                   lower - absorbed(lower), upper - lower,
-                                   xtol=1e-13 * upper + 1e-18, ftol=1e-12 * upper)
+        # The flow absorbed falls as the flow rises (more channel drop, less chamber drop): the
+        # flow without any channel drop is an upper bound, q_t n a lower one.
+        q_lfg, q_c, q_ex = self._leakage(dp_cap, p_ex)
+        upper = qt * speed + self._displacement_loss(speed, dp_cap) + q_lfg + q_c + q_ex
+        flow, _ = solve_increasing(residual, qt * speed, upper, upper,
+                                   xtol=_RTOL * upper + 1e-18, ftol=_RTOL * upper)
         return flow
 
     @staticmethod
