@@ -159,8 +159,14 @@ _Chunk = dict[str, np.ndarray]
 
 
 def _join(parts: list[_Chunk], shape: tuple[int, ...]) -> _Chunk:
-    return {key: (np.concatenate([p[key] for p in parts]) if len(parts) > 1
-                  else parts[0][key]).reshape(shape) for key in parts[0]}
+    joined = {}
+    for key in parts[0]:
+        if np.ndim(parts[0][key]) == 0:  # a component that is zero throughout (no Q_ex)
+            joined[key] = np.zeros(shape)  # calloc'd: no pages written
+        else:
+            values = [p[key] for p in parts]
+            joined[key] = (np.concatenate(values) if len(values) > 1 else values[0]).reshape(shape)
+    return joined
 
 
 class MotorModel:
@@ -278,7 +284,7 @@ class MotorModel:
         h = eq.clearance_height(dp_i, self.geometry, self.coef)
         q_lfg = eq.flat_clearance_leakage(dp_i, h, nu, rho, self.geometry, self.coef)
         q_c = eq.commutation_leakage(dp_i, nu, rho, self.geometry, self.coef)
-        q_ex = eq.external_leakage(p_ex, self.coef)
+        q_ex = eq.external_leakage(p_ex, self.coef) if self.coef.external_leakage else 0.0
         return q_lfg, q_c, q_ex
 
     def _displacement_loss(self, speed: FloatArray, dp_i: FloatArray) -> FloatArray:
@@ -312,7 +318,9 @@ class MotorModel:
             return q_lfg * e * (1.0 / dp_i + 3.0 * h_slope / h) + q_c * self.coef.gamma / dp_i
 
     def _breakdown(self, speed: FloatArray, dp_i: FloatArray, q_lfg: FloatArray,
-                   q_c: FloatArray, q_ex: FloatArray) -> dict[str, FloatArray]:
+                   q_c: FloatArray, q_ex: FloatArray | float,
+                   leak: FloatArray) -> dict[str, FloatArray]:
+        """Return the components of eq. (31); `leak` is Q_Lfg + Q_C + Q_ex."""
         g = self.geometry
         parts = [eq.compressibility_loss(dp_i, speed, self.c_fc_beta, g),
                  eq.deformation_loss(dp_i, speed, self.c_dch, g),
@@ -324,7 +332,7 @@ class MotorModel:
             scale = np.divide(eq.displacement_loss_empirical(dp_i, speed, self.coef), physical,
                               out=np.zeros_like(physical), where=physical > 0.0)
             parts = [p * scale for p in parts]
-        total = (q_lfg + q_c + q_ex) + ((parts[0] + parts[1]) + (parts[2] + parts[3]))
+        total = leak + ((parts[0] + parts[1]) + (parts[2] + parts[3]))
         return dict(zip(COMPONENTS, (q_lfg, q_c, *parts, q_ex, total)))
 
     def _prepare(self, named: dict[str, tuple[ArrayLike, str]],
@@ -457,7 +465,7 @@ class MotorModel:
                 n = self._solve_speed(q, chamber, leak)
             if n.size and n.min() == 0.0:
                 status |= (n == 0.0) * np.uint8(PointStatus.STALLED)
-            losses = self._breakdown(n, chamber, q_lfg, q_c, q_ex)
+            losses = self._breakdown(n, chamber, q_lfg, q_c, q_ex, leak)
             port = dpv if dp is not None else chamber + self._channel_drop(q)
             return self._finish(tuple(given), status, flow=q, speed=n, dp=port, dp_i=chamber,
                                 **losses)
@@ -526,7 +534,7 @@ class MotorModel:
             if self.displacement_law == 'eq39':
                 self._check_empirical_floor(n, chamber, status, errors, at)
             q_lfg, q_c, q_ex = self._leakage(chamber, pex)
-            losses = self._breakdown(n, chamber, q_lfg, q_c, q_ex)
+            losses = self._breakdown(n, chamber, q_lfg, q_c, q_ex, q_lfg + q_c + q_ex)
             flow = self.geometry.displacement * n + losses['total']
             port = dpv if dp is not None else chamber + self._channel_drop(flow)
             return self._finish(tuple(given), status, flow=flow, speed=n, dp=port, dp_i=chamber,
