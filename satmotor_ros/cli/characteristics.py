@@ -81,8 +81,8 @@ def command(out: str, points: int, liquid: str, motor: str | None, law: str,
             raise CliError(f'--points {points}: need at least 2')
         model = build_model(liquid, motor, law, viscosity, density, bulk_modulus)
         dp_i = np.linspace(0.5 * MPA, model.valid_range.dp_max, points)
-        figures = [constant_flow(model, dp_i), constant_speed(model, dp_i),
-                   displacement(model, dp_i), speed_losses(model, dp_i)]
+        figures = [*constant_flow(model, dp_i), constant_speed(model, dp_i),
+                   displacement(model, dp_i)]
         others = {name: build_model(name, motor, law, None, None, None)
                   for name in ('oil', 'water')} if _has_both(motor) else None
         if others is not None:
@@ -105,9 +105,9 @@ def _has_both(motor: str | None) -> bool:
     return {'oil', 'water'} <= set(load_motor(motor).sets)
 
 
-def constant_flow(model: MotorModel, dp_i: np.ndarray) -> Figure:
+def constant_flow(model: MotorModel, dp_i: np.ndarray) -> tuple[Figure, Figure]:
     """
-    Compute Q_vl and speed over dp_i at constant flow (Fig. 8 kind).
+    Compute Q_vl (Fig. 8 kind) and the speed loss n_i, eq. (41), over dp_i at constant flow.
 
     Parameters
     ----------
@@ -118,15 +118,19 @@ def constant_flow(model: MotorModel, dp_i: np.ndarray) -> Figure:
 
     Returns
     -------
-    Figure
-        One curve per flow of :data:`FLOWS_LPM`.
+    tuple of Figure
+        Losses and speed loss, one curve per flow of :data:`FLOWS_LPM`.
 
     """
     op = model.speed(np.array(FLOWS_LPM)[:, None] * LPM, dp_i=dp_i[None, :], errors='mask')
-    return Figure('constant_flow', 'Volumetric losses at constant flow (Fig. 8 kind)',
-                  'Q_vl [l/min]', 'Q [l/min]', FLOWS_LPM,
-                  {'Q_vl [l/min]': op.losses.total / LPM, 'n [rpm]': op.speed / RPM},
-                  ('Q_vl [l/min]',))
+    speed = op.speed / RPM
+    return (Figure('constant_flow', 'Volumetric losses at constant flow (Fig. 8 kind)',
+                   'Q_vl [l/min]', 'Q [l/min]', FLOWS_LPM,
+                   {'Q_vl [l/min]': op.losses.total / LPM, 'n [rpm]': speed},
+                   ('Q_vl [l/min]',)),
+            Figure('speed_loss', 'Speed loss at constant flow, eq. (41)', 'n_i [rpm]',
+                   'Q [l/min]', FLOWS_LPM,
+                   {'n_i [rpm]': op.speed_loss / RPM, 'n [rpm]': speed}, ('n_i [rpm]',)))
 
 
 def constant_speed(model: MotorModel, dp_i: np.ndarray) -> Figure:
@@ -184,30 +188,6 @@ def displacement(model: MotorModel, dp_i: np.ndarray) -> Figure:
                   'dq [cm^3/rev]', 'n [rpm]', SPEEDS_RPM,
                   {'dq eq.33 [cm^3/rev]': dq33 * to_cm3, 'dq eq.39 [cm^3/rev]': dq39 * to_cm3},
                   ('dq eq.33 [cm^3/rev]', 'dq eq.39 [cm^3/rev]'))
-
-
-def speed_losses(model: MotorModel, dp_i: np.ndarray) -> Figure:
-    """
-    Compute the speed loss n_i over dp_i at constant flow, eq. (41).
-
-    Parameters
-    ----------
-    model : MotorModel
-        The model, [-]
-    dp_i : ndarray
-        Chamber pressure drops, [Pa]
-
-    Returns
-    -------
-    Figure
-        One curve per flow of :data:`FLOWS_LPM`.
-
-    """
-    op = model.speed(np.array(FLOWS_LPM)[:, None] * LPM, dp_i=dp_i[None, :], errors='mask')
-    return Figure('speed_loss', 'Speed loss at constant flow, eq. (41)', 'n_i [rpm]',
-                  'Q [l/min]', FLOWS_LPM,
-                  {'n_i [rpm]': op.speed_loss / RPM, 'n [rpm]': op.speed / RPM},
-                  ('n_i [rpm]',))
 
 
 def water_against_oil(water: MotorModel, oil: MotorModel, dp_i: np.ndarray) -> Figure:

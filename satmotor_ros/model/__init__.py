@@ -13,8 +13,9 @@ from satmotor_ros.model.coefficients import (CoefficientSet, Liquid, LossCoeffic
 from satmotor_ros.model.config import (default_config_path, liquid_from_mapping, load_motor,
                                        MotorSpec)
 from satmotor_ros.model.errors import ConfigError, InvalidInputError, ModelError, UnitError
-from satmotor_ros.model.motor import (COMPONENTS, describe_status, INVALID, LossBreakdown,
-                                      MotorModel, OperatingPoints, PointStatus)
+from satmotor_ros.model.motor import MotorModel
+from satmotor_ros.model.results import (COMPONENTS, describe_status, INVALID, LossBreakdown,
+                                        OperatingPoints, PointStatus)
 
 __all__ = [
     'COMPONENTS', 'CoefficientSet', 'ConfigError', 'INVALID', 'InvalidInputError', 'Liquid',

@@ -15,8 +15,6 @@ arrays of operating points and screens its inputs element by element: with
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, fields
-import enum
 from typing import Literal
 
 import numpy as np
@@ -28,92 +26,14 @@ from satmotor_ros.model.coefficients import (CoefficientSet, Liquid, MotorGeomet
                                              ValidRange)
 from satmotor_ros.model.config import load_motor, MotorSpec
 from satmotor_ros.model.errors import InvalidInputError, ModelError
+from satmotor_ros.model.results import (COMPONENTS, INVALID, LossBreakdown, OperatingPoints,
+                                        PointStatus)
 from satmotor_ros.model.solve import solve_increasing
 from satmotor_ros.model.speed import effective_speed, speed_loss
 from satmotor_ros.model.units import LPM, MPA, RPM
 
 Errors = Literal['raise', 'mask']
 DisplacementLaw = Literal['eq33', 'eq39']
-
-
-class PointStatus(enum.IntFlag):
-    """Per-element outcome of a model evaluation; flags combine."""
-
-    OK = 0
-    STALLED = 1  # the leakage takes all the flow: n = 0 (a physical result)
-    CHANNEL_LIMITED = 2  # dp_ich >= dp: the chamber drop dp_i is clipped to 0
-    EXTRAPOLATED = 4  # beyond the coefficient set's validated range (computed)
-    NOT_FINITE = 8  # NaN or inf input (invalid: output NaN)
-    NEGATIVE = 16  # negative flow, speed or pressure drop (invalid: output NaN)
-    BEYOND_LIMIT = 32  # where the equations stop being physical (invalid: output NaN)
-
-
-INVALID = PointStatus.NOT_FINITE | PointStatus.NEGATIVE | PointStatus.BEYOND_LIMIT
-"""The flags that make an element invalid (its outputs are NaN)."""
-
-COMPONENTS = ('flat_clearance', 'commutation', 'compressibility', 'deformation', 'backlash',
-              'inertia', 'external', 'total')
-"""Loss component names, as on the ``losses/<component>`` topics."""
-
-
-@dataclass(frozen=True)
-class LossBreakdown:
-    """The volumetric losses of eq. (31), by component, [m^3/s]."""
-
-    flat_clearance: FloatArray  # Q_Lfg, eq. (1)
-    commutation: FloatArray  # Q_C, eq. (5)
-    compressibility: FloatArray  # Delta Q_fc, eq. (11)
-    deformation: FloatArray  # Delta Q_dch, eq. (12)
-    backlash: FloatArray  # Delta Q_b, eq. (13)
-    inertia: FloatArray  # Delta Q_id, eq. (14)
-    external: FloatArray  # Q_ex, eq. (24)
-    total: FloatArray  # Q_vl, eq. (31)
-
-    def as_dict(self) -> dict[str, FloatArray]:
-        """Return the components by name, in :data:`COMPONENTS` order."""
-        return {f.name: getattr(self, f.name) for f in fields(self)}
-
-
-@dataclass(frozen=True)
-class OperatingPoints:
-    """Operating points of the motor and their losses, all SI."""
-
-    flow: FloatArray  # absorbency Q [m^3/s]
-    speed: FloatArray  # effective shaft speed n [rad/s]
-    dp: FloatArray  # pressure drop between the ports [Pa]
-    dp_i: FloatArray  # pressure drop in the working chambers [Pa]
-    speed_loss: FloatArray  # n_i of eq. (41) [rad/s]
-    losses: LossBreakdown
-    status: npt.NDArray[np.uint8]  # PointStatus flags per element
-
-    @property
-    def invalid(self) -> npt.NDArray[np.bool_]:
-        """Mask of the elements whose outputs are NaN."""
-        return (self.status & int(INVALID)) != 0
-
-
-def describe_status(code: int) -> str:
-    """
-    Spell out a status code.
-
-    Parameters
-    ----------
-    code : int
-        A :class:`PointStatus` value, [-]
-
-    Returns
-    -------
-    str
-        Flag names joined by ``|``, or ``'OK'``.
-
-    Examples
-    --------
-    >>> describe_status(PointStatus.STALLED | PointStatus.EXTRAPOLATED)
-    'STALLED|EXTRAPOLATED'
-
-    """
-    names = [flag.name for flag in PointStatus if flag and code & flag]
-    return '|'.join(n for n in names if n) or 'OK'
 
 
 _CHUNK = 8192
@@ -222,9 +142,9 @@ class MotorModel:
         self.c_b = rest - self.c_dch
         self.c = self.c_fc_beta + rest
         h0 = float(eq.clearance_height(0.0, geometry, coef))
-        slope = h0 - float(eq.clearance_height(1.0, geometry, coef))  # [m/Pa]
-        # Q_Lfg ~ (h^3 dp)^e rises with dp only while h + 3 h' dp > 0, i.e. dp < h0 / (4 slope)
-        self.dp_limit = h0 / (4.0 * slope) if slope > 0.0 else np.inf
+        self._h_slope = float(eq.clearance_height(1.0, geometry, coef)) - h0  # dh/dp_i [m/Pa]
+        # Q_Lfg ~ (h^3 dp)^e rises with dp only while h + 3 h' dp > 0, i.e. dp < h0 / (-4 h')
+        self.dp_limit = h0 / (-4.0 * self._h_slope) if self._h_slope < 0.0 else np.inf
 
     @classmethod
     def from_spec(cls, spec: MotorSpec, coefficients: str = 'oil', liquid: Liquid | None = None,
@@ -311,11 +231,10 @@ class MotorModel:
                        q_c: FloatArray) -> FloatArray:
         """Return d(Q_Lfg + Q_C)/d(dp_i) of eqs. (1), (2) and (5) at the given leakages."""
         h = eq.clearance_height(dp_i, self.geometry, self.coef)
-        h_slope = float(eq.clearance_height(1.0, self.geometry, self.coef)) - (
-            float(eq.clearance_height(0.0, self.geometry, self.coef)))  # dh/d(dp_i) [m/Pa]
         e = 1.0 / (2.0 - self.coef.beta)
         with np.errstate(divide='ignore', invalid='ignore'):
-            return q_lfg * e * (1.0 / dp_i + 3.0 * h_slope / h) + q_c * self.coef.gamma / dp_i
+            return (q_lfg * e * (1.0 / dp_i + 3.0 * self._h_slope / h)
+                    + q_c * self.coef.gamma / dp_i)
 
     def _breakdown(self, speed: FloatArray, dp_i: FloatArray, q_lfg: FloatArray,
                    q_c: FloatArray, q_ex: FloatArray | float,

@@ -1,0 +1,98 @@
+# SPDX-License-Identifier: Apache-2.0
+"""What the model returns: operating points, their loss breakdown and a status per element."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, fields
+import enum
+
+import numpy as np
+import numpy.typing as npt
+
+from satmotor_ros.model._typing import FloatArray
+
+
+class PointStatus(enum.IntFlag):
+    """Per-element outcome of a model evaluation; flags combine."""
+
+    OK = 0
+    STALLED = 1  # the leakage takes all the flow: n = 0 (a physical result)
+    CHANNEL_LIMITED = 2  # dp_ich >= dp: the chamber drop dp_i is clipped to 0
+    EXTRAPOLATED = 4  # beyond the coefficient set's validated range (computed)
+    NOT_FINITE = 8  # NaN or inf input (invalid: output NaN)
+    NEGATIVE = 16  # negative flow, speed or pressure drop (invalid: output NaN)
+    BEYOND_LIMIT = 32  # where the equations stop being physical (invalid: output NaN)
+
+
+INVALID = PointStatus.NOT_FINITE | PointStatus.NEGATIVE | PointStatus.BEYOND_LIMIT
+"""The flags that make an element invalid (its outputs are NaN)."""
+
+COMPONENTS = ('flat_clearance', 'commutation', 'compressibility', 'deformation', 'backlash',
+              'inertia', 'external', 'total')
+"""Loss component names, as on the ``losses/<component>`` topics."""
+
+
+@dataclass(frozen=True)
+class LossBreakdown:
+    """The volumetric losses of eq. (31), by component, [m^3/s]."""
+
+    flat_clearance: FloatArray  # Q_Lfg, eq. (1)
+    commutation: FloatArray  # Q_C, eq. (5)
+    compressibility: FloatArray  # Delta Q_fc, eq. (11)
+    deformation: FloatArray  # Delta Q_dch, eq. (12)
+    backlash: FloatArray  # Delta Q_b, eq. (13)
+    inertia: FloatArray  # Delta Q_id, eq. (14)
+    external: FloatArray  # Q_ex, eq. (24)
+    total: FloatArray  # Q_vl, eq. (31)
+
+    def as_dict(self) -> dict[str, FloatArray]:
+        """Return the components by name, in :data:`COMPONENTS` order."""
+        return {f.name: getattr(self, f.name) for f in fields(self)}
+
+
+@dataclass(frozen=True)
+class OperatingPoints:
+    """
+    Operating points of the motor and their losses, all SI.
+
+    The inputs of the call (``flow`` and ``dp`` of ``speed()``, ``speed`` and
+    ``dp`` of ``absorbency()``) are the caller's arrays, broadcast, not copies;
+    where an element is invalid every field holds NaN.
+    """
+
+    flow: FloatArray  # absorbency Q [m^3/s]
+    speed: FloatArray  # effective shaft speed n [rad/s]
+    dp: FloatArray  # pressure drop between the ports [Pa]
+    dp_i: FloatArray  # pressure drop in the working chambers [Pa]
+    speed_loss: FloatArray  # n_i of eq. (41) [rad/s]
+    losses: LossBreakdown
+    status: npt.NDArray[np.uint8]  # PointStatus flags per element
+
+    @property
+    def invalid(self) -> npt.NDArray[np.bool_]:
+        """Mask of the elements whose outputs are NaN."""
+        return (self.status & int(INVALID)) != 0
+
+
+def describe_status(code: int) -> str:
+    """
+    Spell out a status code.
+
+    Parameters
+    ----------
+    code : int
+        A :class:`PointStatus` value, [-]
+
+    Returns
+    -------
+    str
+        Flag names joined by ``|``, or ``'OK'``.
+
+    Examples
+    --------
+    >>> describe_status(PointStatus.STALLED | PointStatus.EXTRAPOLATED)
+    'STALLED|EXTRAPOLATED'
+
+    """
+    names = [flag.name for flag in PointStatus if flag and code & flag]
+    return '|'.join(n for n in names if n) or 'OK'
