@@ -110,3 +110,16 @@ def test_scalar_and_array_inputs_keep_their_shape(oil, shape):
     assert op.losses.total.shape == shape
     assert op.status.shape == shape
     np.testing.assert_allclose(op.speed, float(oil.speed(10 * LPM, 10 * MPA).speed))
+
+
+def test_mask_mode_over_many_chunks_keeps_every_field_aligned(oil):
+    flow = np.full(50_000, 10 * LPM)
+    dp = np.full(50_000, 10 * MPA)
+    flow[[3, 30_000]] = np.nan
+    op = oil.speed(flow, dp, errors='mask')
+    assert np.flatnonzero(op.invalid).tolist() == [3, 30_000]
+    for value in (op.speed, op.dp_i, op.speed_loss, *op.losses.as_dict().values()):
+        assert value.shape == (50_000,)
+        assert np.isnan(value[[3, 30_000]]).all()
+        assert np.isfinite(np.delete(value, [3, 30_000])).all()
+    assert (op.losses.external[op.losses.external == op.losses.external] == 0.0).all()

@@ -81,11 +81,12 @@ _Chunk = dict[str, np.ndarray]
 def _join(parts: list[_Chunk], shape: tuple[int, ...]) -> _Chunk:
     joined = {}
     for key in parts[0]:
-        if np.ndim(parts[0][key]) == 0:  # a component that is zero throughout (no Q_ex)
+        values = [p[key] for p in parts]
+        if all(np.ndim(v) == 0 for v in values):  # a component that is 0 throughout (no Q_ex)
             joined[key] = np.zeros(shape)  # calloc'd: no pages written
-        else:
-            values = [p[key] for p in parts]
-            joined[key] = (np.concatenate(values) if len(values) > 1 else values[0]).reshape(shape)
+            continue
+        values = [np.broadcast_to(v, p['status'].shape) for v, p in zip(values, parts)]
+        joined[key] = (np.concatenate(values) if len(values) > 1 else values[0]).reshape(shape)
     return joined
 
 
