@@ -29,7 +29,7 @@ from satmotor_ros.model.errors import InvalidInputError, ModelError
 from satmotor_ros.model.results import (COMPONENTS, INVALID, LossBreakdown, OperatingPoints,
                                         PointStatus)
 from satmotor_ros.model.solve import solve_increasing
-from satmotor_ros.model.speed import effective_speed, speed_loss
+from satmotor_ros.model.speed import absorbency, effective_speed, speed_loss
 from satmotor_ros.model.units import LPM, MPA, RPM
 
 Errors = Literal['raise', 'mask']
@@ -398,12 +398,13 @@ class MotorModel:
         hi = np.maximum(flow - leak, 0.0) / qt  # all of it through the displacement
         lo = (eq.empirical_speed_floor(dp_i, self.coef) if self.displacement_law == 'eq39'
               else np.zeros_like(hi))
-        moving = (qt * lo + self._displacement_loss(lo, dp_i) + leak < flow) & (hi > lo)
+        moving = (absorbency(lo, self._displacement_loss(lo, dp_i) + leak, self.geometry) < flow) \
+            & (hi > lo)
 
         def residual(n: FloatArray) -> tuple[FloatArray, FloatArray]:
             loss = self._displacement_loss(n, dp_i)
-            return qt * n + loss + leak - flow, qt + self._displacement_loss_slopes(
-                n, dp_i, loss)[0]
+            return (absorbency(n, loss + leak, self.geometry) - flow,
+                    qt + self._displacement_loss_slopes(n, dp_i, loss)[0])
 
         lo, hi = np.where(moving, lo, 0.0), np.where(moving, hi, 0.0)
         n, _ = solve_increasing(residual, lo, hi, hi, xtol=_RTOL * hi + 1e-15,
@@ -454,8 +455,9 @@ class MotorModel:
             if self.displacement_law == 'eq39':
                 self._check_empirical_floor(n, chamber, status, errors, at)
             q_lfg, q_c, q_ex = self._leakage(chamber, pex)
-            losses = self._breakdown(n, chamber, q_lfg, q_c, q_ex, q_lfg + q_c + q_ex)
-            flow = self.geometry.displacement * n + losses['total']
+            leak = q_lfg + q_c + q_ex
+            losses = self._breakdown(n, chamber, q_lfg, q_c, q_ex, leak)
+            flow = absorbency(n, losses['total'], self.geometry)
             port = dpv if dp is not None else chamber + self._channel_drop(flow)
             return self._finish(tuple(given), status, flow=flow, speed=n, dp=port, dp_i=chamber,
                                 **losses)
@@ -482,7 +484,7 @@ class MotorModel:
             dp_i = np.maximum(dp_cap - self._channel_drop(flow), 0.0)
             q_lfg, q_c, q_ex = self._leakage(dp_i, p_ex)
             loss = self._displacement_loss(speed, dp_i)
-            absorbed = qt * speed + loss + q_lfg + q_c + q_ex
+            absorbed = absorbency(speed, loss + q_lfg + q_c + q_ex, self.geometry)
             d_loss = self._displacement_loss_slopes(speed, dp_i, loss)[1]
             d_absorbed = np.where(dp_i > 0.0, (self._leakage_slope(dp_i, q_lfg, q_c) + d_loss)
                                   * (2.0 * channel_a * flow + channel_b), 0.0)
@@ -491,7 +493,8 @@ class MotorModel:
         # The flow absorbed falls as the flow rises (more channel drop, less chamber drop): the
         # flow without any channel drop is an upper bound, q_t n a lower one.
         q_lfg, q_c, q_ex = self._leakage(dp_cap, p_ex)
-        upper = qt * speed + self._displacement_loss(speed, dp_cap) + q_lfg + q_c + q_ex
+        upper = absorbency(speed, self._displacement_loss(speed, dp_cap) + q_lfg + q_c + q_ex,
+                           self.geometry)
         flow, _ = solve_increasing(residual, qt * speed, upper, upper,
                                    xtol=_RTOL * upper + 1e-18, ftol=_RTOL * upper)
         return flow

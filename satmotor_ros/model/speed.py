@@ -12,21 +12,19 @@ from satmotor_ros.model.units import MPA, RPM
 _CM3_PER_MIN = 1.0e-6 / 60.0  # one cm^3/min in m^3/s
 
 
-def absorbency(speed: ArrayLike, dq: ArrayLike, leakage: ArrayLike,
-               geometry: MotorGeometry) -> FloatArray:
+def absorbency(speed: ArrayLike, losses: ArrayLike, geometry: MotorGeometry) -> FloatArray:
     r"""
     Compute the flow a motor absorbs at a given speed, eq. (36).
 
-    .. math:: Q = q_t\,n + \Delta q\,n + Q_{Lfg} + Q_C + Q_{ex}
+    .. math:: Q = q_t\,n + Q_{vl},\quad
+        Q_{vl} = \Delta q\,n + Q_{Lfg} + Q_C + Q_{ex}
 
     Parameters
     ----------
     speed : float or ndarray
         Shaft speed n, [rad/s]
-    dq : float or ndarray
-        Change of displacement Delta q, eq. (33) or (39), [m^3/rad]
-    leakage : float or ndarray
-        Speed-independent losses Q_Lfg + Q_C + Q_ex, [m^3/s]
+    losses : float or ndarray
+        Volumetric losses Q_vl of eq. (31), [m^3/s]
     geometry : MotorGeometry
         Motor geometry (q_t), [-]
 
@@ -36,8 +34,7 @@ def absorbency(speed: ArrayLike, dq: ArrayLike, leakage: ArrayLike,
         Absorbency Q, [m^3/s]
 
     """
-    speed = np.asarray(speed, dtype=float)
-    return (geometry.displacement + np.asarray(dq, dtype=float)) * speed + leakage
+    return geometry.displacement * np.asarray(speed, dtype=float) + losses
 
 
 def effective_speed(flow: ArrayLike, dp_i: ArrayLike, leakage: ArrayLike, c: float,
