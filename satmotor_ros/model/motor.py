@@ -29,7 +29,7 @@ from satmotor_ros.model.errors import InvalidInputError, ModelError
 from satmotor_ros.model.results import (COMPONENTS, INVALID, LossBreakdown, OperatingPoints,
                                         PointStatus)
 from satmotor_ros.model.solve import solve_increasing
-from satmotor_ros.model.speed import absorbency, effective_speed, speed_loss
+from satmotor_ros.model.speed import absorbency, effective_speed
 from satmotor_ros.model.units import LPM, MPA, RPM
 
 Errors = Literal['raise', 'mask']
@@ -82,10 +82,12 @@ def _join(parts: list[_Chunk], shape: tuple[int, ...]) -> _Chunk:
     joined = {}
     for key in parts[0]:
         values = [p[key] for p in parts]
-        if all(np.ndim(v) == 0 for v in values):  # a component that is 0 throughout (no Q_ex)
+        scalar = [np.ndim(v) == 0 for v in values]
+        if all(scalar):  # a component that is 0 throughout (no Q_ex)
             joined[key] = np.zeros(shape)  # calloc'd: no pages written
             continue
-        values = [np.broadcast_to(v, p['status'].shape) for v, p in zip(values, parts)]
+        if any(scalar):  # 0 in some chunks, masked to NaN in others
+            values = [np.broadcast_to(v, p['status'].shape) for v, p in zip(values, parts)]
         joined[key] = (np.concatenate(values) if len(values) > 1 else values[0]).reshape(shape)
     return joined
 
@@ -270,8 +272,7 @@ class MotorModel:
                 status |= flag
         return arrays, status
 
-    @staticmethod
-    def _run(core: Callable[..., _Chunk], arrays: list[FloatArray],
+    def _run(self, core: Callable[..., _Chunk], arrays: list[FloatArray],
              status: npt.NDArray[np.uint8], given: dict[str, FloatArray]) -> OperatingPoints:
         """Evaluate `core` chunk by chunk; inputs named in `given` are returned, not copied."""
         shape = status.shape
@@ -286,7 +287,7 @@ class MotorModel:
         for name, value in given.items():
             fields_[name] = np.where(invalid, np.nan, value) if invalid.any() else value
         losses = LossBreakdown(**{k: fields_.pop(k) for k in COMPONENTS})
-        return OperatingPoints(losses=losses, **fields_)
+        return OperatingPoints(losses=losses, geometry=self.geometry, **fields_)
 
     def _channel_drop(self, flow: FloatArray) -> FloatArray:
         return eq.channel_pressure_drop(flow, self.liquid.kinematic_viscosity,
@@ -317,13 +318,12 @@ class MotorModel:
 
     def _finish(self, given: tuple[str, ...], status: npt.NDArray[np.uint8],
                 **values: FloatArray) -> _Chunk:
-        """Flag extrapolation, add eq. (41), NaN the invalid; drop the inputs in `given`."""
+        """Flag extrapolation and NaN the invalid; drop the inputs in `given`."""
         speed, dp_i = values['speed'], values['dp_i']
         limits = self.valid_range
         if speed.size and (dp_i.max() > limits.dp_max or speed.max() > limits.speed_max):
             status |= ((dp_i > limits.dp_max) | (speed > limits.speed_max)) \
                 * np.uint8(PointStatus.EXTRAPOLATED)
-        values['speed_loss'] = speed_loss(values['flow'], speed, self.geometry)
         chunk = {k: v for k, v in values.items() if k not in given}
         invalid = (status & int(INVALID)) != 0 if status.any() else None
         if invalid is not None and invalid.any():

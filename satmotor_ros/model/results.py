@@ -10,6 +10,8 @@ import numpy as np
 import numpy.typing as npt
 
 from satmotor_ros.model._typing import FloatArray
+from satmotor_ros.model.coefficients import MotorGeometry
+from satmotor_ros.model.speed import speed_loss
 
 
 class PointStatus(enum.IntFlag):
@@ -64,9 +66,14 @@ class OperatingPoints:
     speed: FloatArray  # effective shaft speed n [rad/s]
     dp: FloatArray  # pressure drop between the ports [Pa]
     dp_i: FloatArray  # pressure drop in the working chambers [Pa]
-    speed_loss: FloatArray  # n_i of eq. (41) [rad/s]
     losses: LossBreakdown
     status: npt.NDArray[np.uint8]  # PointStatus flags per element
+    geometry: MotorGeometry  # the motor the points belong to
+
+    @property
+    def speed_loss(self) -> FloatArray:
+        """Speed loss n_i against the theoretical speed Q/q_t, eq. (41), [rad/s]."""
+        return speed_loss(self.flow, self.speed, self.geometry)
 
     @property
     def invalid(self) -> npt.NDArray[np.bool_]:
