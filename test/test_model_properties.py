@@ -107,3 +107,16 @@ def test_components_add_up_to_total_and_split_keeps_lumped_c():
         total = parts.pop('total')
         np.testing.assert_allclose(sum(parts.values()), total, rtol=1e-12)
         assert model.c_fc_beta + model.c_dch + model.c_b == pytest.approx(model.coef.c)
+
+
+@PROPERTY
+@given(base=liquids, law=laws, nu_cst=st.floats(0.3, 300.0), rho=st.floats(600.0, 1300.0),
+       bulk_gpa=st.floats(0.8, 3.0), n=speeds, dp=drops)
+def test_maps_round_trip_for_any_user_liquid(base, law, nu_cst, rho, bulk_gpa, n, dp):
+    from satmotor_ros.model import Liquid, load_motor
+    liquid = Liquid('user', nu_cst * 1e-6, rho, bulk_gpa * 1e9)
+    model = MotorModel.from_spec(load_motor(), base, liquid, law)
+    forward = model.absorbency(n * RPM, dp * MPA, errors='mask')
+    assert not forward.invalid.any()
+    back = model.speed(forward.flow, dp * MPA)
+    assert float(back.speed) == pytest.approx(n * RPM, rel=1e-8)
