@@ -30,7 +30,7 @@ from satmotor_ros.model.results import (COMPONENTS, INVALID, LossBreakdown, Oper
                                         PointStatus)
 from satmotor_ros.model.solve import solve_increasing
 from satmotor_ros.model.speed import absorbency, effective_speed
-from satmotor_ros.model.units import LPM, MPA, RPM
+from satmotor_ros.model.units import MPA, RPM
 
 Errors = Literal['raise', 'mask']
 DisplacementLaw = Literal['eq33', 'eq39']
@@ -152,6 +152,12 @@ class MotorModel:
         self.c = self.c_fc_beta + rest
         h0 = float(eq.clearance_height(0.0, geometry, coef))
         self._h_slope = float(eq.clearance_height(1.0, geometry, coef)) - h0  # dh/dp_i [m/Pa]
+        # eq. (33) as Delta Q_vl = k_p dp_i n + k_i sqrt(n), eq. (35) as dp_ich = a Q^2 + b Q:
+        # the constants read off the equation functions, for the solvers' slopes
+        self._k_p = float(eq.compressibility_loss(1.0, 1.0, self.c, geometry))
+        self._k_i = float(eq.inertia_loss(1.0, coef.c_id, geometry))
+        plus, minus = (float(self._channel_drop(q)) for q in (1.0, -1.0))
+        self._channel_a, self._channel_b = 0.5 * (plus + minus), 0.5 * (plus - minus)
         # Q_Lfg ~ (h^3 dp)^e rises with dp only while h + 3 h' dp > 0, i.e. dp < h0 / (-4 h')
         self.dp_limit = h0 / (-4.0 * self._h_slope) if self._h_slope < 0.0 else np.inf
 
@@ -231,10 +237,8 @@ class MotorModel:
                 log_dp = np.log(dp_i / MPA)
                 d_speed = loss * (1.0 - self.coef.c2_39 * log_dp * inv_s) / (2.0 * speed)
                 return d_speed, loss * self.coef.c2_39 * inv_s / dp_i
-            # Delta Q_vl = k_p dp_i n + k_i sqrt(n)
-            k_p = float(eq.compressibility_loss(1.0, 1.0, self.c, self.geometry))
-            k_i = float(eq.inertia_loss(1.0, self.coef.c_id, self.geometry))
-            return k_p * dp_i + 0.5 * k_i / np.sqrt(speed), k_p * speed
+            return (self._k_p * dp_i + 0.5 * self._k_i / np.sqrt(speed),
+                    self._k_p * speed)
 
     def _leakage_slope(self, dp_i: FloatArray, q_lfg: FloatArray,
                        q_c: FloatArray) -> FloatArray:
@@ -314,15 +318,13 @@ class MotorModel:
         if dp_i.size == 0 or dp_i.max() <= self.dp_limit:
             return dp_i
         beyond = dp_i > self.dp_limit
-        if beyond.any():
-            if errors == 'raise':
-                _raise_first(dp_name, 'Pa', dp_value, beyond,
-                             f'chamber pressure drop beyond the model limit '
-                             f'{self.dp_limit / MPA:.1f} MPa, where eq. (2) closes the clearance'
-                             f' so fast that eq. (1) would fall with pressure', at)
-            status |= beyond * np.uint8(PointStatus.BEYOND_LIMIT)
-            dp_i = np.where(beyond, 0.0, dp_i)
-        return dp_i
+        if errors == 'raise':
+            _raise_first(dp_name, 'Pa', dp_value, beyond,
+                         f'chamber pressure drop beyond the model limit '
+                         f'{self.dp_limit / MPA:.1f} MPa, where eq. (2) closes the clearance'
+                         f' so fast that eq. (1) would fall with pressure', at)
+        status |= beyond * np.uint8(PointStatus.BEYOND_LIMIT)
+        return np.where(beyond, 0.0, dp_i)
 
     def _finish(self, given: tuple[str, ...], status: npt.NDArray[np.uint8],
                 **values: FloatArray) -> _Chunk:
@@ -485,8 +487,6 @@ class MotorModel:
         """Solve eqs. (34)-(36) together for Q at given n and port dp (Newton, bracketed)."""
         qt = self.geometry.displacement
         dp_cap = np.minimum(dp, self.dp_limit)
-        channel_a = self.coef.c_t * self.liquid.density / (LPM * LPM)  # eq. (35) as a Q^2 + b Q
-        channel_b = self.coef.c_l * self.liquid.dynamic_viscosity * 1e3 / LPM
 
         def residual(flow: FloatArray) -> tuple[FloatArray, FloatArray]:
             dp_i = np.maximum(dp_cap - self._channel_drop(flow), 0.0)
@@ -495,7 +495,7 @@ class MotorModel:
             absorbed = absorbency(speed, loss + q_lfg + q_c + q_ex, self.geometry)
             d_loss = self._displacement_loss_slopes(speed, dp_i, loss)[1]
             d_absorbed = np.where(dp_i > 0.0, (self._leakage_slope(dp_i, q_lfg, q_c) + d_loss)
-                                  * (2.0 * channel_a * flow + channel_b), 0.0)
+                                  * (2.0 * self._channel_a * flow + self._channel_b), 0.0)
             return flow - absorbed, 1.0 + d_absorbed
 
         # The flow absorbed falls as the flow rises (more channel drop, less chamber drop): the
