@@ -46,6 +46,9 @@ setup(
     entry_points={
         'console_scripts': [
             'satmotor = satmotor_ros.cli:main',
+            'motor_model = satmotor_ros.nodes.motor_model:main',
+            'virtual_motor = satmotor_ros.nodes.virtual_motor:main',
+            'speed_controller = satmotor_ros.nodes.speed_controller:main',
         ],
     },
 )
