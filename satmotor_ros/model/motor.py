@@ -50,6 +50,15 @@ closed-form evaluation is a single pass, where chunking would only add a copy.
 _RTOL = 1e-13
 """Relative tolerance of the iterative maps: Newton polishes well below it, bisection to it."""
 
+_CHECK = 1e-10
+"""Largest relative residual an iterative solve may leave before its point is flagged."""
+
+_FLOW_ATOL = 1e-20
+"""Absolute resolution of flows in the solves and their check, [m^3/s] (6e-16 l/min)."""
+
+_ROOT_ATOL = 1e-20
+"""Absolute resolution of sqrt(n) in the speed solve, [(rad/s)^0.5]; worth < 1e-23 m^3/s."""
+
 At = tuple[int, tuple[int, ...]]
 """Where a chunk sits in the batch: flat offset and the batch's shape (for error messages)."""
 
@@ -68,6 +77,20 @@ def _screen(name: str, unit: str, value: FloatArray,
         _raise_first(name, unit, value, negative, 'negative', at)
     return (not_finite * np.uint8(PointStatus.NOT_FINITE)
             | negative * np.uint8(PointStatus.NEGATIVE)).astype(np.uint8)
+
+
+def _numbers(name: str, value: ArrayLike) -> FloatArray:
+    """Return `value` as a float array, refusing strings, booleans and other non-numbers."""
+    raw = np.asarray(value)
+    if raw.dtype.kind not in 'iuf':
+        got = type(value).__name__ if raw.ndim == 0 else f'an array of {raw.dtype}'
+        msg = f'{name} = {_clip(repr(value))}: expected numbers, got {got}'
+        raise InvalidInputError(msg)
+    return raw.astype(float, copy=False)
+
+
+def _clip(text: str, width: int = 60) -> str:
+    return text if len(text) <= width else text[:width - 3] + '...'
 
 
 def _raise_first(name: str, unit: str, value: FloatArray, bad: npt.NDArray[np.bool_],
@@ -151,7 +174,7 @@ class MotorModel:
         self._k_p, self._k_i = d.k_p, d.k_i
         self._channel_a, self._channel_b = d.ch_a, d.ch_b
         self.dp_limit = d.dp_limit
-        self._point = PointEvaluator(d, displacement_law == 'eq39', _RTOL)
+        self._point = PointEvaluator(d, displacement_law == 'eq39')
 
     @classmethod
     def from_spec(cls, spec: MotorSpec, coefficients: str = 'oil', liquid: Liquid | None = None,
@@ -265,10 +288,15 @@ class MotorModel:
         if errors not in ('raise', 'mask'):
             msg = f"errors = {errors!r}: use 'raise' or 'mask'"
             raise ModelError(msg)
-        values = [np.asarray(v, dtype=float) for v, _ in named.values()]
+        values = [_numbers(name, v) for name, (v, _) in named.items()]
         flags = [_screen(name, unit, value, errors)
                  for (name, (_, unit)), value in zip(named.items(), values)]
-        arrays = np.broadcast_arrays(*values)
+        try:
+            arrays = np.broadcast_arrays(*values)
+        except ValueError:
+            shapes = ', '.join(f'{name} {value.shape}' for name, value in zip(named, values))
+            msg = f'the shapes of the arguments do not broadcast together: {shapes}'
+            raise InvalidInputError(msg) from None
         status = np.zeros(arrays[0].shape, dtype=np.uint8)
         for flag in flags:
             if flag is not None:
@@ -291,6 +319,10 @@ class MotorModel:
         invalid = (fields_['status'] & int(INVALID)) != 0
         for name, value in given.items():
             fields_[name] = np.where(invalid, np.nan, value) if invalid.any() else value
+        for name, value in fields_.items():  # the results own their data, read-only
+            if any(np.may_share_memory(value, a) for a in arrays):
+                value = fields_[name] = value.copy()
+            value.flags.writeable = False
         losses = LossBreakdown(**{k: fields_.pop(k) for k in COMPONENTS})
         return OperatingPoints(losses=losses, geometry=self.geometry, **fields_)
 
@@ -319,14 +351,45 @@ class MotorModel:
         status |= beyond * np.uint8(PointStatus.BEYOND_LIMIT)
         return np.where(beyond, 0.0, dp_i)
 
+    def _check_solution(self, value: FloatArray, target: FloatArray,
+                        converged: npt.NDArray[np.bool_], checked: npt.NDArray[np.bool_],
+                        status: npt.NDArray[np.uint8], errors: Errors,
+                        name: tuple[str, str, FloatArray, At], what: str) -> None:
+        """
+        Flag the points where an iterative solve left a residual, or did not converge.
+
+        `value` is the flow eq. (36) gives at the solution and `target` the
+        flow it had to match, compared where `checked`. A solve that converged
+        yet leaves a residual has closed its bracket on a jump: NO_ROOT. One
+        that ran out of iterations is NOT_CONVERGED. Invalid points keep their
+        flags; with ``errors='raise'`` the first flagged point raises.
+        """
+        with np.errstate(invalid='ignore'):
+            off = ~(np.abs(value - target) <= _CHECK * np.abs(target) + _FLOW_ATOL)
+        open_ = checked & ((status & int(INVALID)) == 0)
+        status |= (off & converged & open_) * np.uint8(PointStatus.NO_ROOT)
+        status |= (~converged & open_) * np.uint8(PointStatus.NOT_CONVERGED)
+        if errors == 'raise':
+            arg, unit, values, at = name
+            no_root = (status & np.uint8(PointStatus.NO_ROOT)) != 0
+            if no_root.any():
+                _raise_first(arg, unit, values, no_root, f'{what} has no root here', at)
+            not_converged = (status & np.uint8(PointStatus.NOT_CONVERGED)) != 0
+            if not_converged.any():
+                _raise_first(arg, unit, values, not_converged, f'{what} did not converge', at)
+
     def _finish(self, given: tuple[str, ...], status: npt.NDArray[np.uint8],
                 **values: FloatArray) -> _Chunk:
         """Flag extrapolation and NaN the invalid; drop the inputs in `given`."""
         speed, dp_i = values['speed'], values['dp_i']
-        limits = self.valid_range
-        if speed.size and (dp_i.max() > limits.dp_max or speed.max() > limits.speed_max):
-            status |= ((dp_i > limits.dp_max) | (speed > limits.speed_max)) \
-                * np.uint8(PointStatus.EXTRAPOLATED)
+        d = self.derived
+        if d.liquid_extrapolated:
+            status |= np.uint8(PointStatus.EXTRAPOLATED)
+        elif speed.size and (dp_i.max() > d.dp_max or speed.max() > d.speed_max
+                             or dp_i.min() < d.dp_min or speed.min() < d.speed_min):
+            with np.errstate(invalid='ignore'):
+                status |= ((dp_i > d.dp_max) | (speed > d.speed_max) | (dp_i < d.dp_min)
+                           | (speed < d.speed_min)) * np.uint8(PointStatus.EXTRAPOLATED)
         chunk = {k: v for k, v in values.items() if k not in given}
         invalid = (status & int(INVALID)) != 0 if status.any() else None
         if invalid is not None and invalid.any():
@@ -385,33 +448,48 @@ class MotorModel:
             if closed_form:
                 n = effective_speed(q, chamber, leak, self.c, self.coef.c_id, self.geometry)
             else:
-                n = self._solve_speed(q, chamber, leak)
+                n, converged = self._solve_speed(q, chamber, leak, status)
             if n.size and n.min() == 0.0:
                 status |= (n == 0.0) * np.uint8(PointStatus.STALLED)
             losses = self._breakdown(n, chamber, q_lfg, q_c, q_ex, leak)
+            if not closed_form:
+                absorbed = absorbency(n, losses['total'], self.geometry)
+                self._check_solution(absorbed, q, converged, n > 0.0, status, errors,
+                                     ('flow', 'm^3/s', q, at), 'eq. (36) for the speed')
             port = dpv if dp is not None else chamber + self._channel_drop(q)
             return self._finish(tuple(given), status, flow=q, speed=n, dp=port, dp_i=chamber,
                                 **losses)
 
         return self._run(core, arrays, status, given, not closed_form)
 
-    def _solve_speed(self, flow: FloatArray, dp_i: FloatArray, leak: FloatArray) -> FloatArray:
-        """Solve eq. (36) for n at given flow and dp_i (Newton, bracketed)."""
+    def _solve_speed(self, flow: FloatArray, dp_i: FloatArray, leak: FloatArray,
+                     status: npt.NDArray[np.uint8]) -> tuple[FloatArray, npt.NDArray[np.bool_]]:
+        """
+        Solve eq. (36) for n at given flow and dp_i (Newton, bracketed).
+
+        Where eq. (39) has no speed at or above its floor for a flow the
+        leakage alone does not take, the point is flagged NO_ROOT.
+        """
         qt = self.geometry.displacement
         hi = np.maximum(flow - leak, 0.0) / qt  # all of it through the displacement
         lo = (eq.empirical_speed_floor(dp_i, self.coef) if self.displacement_law == 'eq39'
               else np.zeros_like(hi))
         moving = (absorbency(lo, self._displacement_loss(lo, dp_i) + leak, self.geometry) < flow) \
             & (hi > lo)
+        status |= (~moving & (hi > 0.0) & (lo > 0.0)) * np.uint8(PointStatus.NO_ROOT)
 
-        def residual(n: FloatArray) -> tuple[FloatArray, FloatArray]:
+        def residual(root: FloatArray) -> tuple[FloatArray, FloatArray]:
+            # in s = sqrt(n): eq. (14)'s n^0.5 and eq. (39)'s sqrt(n) become linear at low
+            # speed, where Newton steps in n would only halve
+            n = root * root
             loss = self._displacement_loss(n, dp_i)
-            return (absorbency(n, loss + leak, self.geometry) - flow,
-                    qt + self._displacement_loss_slopes(n, dp_i, loss)[0])
+            with np.errstate(invalid='ignore'):  # inf * 0 at n = 0: bisected instead
+                slope = (qt + self._displacement_loss_slopes(n, dp_i, loss)[0]) * 2.0 * root
+            return absorbency(n, loss + leak, self.geometry) - flow, slope
 
-        lo, hi = np.where(moving, lo, 0.0), np.where(moving, hi, 0.0)
-        n, _ = solve_increasing(residual, lo, hi, hi, xtol=_RTOL * hi + 1e-15)
-        return np.where(moving, n, 0.0)
+        lo, hi = np.sqrt(np.where(moving, lo, 0.0)), np.sqrt(np.where(moving, hi, 0.0))
+        root, converged = solve_increasing(residual, lo, hi, hi, xtol=_ROOT_ATOL, rtol=_RTOL)
+        return np.where(moving, root * root, 0.0), converged
 
     def absorbency(self, speed: ArrayLike, dp: ArrayLike | None = None, *,
                    dp_i: ArrayLike | None = None, p_ex: ArrayLike = 0.0,
@@ -452,7 +530,8 @@ class MotorModel:
             if dp is None:
                 chamber = dpv
             else:
-                chamber = self._chamber_drop(dpv, self._solve_flow(n, dpv, pex), status)
+                root, converged = self._solve_flow(n, dpv, pex)
+                chamber = self._chamber_drop(dpv, root, status)
             chamber = self._check_limits(chamber, dp_name, dpv, status, errors, at)
             if self.displacement_law == 'eq39':
                 self._check_empirical_floor(n, chamber, status, errors, at)
@@ -460,6 +539,9 @@ class MotorModel:
             leak = q_lfg + q_c + q_ex
             losses = self._breakdown(n, chamber, q_lfg, q_c, q_ex, leak)
             flow = absorbency(n, losses['total'], self.geometry)
+            if dp is not None:
+                self._check_solution(flow, root, converged, flow == flow, status, errors,
+                                     ('speed', 'rad/s', n, at), 'eqs. (34)-(36) for the flow')
             port = dpv if dp is not None else chamber + self._channel_drop(flow)
             return self._finish(tuple(given), status, flow=flow, speed=n, dp=port, dp_i=chamber,
                                 **losses)
@@ -475,7 +557,8 @@ class MotorModel:
                              'below the floor of eq. (39), where its loss diverges', at)
             status |= below * np.uint8(PointStatus.BEYOND_LIMIT)
 
-    def _solve_flow(self, speed: FloatArray, dp: FloatArray, p_ex: FloatArray) -> FloatArray:
+    def _solve_flow(self, speed: FloatArray, dp: FloatArray,
+                    p_ex: FloatArray) -> tuple[FloatArray, npt.NDArray[np.bool_]]:
         """Solve eqs. (34)-(36) together for Q at given n and port dp (Newton, bracketed)."""
         qt = self.geometry.displacement
         dp_cap = np.minimum(dp, self.dp_limit)
@@ -495,9 +578,8 @@ class MotorModel:
         q_lfg, q_c, q_ex = self._leakage(dp_cap, p_ex)
         upper = absorbency(speed, self._displacement_loss(speed, dp_cap) + q_lfg + q_c + q_ex,
                            self.geometry)
-        flow, _ = solve_increasing(residual, qt * speed, upper, upper,
-                                   xtol=_RTOL * upper + 1e-18)
-        return flow
+        return solve_increasing(residual, qt * speed, upper, upper, xtol=0.01 * _FLOW_ATOL,
+                                rtol=_RTOL)
 
     @staticmethod
     def _which_dp(dp: ArrayLike | None, dp_i: ArrayLike | None) -> tuple[str, ArrayLike]:

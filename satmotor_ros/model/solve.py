@@ -12,7 +12,8 @@ from satmotor_ros.model._typing import FloatArray
 
 def solve_increasing(func: Callable[[FloatArray], tuple[FloatArray, FloatArray]],
                      lo: FloatArray, hi: FloatArray, x0: FloatArray, xtol: FloatArray,
-                     ftol: FloatArray = 0.0, maxiter: int = 60) -> tuple[FloatArray, FloatArray]:
+                     ftol: FloatArray = 0.0, maxiter: int = 60,
+                     rtol: float = 0.0) -> tuple[FloatArray, FloatArray]:
     """
     Find x in [lo, hi] with f(x) = 0 for an increasing f, element by element.
 
@@ -31,11 +32,13 @@ def solve_increasing(func: Callable[[FloatArray], tuple[FloatArray, FloatArray]]
         Starting estimates inside the bracket, [x]
     xtol : ndarray or float
         An element is done once its bracket, or its last Newton step, is
-        narrower than this, [x]
+        narrower than this plus `rtol` times its estimate, [x]
     ftol : ndarray or float
         ... or once its residual is this small in magnitude, [f]
     maxiter : int
         Iteration limit, [-]
+    rtol : float
+        Tolerance relative to the current estimate, added to `xtol`, [-]
 
     Returns
     -------
@@ -54,12 +57,13 @@ def solve_increasing(func: Callable[[FloatArray], tuple[FloatArray, FloatArray]]
     """
     a, b = np.array(lo, dtype=float), np.array(hi, dtype=float)
     x = np.array(x0, dtype=float)
-    done = b - a <= xtol
+    done = b - a <= xtol + rtol * np.abs(x)
     for _ in range(maxiter):
         f, slope = func(x)
         np.copyto(a, x, where=f < 0.0)
         np.copyto(b, x, where=f > 0.0)
-        done |= (np.abs(f) <= ftol) | (b - a <= xtol) | np.isnan(f)
+        tol = xtol + rtol * np.abs(x) if rtol else xtol
+        done |= (np.abs(f) <= ftol) | (b - a <= tol) | np.isnan(f)
         if done.all():
             break
         with np.errstate(divide='ignore', invalid='ignore'):
@@ -67,7 +71,7 @@ def solve_increasing(func: Callable[[FloatArray], tuple[FloatArray, FloatArray]]
         inside = (newton > a) & (newton < b)  # False for NaN: bisect instead
         np.copyto(x, np.where(inside, newton, 0.5 * (a + b)), where=~done)
         # a Newton step this small leaves an error of its square: done without re-evaluating
-        done |= inside & (np.abs(f) <= xtol * slope)
+        done |= inside & (np.abs(f) <= tol * slope)
     return x, done
 
 
