@@ -110,10 +110,11 @@ def test_eq39_near_stall_is_no_root_not_a_silent_zero_speed():
 
 
 def test_a_solve_that_runs_out_of_iterations_is_flagged_not_converged(monkeypatch):
-    from satmotor_ros.model import motor, solve
+    from satmotor_ros.model import forward, inverse, solve
     real = solve.solve_increasing
-    monkeypatch.setattr(motor, 'solve_increasing',
-                        lambda *a, **k: real(*a, **{**k, 'maxiter': 1}))
+    for module in (forward, inverse):
+        monkeypatch.setattr(module, 'solve_increasing',
+                            lambda *a, **k: real(*a, **{**k, 'maxiter': 1}))
     model = MODELS['water', 'eq39']
     ops = model.speed(np.array([5.0, 20.0]) * LPM, 10 * MPA, errors='mask')
     assert (ops.status == PointStatus.NOT_CONVERGED).all()

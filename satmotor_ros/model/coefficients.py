@@ -15,6 +15,7 @@ from dataclasses import dataclass, fields
 import math
 
 from satmotor_ros.model.errors import ConfigError
+from satmotor_ros.model.units import CM3_PER_REV
 
 
 class FieldError(ConfigError):
@@ -88,7 +89,7 @@ class MotorGeometry:
     @property
     def displacement_cm3_per_rev(self) -> float:
         """Theoretical displacement q_t in the paper's unit, [cm^3/rev]."""
-        return self.displacement * 2.0 * math.pi * 1.0e6
+        return self.displacement / CM3_PER_REV
 
 
 @dataclass(frozen=True)

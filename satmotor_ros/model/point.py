@@ -17,11 +17,12 @@ import math
 
 from satmotor_ros.model.derived import DerivedCoefficients
 from satmotor_ros.model.errors import InvalidInputError
+from satmotor_ros.model.inverse import ROOT_ATOL, RTOL
 from satmotor_ros.model.losses import EMPIRICAL_DP_FLOOR
 from satmotor_ros.model.results import Point, PointStatus
-from satmotor_ros.model.units import MPA, RPM
+from satmotor_ros.model.screening import CHECK, FLOW_ATOL
+from satmotor_ros.model.units import CM3_PER_REV, MPA, RPM
 
-_CM3_PER_REV = 1.0e-6 / (2.0 * math.pi)  # one cm^3/rev in m^3/rad, as in losses.py
 _NOT_FINITE = int(PointStatus.NOT_FINITE)
 _NEGATIVE = int(PointStatus.NEGATIVE)
 _BEYOND_LIMIT = int(PointStatus.BEYOND_LIMIT)
@@ -31,10 +32,6 @@ _EXTRAPOLATED = int(PointStatus.EXTRAPOLATED)
 _FLOOR_MPA = EMPIRICAL_DP_FLOOR / MPA
 _NO_ROOT = int(PointStatus.NO_ROOT)
 _NOT_CONVERGED = int(PointStatus.NOT_CONVERGED)
-_RTOL = 1e-13  # relative tolerance of the solves, as in the array maps
-_CHECK = 1e-10  # largest relative residual a solve may leave, as in the array maps
-_FLOW_ATOL = 1e-20  # absolute resolution of flows [m^3/s], as in the array maps
-_ROOT_ATOL = 1e-20  # absolute resolution of sqrt(n) [(rad/s)^0.5], as in the array maps
 _INF = math.inf
 _NAN = math.nan
 _new_point = tuple.__new__
@@ -118,7 +115,7 @@ class PointEvaluator:
         inv_sqrt_n = 1.0 / math.sqrt(speed / RPM)
         d = self.d
         dp_mpa = dp_i / MPA if dp_i > EMPIRICAL_DP_FLOOR else _FLOOR_MPA
-        return (d.c1_39 * inv_sqrt_n * dp_mpa ** (d.c2_39 * inv_sqrt_n) * _CM3_PER_REV) * speed
+        return (d.c1_39 * inv_sqrt_n * dp_mpa ** (d.c2_39 * inv_sqrt_n) * CM3_PER_REV) * speed
 
     def displacement_loss(self, speed: float, dp_i: float) -> float:
         """Return Delta Q_vl of eq. (33) or (39), [m^3/s]."""
@@ -214,7 +211,7 @@ class PointEvaluator:
             status |= _STALLED
         point = self._point(flow, speed, dp if port else None, dp_i, q_lfg, q_c, q_ex, status)
         if self.empirical and speed > 0.0 and not (
-                abs(d.qt * speed + point.total - flow) <= _CHECK * flow + _FLOW_ATOL):
+                abs(d.qt * speed + point.total - flow) <= CHECK * flow + FLOW_ATOL):
             return _invalid(_NO_ROOT)
         return point
 
@@ -242,7 +239,7 @@ class PointEvaluator:
         for _ in range(60):
             n = x * x
             inv_sqrt_n = 1.0 / math.sqrt(n / RPM)
-            loss = (c1 * inv_sqrt_n * dp_mpa ** (c2 * inv_sqrt_n) * _CM3_PER_REV) * n
+            loss = (c1 * inv_sqrt_n * dp_mpa ** (c2 * inv_sqrt_n) * CM3_PER_REV) * n
             f = qt * n + (loss + leak) - flow
             if f < 0.0:
                 lo = x
@@ -255,13 +252,13 @@ class PointEvaluator:
             newton = x - step
             if lo < newton < hi:
                 size = abs(step)
-                if size <= (_RTOL * x + _ROOT_ATOL):
+                if size <= (RTOL * x + ROOT_ATOL):
                     return newton * newton, 0
                 if (abs(slope - last_slope) * size * size
-                        <= 1e-3 * (_RTOL * x + _ROOT_ATOL) * abs(x - last_x) * slope):
+                        <= 1e-3 * (RTOL * x + ROOT_ATOL) * abs(x - last_x) * slope):
                     return newton * newton, 0
                 last_x, last_slope, x = x, slope, newton
-            elif hi - lo <= (_RTOL * x + _ROOT_ATOL):
+            elif hi - lo <= (RTOL * x + ROOT_ATOL):
                 return n, 0
             else:
                 last_x, last_slope, x = x, _NAN, 0.5 * (lo + hi)
@@ -311,7 +308,7 @@ class PointEvaluator:
             return _invalid(_BEYOND_LIMIT)
         q_lfg, q_c, q_ex = self.leakage(dp_i, p_ex)
         point = self._point(None, speed, dp if port else None, dp_i, q_lfg, q_c, q_ex, status)
-        if port and not abs(point.flow - root) <= _CHECK * root + _FLOW_ATOL:
+        if port and not abs(point.flow - root) <= CHECK * root + FLOW_ATOL:
             return _invalid(_NO_ROOT)
         return point
 
@@ -352,7 +349,7 @@ class PointEvaluator:
             if empirical:
                 above = dp_i > EMPIRICAL_DP_FLOOR
                 dp_mpa = dp_i / MPA if above else _FLOOR_MPA
-                loss = (c1 * dp_mpa ** c2 * _CM3_PER_REV) * speed
+                loss = (c1 * dp_mpa ** c2 * CM3_PER_REV) * speed
                 d_loss = loss * c2 / dp_i if above else 0.0
             else:
                 loss = k_pn * dp_i + ine
@@ -377,15 +374,15 @@ class PointEvaluator:
             newton = x - step
             if lo <= newton <= hi:
                 size = abs(step)
-                if size <= (_RTOL * x + 0.01 * _FLOW_ATOL):
+                if size <= (RTOL * x + 0.01 * FLOW_ATOL):
                     return newton, 0
                 # two Newton evaluations on the smooth side give the curvature, and with it
                 # the error left after this step
                 if (abs(slope - last_slope) * size * size
-                        <= 1e-3 * (_RTOL * x + 0.01 * _FLOW_ATOL) * abs(x - last_x) * slope):
+                        <= 1e-3 * (RTOL * x + 0.01 * FLOW_ATOL) * abs(x - last_x) * slope):
                     return newton, 0
                 last_x, last_slope, x = x, slope, newton
-            elif hi - lo <= (_RTOL * x + 0.01 * _FLOW_ATOL):
+            elif hi - lo <= (RTOL * x + 0.01 * FLOW_ATOL):
                 return x, 0
             else:
                 last_x, last_slope, x = x, _NAN, 0.5 * (lo + hi)
