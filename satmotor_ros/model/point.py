@@ -250,7 +250,7 @@ class PointEvaluator:
             slope = (qt + loss * (1.0 - c2 * log_dp * inv_sqrt_n) / (2.0 * n)) * 2.0 * x
             step = f / slope
             newton = x - step
-            if lo < newton < hi:
+            if lo <= newton <= hi:
                 size = abs(step)
                 if size <= (RTOL * x + ROOT_ATOL):
                     return newton * newton, 0

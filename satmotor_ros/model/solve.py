@@ -68,7 +68,8 @@ def solve_increasing(func: Callable[[FloatArray], tuple[FloatArray, FloatArray]]
             break
         with np.errstate(divide='ignore', invalid='ignore'):
             newton = x - f / slope
-        inside = (newton > a) & (newton < b)  # False for NaN: bisect instead
+        # inclusive: a step below the resolution of x lands on a bracket end (False for NaN)
+        inside = (newton >= a) & (newton <= b)
         np.copyto(x, np.where(inside, newton, 0.5 * (a + b)), where=~done)
         # a Newton step this small leaves an error of its square: done without re-evaluating
         done |= inside & (np.abs(f) <= tol * slope)
