@@ -204,7 +204,7 @@ def read_series(path: str | Path, topics: Iterable[str],
     """
     bag = open_bag(path)
     requested = list(dict.fromkeys(topics))
-    available = bag.topics()
+    available = bag.topics(count=False)
     found = match_topics(available, requested, topic_map)
     for want, name in found.items():
         info = available[name]
@@ -219,7 +219,7 @@ def read_series(path: str | Path, topics: Iterable[str],
         if info.msgtype not in FIELDS:
             raise BagError(f'{want} ({name} in the bag) is {info.msgtype}, which cannot be '
                            f'read as a series (supported: {", ".join(FIELDS)})')
-    _, raw = bag.read(set(found.values()))
+    available, raw = bag.read(set(found.values()))
     result = {}
     for want, name in found.items():
         info = available[name]

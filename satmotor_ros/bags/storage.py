@@ -155,9 +155,15 @@ class Bag:
     metadata: dict[str, TopicInfo] | None  # from metadata.yaml; None when absent
     _tmp: Any = field(default=None, repr=False)
 
-    def topics(self) -> dict[str, TopicInfo]:
+    def topics(self, count: bool = True) -> dict[str, TopicInfo]:
         """
         List the topics of the storage, checked against metadata.yaml.
+
+        Parameters
+        ----------
+        count : bool
+            Count the messages of every topic; without, sqlite3 counts are -1 (not
+            counted), which saves a pass over the messages table, [-]
 
         Returns
         -------
@@ -181,9 +187,9 @@ class Bag:
                             count=info.count + (seen.count if seen else 0))
                 self._check_metadata(infos)
                 return infos
-        return self.read(())[0]
+        return self.read((), count)[0]
 
-    def read(self, names: tuple[str, ...] | list[str] | set[str],
+    def read(self, names: tuple[str, ...] | list[str] | set[str], count: bool = False,
              ) -> tuple[dict[str, TopicInfo], dict[str, RawTopic]]:
         """
         Read the raw messages of some topics.
@@ -192,6 +198,8 @@ class Bag:
         ----------
         names : collection of str
             Full topic names as in the bag, [-]
+        count : bool
+            Also count the messages of the other topics (sqlite3: one more pass), [-]
 
         Returns
         -------
@@ -210,18 +218,21 @@ class Bag:
         parts: dict[str, list[Any]] = {n: [] for n in wanted}
         for path in self.files:
             reader = _read_mcap_file if self.storage == 'mcap' else self._read_sqlite_file
-            for info, pieces in reader(path, wanted):
+            for info, pieces in reader(path, wanted, count):
                 seen = infos.get(info.name)
                 if seen is not None and seen.msgtype != info.msgtype:
                     raise BagError(f'{info.name} is {seen.msgtype} in one storage file and '
                                    f'{info.msgtype} in {path.name}')
-                infos[info.name] = info._replace(count=info.count + (seen.count if seen else 0))
+                if seen is not None and min(seen.count, info.count) >= 0:
+                    info = info._replace(count=info.count + seen.count)
+                infos[info.name] = info
                 if info.name in wanted:
                     parts[info.name].extend(pieces)
         self._check_metadata(infos)
         return infos, {name: _compact(parts[name]) for name in wanted & set(infos)}
 
-    def _read_sqlite_file(self, path: Path, wanted: set[str]):  # noqa: ANN202 (generator)
+    def _read_sqlite_file(self, path: Path, wanted: set[str],
+                          count: bool):  # noqa: ANN202 (generator)
         if path.suffix == '.zstd':
             path = self._decompress_file(path)
         uri = f'{path.resolve().as_uri()}?mode=ro&immutable=1'
@@ -233,17 +244,23 @@ class Bag:
             topics = db.execute('SELECT id, name, type, serialization_format FROM topics')\
                 .fetchall()
             counts = dict(db.execute('SELECT topic_id, COUNT(*) FROM messages '
-                                     'GROUP BY topic_id').fetchall())
+                                     'GROUP BY topic_id').fetchall()) if count else {}
+            ids = {topic_id: name for topic_id, name, _, _ in topics if name in wanted}
+            rows = db.execute(f'SELECT topic_id, timestamp, data FROM messages WHERE topic_id '
+                              f'IN ({",".join(map(str, ids))})').fetchall() if ids else []
+            which = np.fromiter((r[0] for r in rows), dtype=np.int64, count=len(rows))
             for topic_id, name, msgtype, fmt in topics:
-                info = TopicInfo(name, normalize_type(msgtype), fmt, counts.get(topic_id, 0))
-                if name in wanted and info.count:
-                    rows = db.execute('SELECT timestamp, data FROM messages WHERE topic_id = ?',
-                                      (topic_id,)).fetchall()
-                    t = np.fromiter((r[0] for r in rows), dtype=np.int64, count=len(rows))
-                    payloads = _decompressed([r[1] for r in rows], name)
-                    yield info, [(t, *pack_payloads(payloads))]
-                else:
-                    yield info, []
+                info = TopicInfo(name, normalize_type(msgtype), fmt,
+                                 counts.get(topic_id, 0 if count else -1))
+                if topic_id not in ids:
+                    yield (info if count else info._replace(count=-1)), []
+                    continue
+                mine = np.flatnonzero(which == topic_id).tolist() if len(ids) > 1 \
+                    else range(len(rows))
+                t = np.fromiter((rows[i][1] for i in mine), dtype=np.int64, count=len(mine))
+                payloads = _decompressed([rows[i][2] for i in mine], name)
+                yield info._replace(count=len(mine)), ([(t, *pack_payloads(payloads))]
+                                                       if len(mine) else [])
         except sqlite3.DatabaseError as err:
             raise BagError(f'{path.name}: not a rosbag2 sqlite3 file ({err})') from None
         finally:
@@ -276,12 +293,12 @@ class Bag:
             if found.msgtype != meta.msgtype:
                 raise BagError(f'metadata.yaml and storage disagree: {name} is {meta.msgtype} '
                                f'in metadata.yaml and {found.msgtype} in {where}')
-            if found.count != meta.count:
+            if found.count >= 0 and found.count != meta.count:
                 raise BagError(f'metadata.yaml and storage disagree: {name} has {meta.count} '
                                f'messages in metadata.yaml and {found.count} in {where}')
 
 
-def _read_mcap_file(path: Path, wanted: set[str]):  # noqa: ANN202 (generator)
+def _read_mcap_file(path: Path, wanted: set[str], count: bool):  # noqa: ANN202, ARG001
     return _mcap_topics(read_mcap(path, wanted))
 
 
