@@ -65,7 +65,8 @@ def as_float(name: str, value: object) -> float:
         For a string, a bool, a sequence or anything else that is not one real number.
 
     """
-    if isinstance(value, (str, bytes, bool)):
+    kind = getattr(getattr(value, 'dtype', None), 'kind', 'f')  # numpy scalars and arrays
+    if isinstance(value, (str, bytes, bool)) or kind not in 'iuf':
         msg = f'{name} = {value!r}: expected a number, got {type(value).__name__}'
         raise InvalidInputError(msg)
     try:
