@@ -155,6 +155,11 @@ def test_external_leakage_is_k_ex_times_p_ex_in_every_path():
     assert float(op.losses.external) == pytest.approx(2e-6, rel=1e-12)
     assert model.speed_point(10 * LPM, dp_i=10 * MPA, p_ex=2 * MPA).external \
         == pytest.approx(2e-6, rel=1e-12)
+    assert float(model.breakdown(300 * RPM, 10 * MPA, p_ex=2 * MPA).external) \
+        == pytest.approx(2e-6, rel=1e-12)
+    assert float(model.breakdown(300 * RPM, 10 * MPA).external) == 0.0  # p_ex = 0 by default
+    assert model.breakdown_point(300 * RPM, 10 * MPA, 2 * MPA).external \
+        == pytest.approx(2e-6, rel=1e-12)
     no_ex = model.speed(10 * LPM, dp_i=10 * MPA)
     assert float(op.speed) < float(no_ex.speed)
     forward = model.absorbency(float(op.speed), 10 * MPA, p_ex=2 * MPA)
@@ -225,3 +230,13 @@ def test_equation_functions_return_floats_for_integer_input(fn):
         'absorbency': lambda: sp.absorbency(np.array([2]), np.array([1]), model.geometry),
     }
     assert calls[fn]().dtype == np.float64
+
+
+def test_status_codes_are_spelled_out():
+    from satmotor_ros.model import describe_status
+    assert describe_status(0) == 'OK'
+    assert describe_status(PointStatus.NO_ROOT) == 'NO_ROOT'
+    assert describe_status(PointStatus.STALLED | PointStatus.EXTRAPOLATED) \
+        == 'STALLED|EXTRAPOLATED'
+    assert describe_status(PointStatus.NOT_CONVERGED | PointStatus.NEGATIVE) \
+        == 'NEGATIVE|NOT_CONVERGED'
