@@ -77,12 +77,20 @@ def test_missing_and_unknown_keys_are_named(document):
 
 
 def test_unreadable_and_malformed_files_are_config_errors(tmp_path):
-    with pytest.raises(ConfigError, match='cannot read motor config'):
+    with pytest.raises(ConfigError, match=r"^cannot read motor config '.*absent\.yaml': "):
         load_motor(tmp_path / 'absent.yaml')
     bad = tmp_path / 'bad.yaml'
     bad.write_text('geometry: [unclosed\n', encoding='utf-8')
-    with pytest.raises(ConfigError, match='is not valid YAML'):
+    with pytest.raises(ConfigError, match=r"^motor config '.*bad\.yaml' is not valid YAML"):
         load_motor(bad)
+
+
+def test_a_spec_knows_its_source_and_the_default_model_is_oil():
+    path = default_config_path()
+    assert load_motor(path).source == str(path)
+    assert load_motor().source == str(path)
+    assert MotorModel.default().coefficient_set.name == 'oil'
+    assert MotorModel.default().displacement_law == 'eq33'
 
 
 def test_user_file_with_si_numbers_loads_like_the_default(tmp_path, document):

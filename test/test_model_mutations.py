@@ -155,8 +155,88 @@ def test_external_leakage_is_k_ex_times_p_ex_in_every_path():
     assert float(op.losses.external) == pytest.approx(2e-6, rel=1e-12)
     assert model.speed_point(10 * LPM, dp_i=10 * MPA, p_ex=2 * MPA).external \
         == pytest.approx(2e-6, rel=1e-12)
+    assert float(model.breakdown(300 * RPM, 10 * MPA, p_ex=2 * MPA).external) \
+        == pytest.approx(2e-6, rel=1e-12)
+    assert float(model.breakdown(300 * RPM, 10 * MPA).external) == 0.0  # p_ex = 0 by default
+    assert model.breakdown_point(300 * RPM, 10 * MPA, 2 * MPA).external \
+        == pytest.approx(2e-6, rel=1e-12)
     no_ex = model.speed(10 * LPM, dp_i=10 * MPA)
     assert float(op.speed) < float(no_ex.speed)
     forward = model.absorbency(float(op.speed), 10 * MPA, p_ex=2 * MPA)
     back = model.speed(forward.flow, 10 * MPA, p_ex=2 * MPA)
     assert float(back.speed) == pytest.approx(float(op.speed), rel=1e-9)
+
+
+def test_eq40_without_the_inertia_term_is_the_linear_solution():
+    # C_id = 0 makes b = 0 in eq. (40): n = (Q - leakage) / (q_t + C dp_i m^2 H)
+    model = _model('oil', c_id=0.0)
+    flow, dp_i = np.array([5.0, 20.0, 40.0]) * LPM, np.array([2.0, 10.0, 25.0]) * MPA
+    closed = model.speed(flow, dp_i=dp_i)
+    iterative = model.speed(flow, dp_i=dp_i, method='iterative')
+    np.testing.assert_allclose(closed.speed, iterative.speed, rtol=1e-12)
+    leak = closed.losses.flat_clearance + closed.losses.commutation
+    k_p = eq.pressure_speed_coefficient(model.c_lumped, model.geometry)
+    np.testing.assert_allclose(closed.speed,
+                               (flow - leak) / (model.geometry.displacement + k_p * dp_i),
+                               rtol=1e-12)
+    np.testing.assert_array_equal(closed.losses.inertia, 0.0)
+    assert model.speed_point(20 * LPM, dp_i=10 * MPA).speed == pytest.approx(
+        float(closed.speed[1]), rel=1e-12)
+
+
+def test_a_motor_without_compliance_has_no_pressure_limit():
+    model = _model('oil', d_c=0.0, d_k=0.0)
+    assert model.dp_limit == float('inf')
+    op = model.speed(20 * LPM, dp_i=80 * MPA)
+    assert op.status == PointStatus.EXTRAPOLATED and float(op.speed) > 0.0
+
+
+def test_viscosity_range_is_closed_and_checked_on_both_sides():
+    cset = replace(SPEC.sets['oil'], viscosity_range=(30e-6, 50e-6))
+    for nu, outside in [(30e-6 * (1.0 - 1e-9), False), (50e-6 * (1.0 + 1e-9), False),
+                        (29.9e-6, True), (50.1e-6, True), (80e-6, True), (40e-6, False)]:
+        model = MotorModel(SPEC.geometry, cset, SPEC.valid_range,
+                           Liquid('user', nu, 873.0, 1.6e9))
+        assert model.derived.liquid_extrapolated is outside, nu
+    thick = MotorModel.from_spec(SPEC, 'oil', Liquid('cold oil', 60e-6, 873.0, 1.6e9))
+    assert thick.speed_point(20 * LPM, 10 * MPA).status == PointStatus.EXTRAPOLATED
+
+
+@pytest.mark.parametrize('liquid', ['oil', 'water'])
+@pytest.mark.parametrize('law', ['eq33', 'eq39'])
+def test_a_freshly_built_model_gives_the_same_points_on_both_paths(liquid, law):
+    model = _model(liquid, law)  # built inside the test, so that a mutant is rebuilt too
+    flow, dp = np.array([3.0, 12.0, 40.0]) * LPM, np.array([2.0, 0.5, 20.0]) * MPA
+    ops = model.speed(flow, dp)
+    forward = model.absorbency(ops.speed, dp)
+    for i in range(3):
+        p = model.speed_point(float(flow[i]), float(dp[i]))
+        assert p.speed == pytest.approx(float(ops.speed[i]), rel=1e-12)
+        assert p.total == pytest.approx(float(ops.losses.total[i]), rel=1e-12)
+        f = model.absorbency_point(float(ops.speed[i]), float(dp[i]))
+        assert f.flow == pytest.approx(float(forward.flow[i]), rel=1e-12)
+        assert f.flow == pytest.approx(float(flow[i]), rel=1e-9)
+
+
+@pytest.mark.parametrize('fn', ['external_leakage', 'chamber_pressure_drop', 'speed_loss',
+                                'absorbency'])
+def test_equation_functions_return_floats_for_integer_input(fn):
+    from satmotor_ros.model import speed as sp
+    model = _model('oil', external_leakage=1e-12)
+    calls = {
+        'external_leakage': lambda: eq.external_leakage(np.array([3]), model.coef),
+        'chamber_pressure_drop': lambda: eq.chamber_pressure_drop(np.array([7]), np.array([2])),
+        'speed_loss': lambda: sp.speed_loss(np.array([1]), np.array([2]), model.geometry),
+        'absorbency': lambda: sp.absorbency(np.array([2]), np.array([1]), model.geometry),
+    }
+    assert calls[fn]().dtype == np.float64
+
+
+def test_status_codes_are_spelled_out():
+    from satmotor_ros.model import describe_status
+    assert describe_status(0) == 'OK'
+    assert describe_status(PointStatus.NO_ROOT) == 'NO_ROOT'
+    assert describe_status(PointStatus.STALLED | PointStatus.EXTRAPOLATED) \
+        == 'STALLED|EXTRAPOLATED'
+    assert describe_status(PointStatus.NOT_CONVERGED | PointStatus.NEGATIVE) \
+        == 'NEGATIVE|NOT_CONVERGED'

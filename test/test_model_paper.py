@@ -115,3 +115,22 @@ def test_model_matches_reference_speed_ratio_water_over_oil():
              / MotorModel.default('oil').speed(q, dp_i=dp_i).speed)
     np.testing.assert_allclose(ratio, [float(r['n_ratio_w_over_o']) for r in rows],
                                rtol=GRID_TOLERANCE)
+
+
+def test_clearance_and_displacement_change_match_the_reference_grid(liquid):
+    from satmotor_ros.model.losses import (clearance_height, displacement_change,
+                                           displacement_change_empirical)
+    model = MotorModel.default(liquid)
+    rows = [r for r in _grid(liquid) if r['case'] == 'n_const']
+    n = np.array([float(r['n_rpm']) for r in rows]) * RPM
+    dp_i = np.array([float(r['dp_i_MPa']) for r in rows]) * MPA
+    cm3_per_rev = 1e-6 / (2 * np.pi)
+    columns = {
+        'h_um': clearance_height(dp_i, model.geometry, model.coef) * 1e6,
+        'dq33_cm3_rev': displacement_change(dp_i, n, model.coef.c, model.coef.c_id,
+                                            model.geometry) / cm3_per_rev,
+        'dq39_cm3_rev': displacement_change_empirical(dp_i, n, model.coef) / cm3_per_rev,
+    }
+    for name, value in columns.items():
+        expected = np.array([float(r[name]) for r in rows])
+        np.testing.assert_allclose(value, expected, rtol=GRID_TOLERANCE, err_msg=name)

@@ -155,3 +155,6 @@ def test_misuse_raises_model_errors():
         model.speed_point('5', 1e6)
     with pytest.raises(InvalidInputError, match=r'^dp_i = \[1.0, 2.0\]: expected one number'):
         model.breakdown_point(10.0, [1.0, 2.0])
+    for bad in (np.array('5'), np.bool_(True), True, None, 1j):
+        with pytest.raises(InvalidInputError, match=r'^speed = .*: expected (a|one) number'):
+            model.absorbency_point(bad, 1e6)

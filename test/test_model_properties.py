@@ -5,9 +5,10 @@ from hypothesis import given, settings, strategies as st
 import numpy as np
 import pytest
 
-from satmotor_ros.model import MotorModel
+from satmotor_ros.model import load_motor, MotorModel
 from satmotor_ros.model.units import LPM, MPA, RPM
 
+SPEC = load_motor()
 MODELS = {(liquid, law): MotorModel.default(liquid, law)
           for liquid in ('oil', 'water') for law in ('eq33', 'eq39')}
 
@@ -116,9 +117,9 @@ def test_components_add_up_to_total_and_split_keeps_lumped_c():
 @given(base=liquids, law=laws, nu_cst=st.floats(0.3, 300.0), rho=st.floats(600.0, 1300.0),
        bulk_gpa=st.floats(0.8, 3.0), n=speeds, dp=drops)
 def test_maps_round_trip_for_any_user_liquid(base, law, nu_cst, rho, bulk_gpa, n, dp):
-    from satmotor_ros.model import Liquid, load_motor
+    from satmotor_ros.model import Liquid
     liquid = Liquid('user', nu_cst * 1e-6, rho, bulk_gpa * 1e9)
-    model = MotorModel.from_spec(load_motor(), base, liquid, law)
+    model = MotorModel.from_spec(SPEC, base, liquid, law)
     forward = model.absorbency(n * RPM, dp * MPA, errors='mask')
     assert not forward.invalid.any()
     back = model.speed(forward.flow, dp * MPA)

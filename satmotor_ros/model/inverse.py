@@ -14,17 +14,22 @@ from satmotor_ros.model.screening import (At, check_limit, check_solution, Error
 from satmotor_ros.model.solve import solve_increasing
 from satmotor_ros.model.speed import absorbency, effective_speed
 
-RTOL = 1e-13
-"""Relative tolerance of the iterative maps: Newton polishes well below it, bisection to it."""
+RTOL = 1e-11
+"""
+Relative tolerance of the iterative maps.
 
-ROOT_ATOL = 1e-20
-"""Absolute resolution of sqrt(n) in the speed solve, [(rad/s)^0.5]; worth < 1e-23 m^3/s."""
+A solve ends on a Newton step smaller than this and takes the step, which
+leaves an error of the order of its square; only a bisection ends at it.
+"""
+
+SPEED_ATOL = 1e-40
+"""Absolute resolution of n in the speed solve, [rad/s]; its loss is below 1e-24 m^3/s."""
 
 
 def solve_speed(eqs: Equations, flow: FloatArray, dp_i: FloatArray, leak: FloatArray,
                 status: Status) -> tuple[FloatArray, np.ndarray]:
     """
-    Solve eq. (36) for n at given flow and dp_i (Newton in sqrt(n), bracketed).
+    Solve eq. (36) for n at given flow and dp_i (Newton, bracketed).
 
     Where the law has no speed at or above its floor for a flow the leakage
     alone does not take (eq. 39 near stall), the point is flagged NO_ROOT.
@@ -57,18 +62,13 @@ def solve_speed(eqs: Equations, flow: FloatArray, dp_i: FloatArray, leak: FloatA
     moving = (absorbency(lo, law.loss(lo, dp_i) + leak, geometry) < flow) & (hi > lo)
     status |= (~moving & (hi > 0.0) & (lo > 0.0)) * np.uint8(PointStatus.NO_ROOT)
 
-    def residual(root: FloatArray) -> tuple[FloatArray, FloatArray]:
-        # in s = sqrt(n): eq. (14)'s n^0.5 and eq. (39)'s sqrt(n) become linear at low
-        # speed, where Newton steps in n would only halve
-        n = root * root
+    def residual(n: FloatArray) -> tuple[FloatArray, FloatArray]:
         loss = law.loss(n, dp_i)
-        with np.errstate(invalid='ignore'):  # inf * 0 at n = 0: bisected instead
-            slope = (qt + law.slopes(n, dp_i, loss)[0]) * 2.0 * root
-        return absorbency(n, loss + leak, geometry) - flow, slope
+        return absorbency(n, loss + leak, geometry) - flow, qt + law.slopes(n, dp_i, loss)[0]
 
-    lo, hi = np.sqrt(np.where(moving, lo, 0.0)), np.sqrt(np.where(moving, hi, 0.0))
-    root, converged = solve_increasing(residual, lo, hi, hi, xtol=ROOT_ATOL, rtol=RTOL)
-    return np.where(moving, root * root, 0.0), converged
+    lo, hi = np.where(moving, lo, 0.0), np.where(moving, hi, 0.0)
+    n, converged = solve_increasing(residual, lo, hi, hi, xtol=SPEED_ATOL, rtol=RTOL)
+    return np.where(moving, n, 0.0), converged
 
 
 def speed_map(eqs: Equations, flow: object, dp_name: str, dp_value: object, p_ex: object,

@@ -37,6 +37,7 @@ class DisplacementLaw:
 
     name = ''
     closed_form = False  # whether eq. (40) inverts it, with no solve
+    has_floor = False  # whether it is used only above a floor speed
 
     def __init__(self, derived: DerivedCoefficients, geometry: MotorGeometry,
                  coef: LossCoefficients) -> None:
@@ -77,6 +78,7 @@ class EmpiricalLaw(DisplacementLaw):
 
     name = 'eq39'
     closed_form = False
+    has_floor = True
 
     def loss(self, speed: FloatArray, dp_i: FloatArray) -> FloatArray:
         """Return Delta Q_vl of eqs. (32), (39), [m^3/s]."""

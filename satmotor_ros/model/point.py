@@ -17,7 +17,7 @@ import math
 
 from satmotor_ros.model.derived import DerivedCoefficients
 from satmotor_ros.model.errors import InvalidInputError
-from satmotor_ros.model.inverse import ROOT_ATOL, RTOL
+from satmotor_ros.model.inverse import RTOL, SPEED_ATOL
 from satmotor_ros.model.losses import EMPIRICAL_DP_FLOOR
 from satmotor_ros.model.results import Point, PointStatus
 from satmotor_ros.model.screening import CHECK, FLOW_ATOL
@@ -32,6 +32,7 @@ _EXTRAPOLATED = int(PointStatus.EXTRAPOLATED)
 _FLOOR_MPA = EMPIRICAL_DP_FLOOR / MPA
 _NO_ROOT = int(PointStatus.NO_ROOT)
 _NOT_CONVERGED = int(PointStatus.NOT_CONVERGED)
+_ROOT_ATOL = math.sqrt(SPEED_ATOL)  # the speed solve's resolution in x = sqrt(n)
 _INF = math.inf
 _NAN = math.nan
 _new_point = tuple.__new__
@@ -64,7 +65,8 @@ def as_float(name: str, value: object) -> float:
         For a string, a bool, a sequence or anything else that is not one real number.
 
     """
-    if isinstance(value, (str, bytes, bool)):
+    kind = getattr(getattr(value, 'dtype', None), 'kind', 'f')  # numpy scalars and arrays
+    if isinstance(value, (str, bytes, bool)) or kind not in 'iuf':
         msg = f'{name} = {value!r}: expected a number, got {type(value).__name__}'
         raise InvalidInputError(msg)
     try:
@@ -252,13 +254,13 @@ class PointEvaluator:
             newton = x - step
             if lo <= newton <= hi:
                 size = abs(step)
-                if size <= (RTOL * x + ROOT_ATOL):
+                if size <= (RTOL * x + _ROOT_ATOL):
                     return newton * newton, 0
                 if (abs(slope - last_slope) * size * size
-                        <= 1e-3 * (RTOL * x + ROOT_ATOL) * abs(x - last_x) * slope):
+                        <= 1e-3 * (RTOL * x + _ROOT_ATOL) * abs(x - last_x) * slope):
                     return newton * newton, 0
                 last_x, last_slope, x = x, slope, newton
-            elif hi - lo <= (RTOL * x + ROOT_ATOL):
+            elif hi - lo <= (RTOL * x + _ROOT_ATOL):
                 return n, 0
             else:
                 last_x, last_slope, x = x, _NAN, 0.5 * (lo + hi)

@@ -61,9 +61,8 @@ class OperatingPoints:
     """
     Operating points of the motor and their losses, all SI.
 
-    The inputs of the call (``flow`` and ``dp`` of ``speed()``, ``speed`` and
-    ``dp`` of ``absorbency()``) are the caller's arrays, broadcast, not copies;
-    where an element is invalid every field holds NaN.
+    Every array is the result's own (the inputs of the call come back broadcast,
+    as copies) and read-only; where an element is invalid every field holds NaN.
     """
 
     flow: FloatArray  # absorbency Q [m^3/s]

@@ -214,6 +214,8 @@ def check_floor(speed: FloatArray, law: DisplacementLaw, dp_i: FloatArray, statu
         The chunk's place in the batch, [-]
 
     """
+    if not law.has_floor:
+        return
     below = (speed > 0.0) & (speed < law.floor(dp_i))
     if below.any():
         if errors == 'raise':
@@ -255,6 +257,9 @@ def check_solution(value: FloatArray, target: FloatArray, converged: npt.NDArray
     """
     with np.errstate(invalid='ignore'):
         off = ~(np.abs(value - target) <= CHECK * np.abs(target) + FLOW_ATOL)
+    if (not (off & checked).any() and converged.all()
+            and not (status & np.uint8(PointStatus.NO_ROOT)).any()):
+        return  # the usual case: every solution checks out
     open_ = checked & ((status & int(INVALID)) == 0)
     status |= (off & converged & open_) * np.uint8(PointStatus.NO_ROOT)
     status |= (~converged & open_) * np.uint8(PointStatus.NOT_CONVERGED)

@@ -59,6 +59,8 @@ def solve_increasing(func: Callable[[FloatArray], tuple[FloatArray, FloatArray]]
     x = np.array(x0, dtype=float)
     done = b - a <= xtol + rtol * np.abs(x)
     for _ in range(maxiter):
+        if done.all():
+            break
         f, slope = func(x)
         np.copyto(a, x, where=f < 0.0)
         np.copyto(b, x, where=f > 0.0)
