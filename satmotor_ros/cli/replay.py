@@ -11,7 +11,6 @@ holds the recorded and the predicted topics side by side.
 from __future__ import annotations
 
 import argparse
-import csv
 from pathlib import Path
 import time
 
@@ -20,6 +19,7 @@ import numpy as np
 from satmotor_ros.bags import (BagError, describe_topics, encode_many, FLOAT64, JOINT_STATE,
                                list_topics, missing_topics, OutTopic, parse_topic_map,
                                read_series, Series, write_bag)
+from satmotor_ros.cli import _fastcsv as fastcsv
 from satmotor_ros.cli._common import add_model_options, build_model, CliError, fail
 from satmotor_ros.model import COMPONENTS, describe_status, ModelError
 from satmotor_ros.model.units import LPM, MPA, RPM
@@ -33,14 +33,15 @@ FIELD_OF = {'flow': 'data', 'p_in': 'fluid_pressure', 'p_out': 'fluid_pressure',
             'measured_speed': 'velocity'}
 """The Series field each input is read from."""
 
-_INPUT_COLUMNS = (('flow', 'flow [l/min]', LPM), ('p_in', 'p_in [MPa]', MPA),
-                  ('p_out', 'p_out [MPa]', MPA), ('p_case', 'p_case [MPa]', MPA),
-                  ('temperature', 'temperature [degC]', 1.0),
-                  ('measured_speed', 'measured_speed [rpm]', RPM))
-_OUTPUT_COLUMNS = (('dp', 'dp [MPa]', MPA), ('dp_i', 'dp_i [MPa]', MPA),
-                   ('speed', 'speed [rpm]', RPM), ('speed', 'speed [rad/s]', 1.0),
-                   *((c, f'{c} [l/min]', LPM) for c in COMPONENTS),
-                   ('residual', 'residual [rpm]', RPM))
+# (name, CSV header, unit in SI, decimal places written)
+_INPUT_COLUMNS = (('flow', 'flow [l/min]', LPM, 12), ('p_in', 'p_in [MPa]', MPA, 9),
+                  ('p_out', 'p_out [MPa]', MPA, 9), ('p_case', 'p_case [MPa]', MPA, 9),
+                  ('temperature', 'temperature [degC]', 1.0, 6),
+                  ('measured_speed', 'measured_speed [rpm]', RPM, 9))
+_OUTPUT_COLUMNS = (('dp', 'dp [MPa]', MPA, 9), ('dp_i', 'dp_i [MPa]', MPA, 9),
+                   ('speed', 'speed [rpm]', RPM, 9), ('speed', 'speed [rad/s]', 1.0, 12),
+                   *((c, f'{c} [l/min]', LPM, 15) for c in COMPONENTS),
+                   ('residual', 'residual [rpm]', RPM, 9))
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -300,7 +301,9 @@ def write_csv(path: Path, batch: PredictionBatch) -> None:
     Columns: ``log_time [ns]``, ``time [s]`` (from the first), the inputs (optional ones
     only when the bag has them), the outputs (``residual`` only with a measured speed),
     ``level`` (OK, WARN, ERROR: ERROR rows are what the node would not publish, their
-    outputs empty), ``model_status`` and ``inputs`` (the unusable ones and why).
+    outputs empty), ``model_status`` and ``inputs`` (the unusable ones and why). Numbers
+    are fixed-point with 9 to 15 decimal places (at least 12 significant digits at the
+    model's scales).
 
     Parameters
     ----------
@@ -312,33 +315,27 @@ def write_csv(path: Path, batch: PredictionBatch) -> None:
     """
     snaps = batch.snapshots
     t_ns = snaps.stamp_ns
-    columns = [t_ns.tolist(), ((t_ns - t_ns[0]) / 1e9).tolist() if len(t_ns) else []]
     header = ['log_time [ns]', 'time [s]']
-    for name, title, unit in _INPUT_COLUMNS:
+    fields = [fastcsv.fixed_point(t_ns, 0),
+              fastcsv.fixed_point((t_ns - (t_ns[0] if len(t_ns) else 0)) / 1e9, 9)]
+    for name, title, unit, decimals in _INPUT_COLUMNS:
         values = snaps.values[INPUTS.index(name)]
         if name in REQUIRED or not np.isnan(values).all():  # absent optional inputs: no column
-            columns.append(_blank_nan(values / unit))
+            fields.append(fastcsv.fixed_point(values / unit, decimals))
             header.append(title)
-    for name, title, unit in _OUTPUT_COLUMNS:
+    for name, title, unit, decimals in _OUTPUT_COLUMNS:
         values = batch.output(name)
         if name != 'residual' or not np.isnan(values).all():
-            columns.append(_blank_nan(values / unit))
+            fields.append(fastcsv.fixed_point(values / unit, decimals))
             header.append(title)
     levels = [Level(k).name for k in range(3)]
-    columns += [[levels[k] for k in batch.level.tolist()], _status_names(batch),
-                _state_notes(batch)]
+    fields += [fastcsv.text([levels[k] for k in batch.level.tolist()]),
+               fastcsv.text(_status_names(batch)), fastcsv.text(_state_notes(batch))]
     header += ['level', 'model_status', 'inputs']
-    with path.open('w', newline='', encoding='utf-8') as stream:
-        writer = csv.writer(stream)
-        writer.writerow(header)
-        writer.writerows(zip(*columns))
-
-
-def _blank_nan(values: np.ndarray) -> list:
-    listed = values.tolist()
-    if np.isnan(values).any():
-        listed = ['' if v != v else v for v in listed]
-    return listed
+    with path.open('wb') as stream:
+        stream.write((','.join(header) + '\n').encode('ascii'))
+        if len(t_ns):
+            stream.write(fastcsv.rows(fields))
 
 
 def _write_bag(path: Path, series: dict[str, Series], batch: PredictionBatch,
