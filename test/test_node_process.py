@@ -81,6 +81,21 @@ def _drive(h, motor, flow=FLOW, settle=0.15, **inputs):
     return before
 
 
+def _drive_until_predicted(h, motor, timeout=8.0, **inputs):
+    """
+    Drive until a prediction arrives.
+
+    Right after start-up the node's best-effort readers may not have matched our writers
+    yet, and what is sent before is lost, as it would be from a sensor.
+    """
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        before = _drive(h, motor, **inputs)
+        if h.spin_until(lambda: motor.predicted, 0.4):
+            return before
+    raise AssertionError(f'no prediction from {motor.ns} within {timeout} s')
+
+
 def _drive_until_diag(h, motor, level, text, timeout=6.0, **inputs):
     """
     Drive good predictions until a report of `level` with `text` arrives.
@@ -114,12 +129,11 @@ def test_node_publishes_the_library_prediction_and_recovers_from_bad_input(
     try:
         h, motor = harness, harness.motor(ns)
         h.wait_connected(motor)
-        before = _drive(h, motor, p_in=P_IN, p_out=P_OUT, speed=50.0)
-        assert h.spin_until(lambda: motor.predicted and motor.losses['total']
-                            and motor.residual, 5.0)
+        before = _drive_until_predicted(h, motor, p_in=P_IN, p_out=P_OUT, speed=50.0)
+        assert h.spin_until(lambda: motor.losses['total'] and motor.residual, 5.0)
         after = time.time_ns()
         expected = OIL.speed_point(FLOW, P_IN - P_OUT)
-        (joint,) = motor.predicted
+        joint = motor.predicted[-1]
         assert joint.name == ['motor_shaft'] and joint.position.tolist() == []
         assert joint.velocity[0] == pytest.approx(expected.speed, rel=1e-15)
         stamp = joint.header.stamp.sec * 10**9 + joint.header.stamp.nanosec
@@ -131,7 +145,8 @@ def test_node_publishes_the_library_prediction_and_recovers_from_bad_input(
         ok = _wait_diag(h, motor, 0, 'OK')
         keys = {kv.key: kv.value for kv in ok.values}
         assert float(keys['inlet_pressure.fluid_pressure [Pa]']) == P_IN
-        assert keys['model status'] == 'OK' and keys['predictions published'] == '1'
+        assert keys['model status'] == 'OK'
+        assert keys['predictions published'] == str(len(motor.predicted))
 
         cases = [({'p_in': P_IN, 'p_out': 30 * MPA}, FLOW,
                   'outlet_pressure.fluid_pressure = 30000000.0 Pa is above '
@@ -200,8 +215,7 @@ def test_node_rejects_bad_parameters_with_a_reason_and_applies_good_ones(
         assert not result.successful and "liquid = 'glycol': not a coefficient set" \
             in result.reason
         motor.clear()
-        _drive(h, motor, p_in=P_IN, p_out=P_OUT)
-        assert h.spin_until(lambda: motor.predicted, 5.0)
+        _drive_until_predicted(h, motor, p_in=P_IN, p_out=P_OUT)
         water = WATER.speed_point(FLOW, P_IN - P_OUT).speed
         assert motor.predicted[0].velocity[0] == pytest.approx(water, rel=1e-15)
         _drive_until_diag(h, motor, 0, 'OK', p_in=P_IN, p_out=P_OUT)  # start-up problems over
@@ -227,17 +241,16 @@ def test_two_motors_in_two_namespaces_at_once(install, executable, harness):
         a, b = h.motor(left), h.motor(right, joint='shaft_b')
         h.wait_connected(a)
         h.wait_connected(b)
-        a.inputs(p_in=P_IN, p_out=P_OUT)
-        _drive(h, b, p_in=P_IN, p_out=P_OUT)
-        _drive(h, a, p_in=P_IN, p_out=P_OUT)
-        assert h.spin_until(lambda: a.predicted and b.predicted, 5.0)
+        _drive_until_predicted(h, a, p_in=P_IN, p_out=P_OUT)
+        _drive_until_predicted(h, b, p_in=P_IN, p_out=P_OUT)
         h.spin_for(0.3)
-        assert len(a.predicted) == len(b.predicted) == 1
-        assert a.predicted[0].velocity[0] == pytest.approx(
-            OIL.speed_point(FLOW, P_IN - P_OUT).speed, rel=1e-15)
-        assert b.predicted[0].velocity[0] == pytest.approx(
-            WATER.speed_point(FLOW, P_IN - P_OUT).speed, rel=1e-15)
-        assert b.predicted[0].name == ['shaft_b']
+        oil = OIL.speed_point(FLOW, P_IN - P_OUT).speed
+        water = WATER.speed_point(FLOW, P_IN - P_OUT).speed
+        assert [m.velocity[0] for m in a.predicted] == pytest.approx(
+            [oil] * len(a.predicted), rel=1e-15)
+        assert [m.velocity[0] for m in b.predicted] == pytest.approx(
+            [water] * len(b.predicted), rel=1e-15)  # no cross-talk between the namespaces
+        assert {tuple(m.name) for m in b.predicted} == {('shaft_b',)}
     finally:
         results = [stop_node(p) for p in procs]
     assert all(code == 0 for code, _ in results), results
@@ -258,8 +271,7 @@ def test_node_runs_on_sim_time_from_clock(install, executable, harness):
                 h.spin_for(0.05)
 
         tick(1000)
-        _drive(h, motor, p_in=P_IN, p_out=P_OUT)
-        assert h.spin_until(lambda: motor.predicted, 5.0)
+        _drive_until_predicted(h, motor, p_in=P_IN, p_out=P_OUT)
         assert motor.predicted[0].header.stamp.sec == 1000
         assert motor.predicted[0].header.stamp.nanosec == 0
         motor.clear()

@@ -14,6 +14,7 @@ from __future__ import annotations
 import dataclasses
 from typing import Any
 
+from builtin_interfaces.msg import Time as TimeMsg
 from diagnostic_msgs.msg import DiagnosticArray
 from rcl_interfaces.msg import SetParametersResult
 import rclpy
@@ -281,7 +282,7 @@ class MotorModelNode(Node):
         self._published += 1
         out = pred.outputs
         joint = JointState(name=[self._joint], velocity=[out[3]])
-        joint.header.stamp = Time(nanoseconds=t_ns).to_msg()
+        joint.header.stamp = TimeMsg(sec=t_ns // 1_000_000_000, nanosec=t_ns % 1_000_000_000)
         self._pub_joint.publish(joint)
         for k, publisher in enumerate(self._pub_losses):
             publisher.publish(Float64(data=out[4 + k]))

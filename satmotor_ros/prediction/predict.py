@@ -82,8 +82,22 @@ def _messages(snap: Snapshot, timeout: float, status: int, dp: float) -> tuple[i
     return int(level), '; '.join(notes) if notes else 'OK'
 
 
-def _inputs_usable(states: tuple[int, ...]) -> bool:
-    return all(input_level(name, state) < Level.ERROR for name, state in zip(INPUTS, states))
+def _level_table() -> npt.NDArray[np.uint8]:
+    table = np.zeros((len(INPUTS), max(InputState) + 1), dtype=np.uint8)
+    for i, name in enumerate(INPUTS):
+        for state in InputState:
+            table[i, state] = input_level(name, state)
+    return table
+
+
+_LEVELS = _level_table()
+_LEVEL_ROWS = [tuple(int(x) for x in row) for row in _LEVELS]
+_NOTED_OR_INVALID = int(_NOTED | INVALID)
+
+
+def _input_level(states: tuple[int, ...]) -> int:
+    """Return the worst level of the inputs' states (a table look-up per input)."""
+    return max(row[state] for row, state in zip(_LEVEL_ROWS, states))
 
 
 def predict_point(model: MotorModel, snap: Snapshot, timeout: float) -> Prediction:
@@ -105,7 +119,8 @@ def predict_point(model: MotorModel, snap: Snapshot, timeout: float) -> Predicti
         Outputs and status; NaN outputs and level ERROR when no prediction may be made.
 
     """
-    if not _inputs_usable(snap.states):
+    inputs_level = _input_level(snap.states)
+    if inputs_level >= Level.ERROR:
         level, message = _messages(snap, timeout, 0, math.nan)
         return Prediction(snap.stamp_ns, snap.values, (math.nan,) * len(OUTPUTS), 0, level,
                           message)
@@ -117,7 +132,10 @@ def predict_point(model: MotorModel, snap: Snapshot, timeout: float) -> Predicti
     speed = point.speed
     residual = (snap.values[_I_SPEED] - speed if snap.states[_I_SPEED] == InputState.FRESH
                 else math.nan)
-    level, message = _messages(snap, timeout, status, dp)
+    if inputs_level == Level.OK and not status & _NOTED_OR_INVALID:
+        level, message = Level.OK, 'OK'  # the usual case, without building any text
+    else:
+        level, message = _messages(snap, timeout, status, dp)
     if level >= Level.ERROR:
         return Prediction(snap.stamp_ns, snap.values, (math.nan,) * len(OUTPUTS), status,
                           level, message)
@@ -198,17 +216,6 @@ class PredictionBatch(NamedTuple):
         """
         dp = float(self.snapshots.values[1, i] - self.snapshots.values[2, i])
         return _messages(self.snapshot(i), self.timeout, int(self.status[i]), dp)[1]
-
-
-def _level_table() -> npt.NDArray[np.uint8]:
-    table = np.zeros((len(INPUTS), max(InputState) + 1), dtype=np.uint8)
-    for i, name in enumerate(INPUTS):
-        for state in InputState:
-            table[i, state] = input_level(name, state)
-    return table
-
-
-_LEVELS = _level_table()
 
 
 def predict_batch(model: MotorModel, snaps: SnapshotBatch, timeout: float) -> PredictionBatch:

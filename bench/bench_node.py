@@ -1,0 +1,196 @@
+# SPDX-License-Identifier: Apache-2.0
+"""
+Benchmark the motor_model node's input-to-output latency against a bare relay node.
+
+Two node processes are measured one after the other in the same run, each fed
+``flow_command`` at 1 kHz (and the pressures at 100 Hz) from this process:
+- relay: subscribes ``flow_command`` and publishes the same message on ``relay_out``,
+  no computation (the floor of rclpy's take -> callback -> publish path);
+- motor_model: the node, from this source tree, publishing ``predicted_joint_state``.
+Latency is the time from publishing a flow_command to receiving its output here (one
+monotonic clock for all processes). Each output is matched to its input by value: the
+flows are all distinct and the predicted speed grows with the flow, so a lost message
+is a drop, not a shifted pairing. Reported: p50/p99 latency, the ratio to the relay,
+drops, and the node process's CPU time per input message (/proc).
+
+Run: ``ROS_DOMAIN_ID=.. python bench/bench_node.py [--seconds 30] [--rate 1000]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+from pathlib import Path
+import subprocess
+import sys
+import threading
+import time
+import uuid
+
+os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))  # this source tree's satmotor_ros
+
+import numpy as np  # noqa: E402
+import rclpy  # noqa: E402
+from rclpy.context import Context  # noqa: E402
+from rclpy.executors import SingleThreadedExecutor  # noqa: E402
+from rclpy.node import Node  # noqa: E402
+from satmotor_ros.model import MotorModel  # noqa: E402
+from satmotor_ros.model.units import LPM, MPA  # noqa: E402
+from sensor_msgs.msg import FluidPressure, JointState  # noqa: E402
+from std_msgs.msg import Float64  # noqa: E402
+
+P_IN, P_OUT = 20 * MPA, 0.2 * MPA
+
+
+class Relay(Node):
+    """Subscribe flow_command, publish it unchanged on relay_out: no computation."""
+
+    def __init__(self) -> None:
+        """Create the subscription and the publisher."""
+        super().__init__('relay')
+        self.pub = self.create_publisher(Float64, 'relay_out', 10)
+        self.create_subscription(Float64, 'flow_command', self.pub.publish, 10)
+
+
+def run_relay() -> None:
+    """Spin the relay node (the child process)."""
+    rclpy.init()
+    node = Relay()
+    try:
+        rclpy.spin(node)
+    except (KeyboardInterrupt, rclpy.executors.ExternalShutdownException):
+        pass
+    finally:
+        node.destroy_node()
+        rclpy.try_shutdown()
+
+
+def _cpu_seconds(pid: int) -> float:
+    fields = Path(f'/proc/{pid}/stat').read_text().rsplit(')', 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK')
+
+
+def measure(kind: str, seconds: float, rate: float, namespace: str) -> dict[str, float]:
+    """
+    Start one node process, feed it, and measure its latency.
+
+    Parameters
+    ----------
+    kind : {'relay', 'motor_model'}
+        Which node, [-]
+    seconds : float
+        Length of the measurement, [s]
+    rate : float
+        flow_command rate, [Hz]
+    namespace : str
+        Namespace of the node, [-]
+
+    Returns
+    -------
+    dict
+        p50, p99 [ms], drops, sent, cpu per message [us].
+
+    """
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    code = ('import sys; sys.path.insert(0, %r); import bench_node; bench_node.run_relay()'
+            % str(ROOT / 'bench')) if kind == 'relay' else \
+        'from satmotor_ros.nodes.motor_model import main; main()'
+    proc = subprocess.Popen([sys.executable, '-c', code, '--ros-args', '-r',
+                             f'__ns:={namespace}'], env=env)
+    context = Context()
+    context.init()
+    node = Node(f'bench_{uuid.uuid4().hex[:8]}', context=context)
+    executor = SingleThreadedExecutor(context=context)
+    executor.add_node(node)
+    n = int(seconds * rate)
+    flows = (5.0 + 30.0 * np.arange(n) / n) * LPM
+    received: list[tuple[int, float]] = []
+    flow_pub = node.create_publisher(Float64, f'{namespace}/flow_command', 10)
+    p_in = node.create_publisher(FluidPressure, f'{namespace}/inlet_pressure', 10)
+    p_out = node.create_publisher(FluidPressure, f'{namespace}/outlet_pressure', 10)
+    if kind == 'relay':
+        node.create_subscription(Float64, f'{namespace}/relay_out',
+                                 lambda m: received.append((time.monotonic_ns(), m.data)), 10)
+    else:
+        node.create_subscription(
+            JointState, f'{namespace}/predicted_joint_state',
+            lambda m: received.append((time.monotonic_ns(), m.velocity[0])), 10)
+    sent = np.zeros(n, dtype=np.int64)
+    try:
+        deadline = time.monotonic() + 30.0
+        while time.monotonic() < deadline and not (
+                flow_pub.get_subscription_count() and node.count_publishers(
+                    f'{namespace}/relay_out' if kind == 'relay'
+                    else f'{namespace}/predicted_joint_state')):
+            executor.spin_once(timeout_sec=0.05)
+        for _ in range(20):  # the pressures arrive before the first flow_command
+            p_in.publish(FluidPressure(fluid_pressure=P_IN))
+            p_out.publish(FluidPressure(fluid_pressure=P_OUT))
+            executor.spin_once(timeout_sec=0.01)
+        cpu0 = _cpu_seconds(proc.pid)
+
+        def feed() -> None:
+            period = 1.0 / rate
+            start = time.monotonic()
+            for k in range(n):
+                target = start + k * period
+                while (now := time.monotonic()) < target:
+                    time.sleep(min(target - now, 2e-4))
+                if k % max(1, int(rate / 100)) == 0:
+                    p_in.publish(FluidPressure(fluid_pressure=P_IN))
+                    p_out.publish(FluidPressure(fluid_pressure=P_OUT))
+                sent[k] = time.monotonic_ns()
+                flow_pub.publish(Float64(data=flows[k]))
+
+        feeder = threading.Thread(target=feed)
+        feeder.start()
+        while feeder.is_alive():
+            executor.spin_once(timeout_sec=0.01)
+        end = time.monotonic() + 1.0
+        while time.monotonic() < end:
+            executor.spin_once(timeout_sec=0.01)
+        cpu = _cpu_seconds(proc.pid) - cpu0
+    finally:
+        executor.shutdown()
+        node.destroy_node()
+        context.try_shutdown()
+        proc.send_signal(2)
+        proc.wait(10)
+    if kind == 'relay':
+        keys = flows
+    else:
+        keys = MotorModel.default('oil').speed(flows, P_IN - P_OUT).speed
+    values = np.array([v for _, v in received])
+    index = np.clip(np.searchsorted(keys, values), 0, n - 1)
+    left = np.clip(index - 1, 0, n - 1)
+    index = np.where(np.abs(keys[left] - values) < np.abs(keys[index] - values), left, index)
+    latency = (np.array([t for t, _ in received]) - sent[index]) / 1e6
+    return {'p50': float(np.percentile(latency, 50)), 'p99': float(np.percentile(latency, 99)),
+            'sent': n, 'drops': n - len(np.unique(index)), 'cpu_us': cpu / n * 1e6}
+
+
+def main() -> None:
+    """Measure the relay, then the node, and print the comparison."""
+    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    parser.add_argument('--seconds', type=float, default=30.0)
+    parser.add_argument('--rate', type=float, default=1000.0)
+    args = parser.parse_args()
+    ns = f'/bench_{uuid.uuid4().hex[:8]}'
+    relay = measure('relay', args.seconds, args.rate, ns + '/relay')
+    model = measure('motor_model', args.seconds, args.rate, ns + '/motor')
+    print(f'{args.rate:g} Hz for {args.seconds:g} s, ROS_DOMAIN_ID '
+          f'{os.environ.get("ROS_DOMAIN_ID", "0")}, load {os.getloadavg()[0]:.1f}')
+    print(f'{"node":12s} {"p50 [ms]":>9s} {"p99 [ms]":>9s} {"sent":>7s} {"drops":>6s} '
+          f'{"CPU/msg [us]":>13s}')
+    for name, r in (('relay', relay), ('motor_model', model)):
+        print(f'{name:12s} {r["p50"]:9.3f} {r["p99"]:9.3f} {r["sent"]:7d} {r["drops"]:6d} '
+              f'{r["cpu_us"]:13.1f}')
+    print(f'ratio motor_model/relay: p50 {model["p50"] / relay["p50"]:.2f}x, '
+          f'p99 {model["p99"] / relay["p99"]:.2f}x, '
+          f'CPU/msg {model["cpu_us"] / relay["cpu_us"]:.2f}x')
+
+
+if __name__ == '__main__':
+    main()
