@@ -142,3 +142,32 @@ def test_effect_records_are_frozen():
     """Parameters cannot change under a running plant."""
     with pytest.raises(dataclasses.FrozenInstanceError):
         EffectParams().external_leakage = 1.0
+
+
+def test_flat_parameter_table_round_trips_and_names_bad_values():
+    """Every dotted name maps to a field with unit and range; bad values name the field."""
+    from satmotor_ros.plant.config import flat_from_params, parameter_specs, params_from_flat
+    specs = {s.name: s for s in parameter_specs()}
+    assert specs['lines.inlet_volume'].unit == 'm^3'
+    assert specs['sensors.flow.noise'].unit == 'm^3/s'
+    assert specs['effects.external_leakage'].low == 0.0
+    assert all(s.description and s.unit for s in specs.values())
+    params = params_from_flat({'effects.external_leakage': 1e-12, 'sensors.speed.rate': 50.0})
+    assert params.effects.external_leakage == 1e-12 and params.sensors.speed.rate == 50.0
+    assert params_from_flat(flat_from_params(params)) == params
+    with pytest.raises(Exception, match=r'ShaftParams.inertia = -1'):
+        params_from_flat({'shaft.inertia': -1.0})
+    with pytest.raises(Exception, match='unknown plant parameter'):
+        params_from_flat({'shaft.mass': 1.0})
+
+
+def test_reconfigure_keeps_the_state_and_applies_the_new_parameters():
+    """A new liquid or effect takes hold from the next step without a jump in the state."""
+    plant, _ = _run()
+    before = plant.state
+    plant.reconfigure(dataclasses.replace(plant.params, effects=EffectParams(
+        flow_sensor_offset=1e-5)), MotorModel.default('oil'))
+    assert plant.state == before
+    assert plant.model.liquid.name != MODEL.liquid.name
+    plant.step(FLOW)
+    assert plant.measure().flow == pytest.approx(plant.flows.motor + 1e-5, rel=1e-12)

@@ -13,9 +13,8 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from typing import NamedTuple
 
-from satmotor_ros.model import COMPONENTS, MotorModel
+from satmotor_ros.model import MotorModel
 
 
 class MotorCache:
@@ -108,54 +107,8 @@ def mirrored_point(model: MotorModel, speed: float, dp: float,
     qt = model.geometry.displacement
     a_speed, a_dp = abs(speed), abs(dp)
     guess = None if flow_guess is None else qt * a_speed + abs(flow_guess - qt * speed)
-    pt = absorbency_point(model, a_speed, a_dp, guess)
+    pt = model.absorbency_point(a_speed, a_dp, flow_guess=guess)
     loss = pt.flow - qt * a_speed - pt.inertia
     sign = 1.0 if dp >= 0.0 else -1.0
     return (qt * speed + math.copysign(pt.inertia, speed) + sign * loss,
             math.copysign(pt.dp_i, dp), pt.external, pt.inertia, pt.status)
-
-
-class _Point(NamedTuple):
-    """Stand-in for the model's single-point result until the model branch lands."""
-
-    flow: float
-    speed: float
-    dp: float
-    dp_i: float
-    flat_clearance: float
-    commutation: float
-    compressibility: float
-    deformation: float
-    backlash: float
-    inertia: float
-    external: float
-    total: float
-    status: int
-
-
-def absorbency_point(model: MotorModel, speed: float, dp: float,
-                     flow_guess: float | None) -> _Point:
-    """
-    Evaluate the forward map at one point (temporary: through the array API).
-
-    Parameters
-    ----------
-    model : MotorModel
-        The motor, [-]
-    speed : float
-        Shaft speed, [rad/s]
-    dp : float
-        Port pressure drop, [Pa]
-    flow_guess : float or None
-        Warm start, unused here, [m^3/s]
-
-    Returns
-    -------
-    _Point
-        The point.
-
-    """
-    op = model.absorbency(speed, dp, errors='mask')
-    losses = op.losses
-    return _Point(float(op.flow), float(op.speed), float(op.dp), float(op.dp_i),
-                  *(float(getattr(losses, name)) for name in COMPONENTS), int(op.status))

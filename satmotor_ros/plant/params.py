@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field, fields
 import math
+from typing import ClassVar
 
 from satmotor_ros.model.units import LPM, MPA
 from satmotor_ros.plant.errors import PlantError
@@ -19,15 +20,28 @@ ATMOSPHERE = 101325.0
 """Standard atmospheric pressure, the default tank pressure, [Pa]."""
 
 
-def _check(owner: object, name: str, low: float, high: float, closed_low: bool = True) -> None:
-    value = getattr(owner, name)
-    ok = isinstance(value, (int, float)) and math.isfinite(value) and value <= high and (
-        value >= low if closed_low else value > low)
-    if not ok:
-        bracket = '[' if closed_low else '('
-        msg = (f'{type(owner).__name__}.{name} = {value!r} is outside '
-               f'{bracket}{low:g}, {high:g}]')
-        raise PlantError(msg)
+def check_bounds(record: object) -> None:
+    """
+    Check every numeric field of a record against its class's ``bounds`` (closed ranges).
+
+    Parameters
+    ----------
+    record : object
+        A parameter record with a ``bounds`` mapping field -> (low, high), [-]
+
+    Raises
+    ------
+    PlantError
+        Naming the first field outside its range and its value.
+
+    """
+    for name, (low, high) in record.bounds.items():
+        value = getattr(record, name)
+        ok = (isinstance(value, (int, float)) and not isinstance(value, bool)
+              and math.isfinite(value) and low <= value <= high)
+        if not ok:
+            msg = f'{type(record).__name__}.{name} = {value!r} is outside [{low:g}, {high:g}]'
+            raise PlantError(msg)
 
 
 @dataclass(frozen=True)
@@ -41,14 +55,14 @@ class LineParams:
     return_conductance: float = 40.0 * LPM / MPA  # G_r, return valve slope [m^3/(s*Pa)]
     vapour_pressure: float = 2.0e3  # absolute floor of both lines (cavitation) [Pa]
 
+    bounds: ClassVar[dict[str, tuple[float, float]]] = {
+        'inlet_volume': (1.0e-7, 1.0), 'outlet_volume': (1.0e-7, 1.0),
+        'tank_pressure': (1.0e3, 1.0e7), 'back_pressure': (0.0, 1.0e7),
+        'return_conductance': (1.0e-13, 1.0e-5), 'vapour_pressure': (0.0, 1.0e5)}
+
     def __post_init__(self) -> None:
-        """Reject non-physical values, naming the field."""
-        _check(self, 'inlet_volume', 0.0, 1.0, closed_low=False)
-        _check(self, 'outlet_volume', 0.0, 1.0, closed_low=False)
-        _check(self, 'tank_pressure', 0.0, 1.0e8)
-        _check(self, 'back_pressure', 0.0, 1.0e8)
-        _check(self, 'return_conductance', 0.0, 1.0, closed_low=False)
-        _check(self, 'vapour_pressure', 0.0, self.tank_pressure)
+        """Reject values outside ``bounds``, naming the field."""
+        check_bounds(self)
 
 
 @dataclass(frozen=True)
@@ -58,10 +72,12 @@ class ReliefParams:
     cracking_pressure: float = 27.0 * MPA  # p_cr, above tank pressure [Pa]
     conductance: float = 40.0 * LPM / (2.0 * MPA)  # k_rv, flow per override [m^3/(s*Pa)]
 
+    bounds: ClassVar[dict[str, tuple[float, float]]] = {
+        'cracking_pressure': (1.0e5, 4.5e7), 'conductance': (1.0e-13, 1.0e-5)}
+
     def __post_init__(self) -> None:
-        """Reject non-physical values, naming the field."""
-        _check(self, 'cracking_pressure', 0.0, 1.0e9, closed_low=False)
-        _check(self, 'conductance', 0.0, 1.0, closed_low=False)
+        """Reject values outside ``bounds``, naming the field."""
+        check_bounds(self)
 
 
 @dataclass(frozen=True)
@@ -72,14 +88,15 @@ class ShaftParams:
     viscous_friction: float = 2.0e-3  # b, torque per speed [N*m*s/rad]
     coulomb_friction: float = 0.5  # T_c, dry friction [N*m]
     pressure_friction: float = 0.04  # c_p, share of q_t*dp_i lost to friction [-]
-    locked: bool = False  # shaft blocked by a brake: speed held at 0
+    locked: bool = False  # shaft blocked by a brake: speed held at 0 [-]
+
+    bounds: ClassVar[dict[str, tuple[float, float]]] = {
+        'inertia': (1.0e-6, 1.0e3), 'viscous_friction': (0.0, 1.0e3),
+        'coulomb_friction': (0.0, 1.0e4), 'pressure_friction': (0.0, 0.9)}
 
     def __post_init__(self) -> None:
-        """Reject non-physical values, naming the field."""
-        _check(self, 'inertia', 0.0, 1.0e3, closed_low=False)
-        _check(self, 'viscous_friction', 0.0, 1.0e3)
-        _check(self, 'coulomb_friction', 0.0, 1.0e4)
-        _check(self, 'pressure_friction', 0.0, 0.9)
+        """Reject values outside ``bounds``, naming the field."""
+        check_bounds(self)
 
 
 @dataclass(frozen=True)
@@ -88,16 +105,17 @@ class ThermalParams:
 
     heat_capacity: float = 4.0e4  # C_th, liquid and metal [J/K]
     cooling: float = 50.0  # hA, heat loss to the ambient per kelvin [W/K]
-    ambient: float = 25.0  # T_a [degC]
+    ambient: float = 25.0  # T_a, ambient temperature [degC]
     initial: float = 40.0  # liquid temperature at t = 0 [degC]
     reference: float = 40.0  # temperature of the liquid's nominal viscosity [degC]
 
+    bounds: ClassVar[dict[str, tuple[float, float]]] = {
+        'heat_capacity': (1.0, 1.0e9), 'cooling': (0.0, 1.0e6), 'ambient': (-50.0, 200.0),
+        'initial': (-50.0, 200.0), 'reference': (-50.0, 200.0)}
+
     def __post_init__(self) -> None:
-        """Reject non-physical values, naming the field."""
-        _check(self, 'heat_capacity', 0.0, 1.0e9, closed_low=False)
-        _check(self, 'cooling', 0.0, 1.0e6)
-        for name in ('ambient', 'initial', 'reference'):
-            _check(self, name, -50.0, 200.0)
+        """Reject values outside ``bounds``, naming the field."""
+        check_bounds(self)
 
 
 @dataclass(frozen=True)
@@ -107,10 +125,12 @@ class CaseParams:
     offset: float = 0.05 * MPA  # case pressure above tank at zero outlet pressure [Pa]
     outlet_share: float = 0.1  # d p_case / d p_out [-]
 
+    bounds: ClassVar[dict[str, tuple[float, float]]] = {
+        'offset': (0.0, 1.0e7), 'outlet_share': (0.0, 1.0)}
+
     def __post_init__(self) -> None:
-        """Reject non-physical values, naming the field."""
-        _check(self, 'offset', 0.0, 1.0e8)
-        _check(self, 'outlet_share', 0.0, 1.0)
+        """Reject values outside ``bounds``, naming the field."""
+        check_bounds(self)
 
 
 @dataclass(frozen=True)
@@ -125,25 +145,25 @@ class EffectParams:
     the flowmeter and the speed sensor only.
     """
 
-    external_leakage: float = 0.0  # k_x [m^3/(s*Pa)]
+    external_leakage: float = 0.0  # k_x, leakage to the tank per driving pressure [m^3/(s*Pa)]
     leakage_driver: str = 'case'  # 'case' or 'outlet': pressure that drives k_x [-]
-    viscosity_temperature: float = 0.0  # a [1/K]
+    viscosity_temperature: float = 0.0  # a, viscosity-temperature exponent of eq. (P7) [1/K]
     clearance_wear: float = 0.0  # growth of h_R and h_S [m/rev]
     flow_sensor_offset: float = 0.0  # added to the measured flow [m^3/s]
     flow_sensor_gain: float = 0.0  # relative gain error of the flowmeter [-]
     speed_sensor_gain: float = 0.0  # relative gain error of the speed sensor [-]
 
+    bounds: ClassVar[dict[str, tuple[float, float]]] = {
+        'external_leakage': (0.0, 1.0e-8), 'viscosity_temperature': (0.0, 0.2),
+        'clearance_wear': (0.0, 1.0e-6), 'flow_sensor_offset': (-1.0e-2, 1.0e-2),
+        'flow_sensor_gain': (-0.5, 0.5), 'speed_sensor_gain': (-0.5, 0.5)}
+
     def __post_init__(self) -> None:
-        """Reject non-physical values, naming the field."""
-        _check(self, 'external_leakage', 0.0, 1.0e-8)
+        """Reject values outside ``bounds``, naming the field."""
+        check_bounds(self)
         if self.leakage_driver not in ('case', 'outlet'):
             msg = f"EffectParams.leakage_driver = {self.leakage_driver!r}: use 'case' or 'outlet'"
             raise PlantError(msg)
-        _check(self, 'viscosity_temperature', 0.0, 0.2)
-        _check(self, 'clearance_wear', 0.0, 1.0e-6)
-        _check(self, 'flow_sensor_offset', -1.0e-2, 1.0e-2)
-        _check(self, 'flow_sensor_gain', -0.5, 0.5)
-        _check(self, 'speed_sensor_gain', -0.5, 0.5)
 
 
 @dataclass(frozen=True)
@@ -152,15 +172,16 @@ class SensorParams:
 
     noise: float = 0.0  # standard deviation of white noise [unit of the channel]
     bias: float = 0.0  # constant offset [unit of the channel]
-    gain: float = 1.0  # [-]
+    gain: float = 1.0  # factor on the true value [-]
     rate: float = 0.0  # samples per second; 0 samples at every read [Hz]
 
+    bounds: ClassVar[dict[str, tuple[float, float]]] = {
+        'noise': (0.0, 1.0e9), 'bias': (-1.0e9, 1.0e9), 'gain': (1.0e-3, 10.0),
+        'rate': (0.0, 1.0e6)}
+
     def __post_init__(self) -> None:
-        """Reject non-physical values, naming the field."""
-        _check(self, 'noise', 0.0, 1.0e12)
-        _check(self, 'bias', -1.0e12, 1.0e12)
-        _check(self, 'gain', 0.0, 10.0, closed_low=False)
-        _check(self, 'rate', 0.0, 1.0e6)
+        """Reject values outside ``bounds``, naming the field."""
+        check_bounds(self)
 
 
 SENSOR_CHANNELS = ('inlet_pressure', 'outlet_pressure', 'case_pressure', 'flow', 'speed',
@@ -196,10 +217,12 @@ class PlantParams:
     seed: int = 0  # seed of the sensor noise [-]
     rebuild_tolerance: float = 0.005  # relative change of nu or h that rebuilds the model [-]
 
+    bounds: ClassVar[dict[str, tuple[float, float]]] = {
+        'step': (1.0e-6, 0.1), 'rebuild_tolerance': (1.0e-6, 0.5)}
+
     def __post_init__(self) -> None:
-        """Reject non-physical values, naming the field."""
-        _check(self, 'step', 1.0e-6, 0.1)
-        _check(self, 'rebuild_tolerance', 0.0, 0.5, closed_low=False)
+        """Reject values outside ``bounds``, naming the field."""
+        check_bounds(self)
 
 
 def record_fields(record: type) -> tuple[str, ...]:

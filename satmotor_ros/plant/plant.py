@@ -31,7 +31,7 @@ from satmotor_ros.model import MotorModel
 from satmotor_ros.plant.equations import case_pressure, friction_torque, viscosity_at
 from satmotor_ros.plant.errors import PlantError
 from satmotor_ros.plant.load import ConstantLoad, LoadProfile
-from satmotor_ros.plant.motor import absorbency_point, mirrored_point, MotorCache
+from satmotor_ros.plant.motor import mirrored_point, MotorCache
 from satmotor_ros.plant.params import PlantParams
 from satmotor_ros.plant.sensors import Sensor
 
@@ -112,6 +112,7 @@ class Plant:
         self.params = params if params is not None else PlantParams()
         self.load = load if load is not None else ConstantLoad()
         self._motor = MotorCache(model, self.params.rebuild_tolerance)
+        self._point = model.absorbency_point
         self._set_constants()
         self.reset()
 
@@ -180,6 +181,28 @@ class Plant:
         self.invalid_points = 0  # steps that fell back on the last good linearisation
         self._make_sensors()
 
+    def reconfigure(self, params: PlantParams, model: MotorModel | None = None) -> None:
+        """
+        Change parameters (and optionally the motor) and keep the state.
+
+        Parameters
+        ----------
+        params : PlantParams
+            New parameters, [-]
+        model : MotorModel, optional
+            A new motor or liquid; the drifting effects restart from it, [-]
+
+        """
+        self.params = params
+        if model is not None or params.rebuild_tolerance != self._motor.tolerance:
+            self._motor = MotorCache(model or self._motor.base, params.rebuild_tolerance)
+            self._point = self._motor.model.absorbency_point
+            self._q_guess = None
+        self._set_constants()
+        if self._locked:
+            self._w = 0.0
+        self._make_sensors()
+
     def _make_sensors(self) -> None:
         p = self.params
         rng = np.random.default_rng(p.seed)
@@ -227,7 +250,7 @@ class Plant:
             raise PlantError(msg)
         if load_torque is None:
             tl0, tls = self.load.at(self._t)
-        elif math.isfinite(load_torque):
+        elif load_torque - load_torque == 0.0:  # finite
             tl0, tls = load_torque, 0.0
         else:
             msg = f'load_torque = {load_torque!r} N*m: not finite'
@@ -235,54 +258,71 @@ class Plant:
         tc = self._tc
         if not self._active_load:  # a brake: |t0| adds to the dry friction
             tc, tl0 = tc + abs(tl0), 0.0
-        w, p_in, p_out = self._w, self._p_in, self._p_out
-        dp = p_in - p_out
+        w = self._w
+        dp = self._p_in - self._p_out
         qt = self._qt
-        self._linearise(w, dp)
-        g, h, dich, qx = self._lin
 
-        # constant parts of the 2x2 pressure system once the shaft is eliminated
-        a11 = self._a + g
-        a12 = self._e1 - g
-        b1 = self._a * p_in + flow_command - h - self._e0
-        a22 = self._c + g + self._gr
-        b2 = self._c * p_out + h - qx + self._gr * self._pr0
-        relief = p_in > self._pcr
+        # 1. the motor at the start of the step, linearised as Q_m' = q_t w' + G dp' + h
+        if w >= 0.0 and dp >= 0.0:
+            pt = self._point(w, dp, flow_guess=self._q_guess)
+            q, dp_i, q_id, qx, self.model_status = pt[0], pt[3], pt[9], pt[10], pt[12]
+        else:
+            q, dp_i, qx, q_id, self.model_status = mirrored_point(self._motor.model, w, dp,
+                                                                  self._q_guess)
+        if q == q:
+            self._q_guess = q
+            qtw = qt * w
+            g = abs(q - qtw - (q_id if w >= 0.0 else -q_id)) / max(abs(dp), _DP_REF)
+            lin = self._lin = (g, q - qtw - g * dp, dp - dp_i, qx)
+        else:  # NaN: the model refused the point; keep the last good linearisation
+            self.invalid_points += 1
+            lin = self._lin
+        dich = lin[2]
 
-        if self._locked or w == 0.0:
-            p, r, relief = self._solve(a11, a12, b1, a22, b2, 0.0, 0.0, relief)
-            w_new, sign = 0.0, self._breakaway(p - r - dich, tl0, tc)
+        # 2. the implicit step: sliding, sticking or breaking away (Karnopp)
+        relief = self._p_in > self._pcr
+        if w == 0.0:
+            p, r, relief = self._solve(flow_command, lin, 0.0, 0.0, relief)
+            w_new = 0.0
+            sign = 0.0 if self._locked else self._breakaway(p - r - dich, tl0, tc)
         else:
             sign = 1.0 if w > 0.0 else -1.0
-            w_new = None
-        if sign != 0.0 and not self._locked:
-            kt = qt * (1.0 - self._cp * sign * (1.0 if dp - dich >= 0.0 else -1.0))
-            den = self._m + self._b + tls
-            w0 = (self._m * w - kt * dich - sign * tc - tl0) / den
+        if sign != 0.0:
+            kt = qt * (1.0 - self._cp * sign * (1.0 if dp >= dich else -1.0))
+            m = self._m
+            den = m + self._b + tls
+            w0 = (m * w - kt * dich - sign * tc - tl0) / den
             wk = kt / den
-            p, r, relief = self._solve(a11, a12, b1, a22, b2, w0, wk, relief)
+            p, r, relief = self._solve(flow_command, lin, w0, wk, relief)
             w_new = w0 + wk * (p - r)
             if w_new * sign < 0.0:  # friction stops the shaft within the step
-                p, r, relief = self._solve(a11, a12, b1, a22, b2, 0.0, 0.0, relief)
+                p, r, relief = self._solve(flow_command, lin, 0.0, 0.0, relief)
                 w_new = 0.0
-        self._finish(flow_command, p, r, w_new, relief, dich)
 
-    def _linearise(self, w: float, dp: float) -> None:
-        """Evaluate the motor at the start of the step; keep (G, h, channel drop, Q_ex)."""
-        model = self._motor.model
-        if w >= 0.0 and dp >= 0.0:
-            pt = absorbency_point(model, w, dp, self._q_guess)
-            q, dp_i, qx, q_id, status = pt.flow, pt.dp_i, pt.external, pt.inertia, pt.status
-        else:
-            q, dp_i, qx, q_id, status = mirrored_point(model, w, dp, self._q_guess)
-        self.model_status = status
-        if q != q:  # NaN: the model refused the point; keep the last good linearisation
-            self.invalid_points += 1
-            return
-        self._q_guess = q
-        qtw = self._qt * w
-        g = abs(q - qtw - math.copysign(q_id, w)) / max(abs(dp), _DP_REF)
-        self._lin = (g, q - qtw - g * dp, dp - dp_i, qx)
+        # 3. cavitation floor, torque, heat, angle, time
+        self._last = (flow_command, p, r, relief)  # as solved: the flows balance with these
+        pv = self._pv
+        if p < pv:
+            p = pv
+        if r < pv:
+            r = pv
+        dt = self._dt
+        dp_i = self._dp_i = p - r - dich
+        torque = 0.0
+        if w_new != 0.0:
+            torque = qt * dp_i - friction_torque(w_new, dp_i, qt, self._b, self._tc, self._cp)
+        self._torque = torque
+        heat_capacity, cooling, ambient = self._heat
+        temp = self._temp
+        loss_power = flow_command * (p - self._pt) - w_new * torque
+        self._temp = temp + dt * (loss_power - cooling * (temp - ambient)) / heat_capacity
+        self._p_in, self._p_out, self._w = p, r, w_new
+        self._theta += w_new * dt
+        n = self._n = self._n + 1
+        self._t = n * dt
+        if self._drifts:
+            self._revolutions += abs(w_new) * dt / (2.0 * math.pi)
+            self._drift()
 
     def _breakaway(self, dp_i: float, load: float, dry: float) -> float:
         """Return 0 while static friction holds the shaft, else the direction it breaks away."""
@@ -291,58 +331,40 @@ class Plant:
             return 0.0
         return 1.0 if drive > 0.0 else -1.0
 
-    def _solve(self, a11: float, a12: float, b1: float, a22: float, b2: float, w0: float,
+    def _solve(self, q_cmd: float, lin: tuple[float, float, float, float], w0: float,
                wk: float, relief: bool) -> tuple[float, float, bool]:
-        """Solve the implicit pressures with omega' = w0 + wk (P - R); relief open or shut."""
+        """
+        Solve the implicit line pressures with omega' = w0 + wk (P - R).
+
+        Inlet:  a (P - p_in)  = Q_cmd - Q_m' - Q_rv(P) - Q_x(R)        (P1), (P2)
+        Outlet: c (R - p_out) = Q_m' - Q_ex - Q_r(R)                    (P1), (P3)
+        with Q_m' = q_t omega' + G (P - R) + h. The relief valve is tried in
+        its last state and switched once if the solution contradicts it.
+        """
+        g, h, _, qx = lin
         qt = self._qt
         qwk = qt * wk
-        a11 += qwk
-        a12 -= qwk
-        a21 = -self._lin[0] - qwk
-        a22 += qwk
-        b1 -= qt * w0
-        b2 += qt * w0
+        a11 = self._a + g + qwk
+        a12 = self._e1 - g - qwk
+        a21 = -g - qwk
+        a22 = self._c + g + self._gr + qwk
+        b1 = self._a * self._p_in + q_cmd - h - self._e0 - qt * w0
+        b2 = self._c * self._p_out + h - qx + self._gr * self._pr0 + qt * w0
+        pcr = self._pcr
         p = r = 0.0
         for _ in range(3):
             if relief:
                 kv = self._kv
-                c11, d1 = a11 + kv, b1 + kv * self._pcr
+                c11, d1 = a11 + kv, b1 + kv * pcr
             else:
                 c11, d1 = a11, b1
             det = c11 * a22 - a12 * a21
             p = (d1 * a22 - a12 * b2) / det
             r = (c11 * b2 - a21 * d1) / det
-            if (p > self._pcr) == relief:
+            if (p > pcr) == relief:
                 break
             relief = not relief
         return p, r, relief
-
-    def _finish(self, q_cmd: float, p: float, r: float, w: float, relief: bool,
-                dich: float) -> None:
-        """Clamp cavitation, advance angle, time, heat and the drifting effects."""
-        dt = self._dt
-        self._last = (q_cmd, p, r, relief)  # as solved: the flows balance with these
-        if p < self._pv:
-            p = self._pv
-        if r < self._pv:
-            r = self._pv
-        dp_i = p - r - dich
-        self._dp_i = dp_i
-        torque = 0.0
-        if w != 0.0:
-            torque = self._qt * dp_i - friction_torque(w, dp_i, self._qt, self._b, self._tc,
-                                                       self._cp)
-        self._torque = torque
-        heat_capacity, cooling, ambient = self._heat
-        loss_power = q_cmd * (p - self._pt) - w * torque
-        self._temp += dt * (loss_power - cooling * (self._temp - ambient)) / heat_capacity
-        self._p_in, self._p_out, self._w = p, r, w
-        self._theta += w * dt
-        self._n += 1
-        self._t = self._n * dt
-        if self._drifts:
-            self._revolutions += abs(w) * dt / (2.0 * math.pi)
-            self._drift()
 
     def _drift(self) -> None:
         fx = self.params.effects
@@ -350,6 +372,7 @@ class Plant:
                           fx.viscosity_temperature)
         if self._motor.update(nu, fx.clearance_wear * self._revolutions):
             self._q_guess = None
+            self._point = self._motor.model.absorbency_point
 
     def run(self, steps: int, flow_command: float, load_torque: float | None = None) -> None:
         """
