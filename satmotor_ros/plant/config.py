@@ -31,7 +31,7 @@ CHANNEL_UNITS = {'inlet_pressure': 'Pa', 'outlet_pressure': 'Pa', 'case_pressure
                  'flow': 'm^3/s', 'speed': 'rad/s', 'temperature': 'degC'}
 """SI unit of each sensed channel (noise and bias are in it)."""
 
-_TOP = ('step', 'active_load', 'seed', 'rebuild_tolerance')
+_TOP = ('step', 'pump_lag', 'active_load', 'seed', 'rebuild_tolerance')
 _COMMENT = re.compile(r'^\s+(\w+): [^=]+=.*#\s*(.*?)\s*\[([^\]]*)\]\s*$', re.MULTILINE)
 
 

@@ -206,6 +206,7 @@ class PlantParams:
     """Everything the plant needs besides the motor model."""
 
     step: float = 1.0e-3  # physics step dt [s]
+    pump_lag: float = 0.03  # time constant of the pump's flow response to a command [s]
     lines: LineParams = field(default_factory=LineParams)
     relief: ReliefParams = field(default_factory=ReliefParams)
     shaft: ShaftParams = field(default_factory=ShaftParams)
@@ -218,7 +219,7 @@ class PlantParams:
     rebuild_tolerance: float = 0.005  # relative change of nu or h that rebuilds the model [-]
 
     bounds: ClassVar[dict[str, tuple[float, float]]] = {
-        'step': (1.0e-6, 0.1), 'rebuild_tolerance': (1.0e-6, 0.5)}
+        'step': (1.0e-6, 0.1), 'pump_lag': (0.0, 10.0), 'rebuild_tolerance': (1.0e-6, 0.5)}
 
     def __post_init__(self) -> None:
         """Reject values outside ``bounds``, naming the field."""

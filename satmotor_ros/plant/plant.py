@@ -5,6 +5,7 @@ The virtual motor: lines, relief valve, shaft and heat around the model's motor.
 State: inlet-line pressure p_in, outlet-line pressure p_out (both absolute),
 shaft speed omega and angle theta, liquid temperature T. Per step of dt:
 
+0. the pump delivers the flow command through a first-order lag;
 1. the motor model gives the absorbency Q_m(omega, dp) at the start of the step
    (eqs. (34)-(36) of Śliwiński 2017, through the model's single-point path);
 2. a linearly implicit (backward Euler) step solves the line pressures (P1),
@@ -56,7 +57,7 @@ class PlantState(NamedTuple):
 class StepFlows(NamedTuple):
     """The flows of the last step, as the integrator balanced them, [m^3/s]."""
 
-    command: float  # from the pump into the inlet line
+    command: float  # from the pump into the inlet line (the command after the pump's lag)
     motor: float  # into the motor's inlet port (model absorbency, linearised)
     relief: float  # relief valve, inlet line to tank
     leakage: float  # external-leakage effect, inlet line to tank
@@ -146,6 +147,7 @@ class Plant:
         self._heat = (th.heat_capacity, th.cooling, th.ambient)
         self._nu_ref = model.liquid.kinematic_viscosity
         self._drifts = fx.viscosity_temperature > 0.0 or fx.clearance_wear > 0.0
+        self._lag = dt / (p.pump_lag + dt)
 
     def reset(self, inlet_pressure: float | None = None, outlet_pressure: float | None = None,
               speed: float = 0.0, temperature: float | None = None) -> None:
@@ -166,6 +168,7 @@ class Plant:
         """
         self._n = 0
         self._t = 0.0
+        self._q_pump = 0.0  # flow the pump delivers [m^3/s]
         self._p_in = self._pr0 if inlet_pressure is None else float(inlet_pressure)
         self._p_out = self._pr0 if outlet_pressure is None else float(outlet_pressure)
         self._w = 0.0 if self._locked else float(speed)
@@ -258,6 +261,8 @@ class Plant:
         tc = self._tc
         if not self._active_load:  # a brake: |t0| adds to the dry friction
             tc, tl0 = tc + abs(tl0), 0.0
+        # the pump follows the command with a first-order lag (implicit: any lag >= 0)
+        flow_command = self._q_pump = self._q_pump + self._lag * (flow_command - self._q_pump)
         w = self._w
         dp = self._p_in - self._p_out
         qt = self._qt
