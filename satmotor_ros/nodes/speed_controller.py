@@ -41,6 +41,8 @@ PARAMETERS: tuple[ParameterSpec, ...] = (
     ParameterSpec('rate', 100.0, 'control rate on the node clock', 'Hz', 1.0, 1000.0),
     ParameterSpec('kp', _DEFAULTS.kp, 'proportional gain', 'm^3/rad', 0.0, 1.0e-3),
     ParameterSpec('ki', _DEFAULTS.ki, 'integral gain', 'm^3/(s*rad)', 0.0, 1.0e-2),
+    ParameterSpec('setpoint_weight', _DEFAULTS.setpoint_weight,
+                  'share of the set-point in the proportional part', '-', 0.0, 1.0),
     ParameterSpec('flow_min', _DEFAULTS.flow_min, 'smallest flow command', 'm^3/s', 0.0,
                   1.0e-2),
     ParameterSpec('flow_max', _DEFAULTS.flow_max, 'largest flow command', 'm^3/s', 1.0e-7,
@@ -61,7 +63,7 @@ PARAMETERS: tuple[ParameterSpec, ...] = (
 )
 """Every parameter of the node."""
 
-_LAW = ('kp', 'ki', 'flow_min', 'flow_max', 'feedforward', 'anti_windup')
+_LAW = ('kp', 'ki', 'setpoint_weight', 'flow_min', 'flow_max', 'feedforward', 'anti_windup')
 
 
 class SpeedControllerNode(Node):

@@ -5,10 +5,12 @@ The example speed controller's law: PI on commanded flow, anti-windup, feed-forw
 No ROS here: the ``speed_controller`` node and ``satmotor demo`` call it. The flow
 command is
 
-    Q = Q_ff(n_set, dp) + k_p e + I,     dI/dt = k_i e + (Q_sat - Q) / T_t
+    Q = Q_ff(n_set, dp) + k_p (b n_set - n) + I,     dI/dt = k_i e + (Q_sat - Q) / T_t
 
-with e = n_set - n the speed error, Q_sat the command clipped to the pump's range and
-T_t = k_p / k_i the back-calculation time constant (anti-windup). The feed-forward is
+with e = n_set - n the speed error, b the set-point weight of the proportional part
+(b < 1 keeps the proportional kick off a set-point step the feed-forward already makes),
+Q_sat the command clipped to the pump's range and T_t = k_p / k_i the back-calculation
+time constant (anti-windup). The feed-forward is
 
 - ``model``: the absorbency of eq. (36) at the set-point speed and the measured port
   pressure drop, i.e. the inverse model: the flow that gives n_set at this pressure
@@ -40,12 +42,13 @@ class ControllerParams:
     ki: float = 3.0e-5  # integral gain, flow per integrated speed error [m^3/(s*rad)]
     flow_min: float = 0.0  # smallest flow the pump gives [m^3/s]
     flow_max: float = 60.0 * LPM  # largest flow the pump gives [m^3/s]
+    setpoint_weight: float = 0.0  # b of the proportional part k_p (b n_set - n) [-]
     feedforward: str = 'model'  # 'model', 'naive' or 'none' [-]
     anti_windup: bool = True  # back-calculation of the integrator at the limits [-]
 
     bounds: ClassVar[dict[str, tuple[float, float]]] = {
         'kp': (0.0, 1.0e-3), 'ki': (0.0, 1.0e-2), 'flow_min': (0.0, 1.0e-2),
-        'flow_max': (1.0e-7, 1.0e-2)}
+        'flow_max': (1.0e-7, 1.0e-2), 'setpoint_weight': (0.0, 1.0)}
 
     def __post_init__(self) -> None:
         """Reject values outside ``bounds`` and an unknown feed-forward, naming the field."""
@@ -149,7 +152,7 @@ class SpeedController:
         p = self.params
         error = setpoint - speed
         ff = self.feedforward_flow = self.feedforward(setpoint, dp)
-        raw = ff + p.kp * error + self.integral
+        raw = ff + p.kp * (p.setpoint_weight * setpoint - speed) + self.integral
         command = min(max(raw, p.flow_min), p.flow_max)
         self.saturated = command != raw
         rate = p.ki * error

@@ -180,7 +180,8 @@ class ClosedLoopRun(NamedTuple):
 
 
 def run_closed_loop(model: MotorModel, cycle: Cycle, controller: ControllerParams,
-                    params: PlantParams | None = None, rate: float = 100.0) -> ClosedLoopRun:
+                    params: PlantParams | None = None, rate: float = 100.0,
+                    delay: int = 1) -> ClosedLoopRun:
     """
     Run plant and controller through a cycle without ROS.
 
@@ -196,6 +197,9 @@ def run_closed_loop(model: MotorModel, cycle: Cycle, controller: ControllerParam
         The plant, [-]
     rate : float
         Controller rate, [Hz]
+    delay : int
+        Controller periods between a measurement and its command reaching the plant
+        (1 is what topics at one rate give), [-]
 
     Returns
     -------
@@ -209,13 +213,14 @@ def run_closed_loop(model: MotorModel, cycle: Cycle, controller: ControllerParam
     dt = per_update * plant.params.step
     count = int(cycle.duration / dt)
     out = np.zeros((6, count))
-    command = 0.0
+    pending = [0.0] * delay
     for k in range(count):
         t = k * dt
         segment = cycle.at(t)
         reading = plant.measure()
         dp = reading.inlet_pressure - reading.outlet_pressure
-        command = law.update(segment.setpoint, reading.speed, dp, dt)
+        pending.append(law.update(segment.setpoint, reading.speed, dp, dt))
+        command = pending.pop(0)
         out[:, k] = (t, segment.setpoint, reading.speed, command, dp, segment.load)
         plant.run(per_update, command, segment.load)
     return ClosedLoopRun(*out)
