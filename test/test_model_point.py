@@ -68,7 +68,7 @@ def test_absorbency_point_warm_start_reaches_the_same_root(key):
     model = MODELS[key]
     n, dp = (a.ravel() for a in np.meshgrid(SPEEDS, DROPS))
     cold = [model.absorbency_point(nn, float(dd)) for nn, dd in zip(n.tolist(), dp)]
-    for factor in (1.0, 1.01, 0.5, 3.0):
+    for factor in (1.0, 1.0001, 0.999, 1.01, 0.9, 0.5, 1.5, 3.0):
         warm = [model.absorbency_point(nn, float(dd), flow_guess=c.flow * factor)
                 for nn, dd, c in zip(n.tolist(), dp, cold)]
         for name in FIELDS:

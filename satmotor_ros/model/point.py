@@ -19,7 +19,6 @@ from satmotor_ros.model.derived import DerivedCoefficients
 from satmotor_ros.model.errors import InvalidInputError
 from satmotor_ros.model.losses import EMPIRICAL_DP_FLOOR
 from satmotor_ros.model.results import Point, PointStatus
-from satmotor_ros.model.solve import solve_increasing_scalar
 from satmotor_ros.model.units import MPA, RPM
 
 _CM3_PER_REV = 1.0e-6 / (2.0 * math.pi)  # one cm^3/rev in m^3/rad, as in losses.py
@@ -210,24 +209,51 @@ class PointEvaluator:
         return self._point(flow, speed, dp if port else None, dp_i, q_lfg, q_c, q_ex, status)
 
     def _solve_speed(self, flow: float, dp_i: float, leak: float) -> float:
-        """Solve eq. (36) for n at given flow and dp_i (Newton, bracketed)."""
-        qt = self.d.qt
+        """
+        Solve eq. (36) with eq. (39) for n at given flow and dp_i (Newton, bracketed).
+
+        Like the coupled solve, it stops without a confirming evaluation once
+        two Newton evaluations show that the error left is far below tolerance.
+        """
+        d = self.d
+        qt = d.qt
         hi = max(flow - leak, 0.0) / qt
         lo = self.speed_floor(dp_i)
-        if not (qt * lo + (self.displacement_loss(lo, dp_i) + leak) < flow and hi > lo):
+        if not (qt * lo + (self.empirical_loss(lo, dp_i) + leak) < flow and hi > lo):
             return 0.0
-        empirical_loss = self.empirical_loss
-        c2 = self.d.c2_39
-        log_dp = math.log(dp_i / MPA) if dp_i > EMPIRICAL_DP_FLOOR else 0.0
-
-        def residual(n: float) -> tuple[float, float]:
-            loss = empirical_loss(n, dp_i)
-            d_speed = loss * (1.0 - c2 * log_dp / math.sqrt(n / RPM)) / (2.0 * n)
-            return qt * n + (loss + leak) - flow, qt + d_speed
-
+        above = dp_i > EMPIRICAL_DP_FLOOR
+        dp_mpa = dp_i / MPA if above else _FLOOR_MPA
+        log_dp = math.log(dp_mpa)
+        c1, c2 = d.c1_39, d.c2_39
         rtol = self.rtol
-        n, _ = solve_increasing_scalar(residual, lo, hi, hi, rtol * hi + 1e-15, rtol * flow)
-        return n
+        x = hi
+        last_x = last_slope = _NAN
+        for _ in range(60):
+            inv_sqrt_n = 1.0 / math.sqrt(x / RPM)
+            loss = (c1 * inv_sqrt_n * dp_mpa ** (c2 * inv_sqrt_n) * _CM3_PER_REV) * x
+            f = qt * x + (loss + leak) - flow
+            if f < 0.0:
+                lo = x
+            elif f > 0.0:
+                hi = x
+            else:
+                return x
+            slope = qt + loss * (1.0 - c2 * log_dp * inv_sqrt_n) / (2.0 * x)
+            step = f / slope
+            newton = x - step
+            if lo < newton < hi:
+                size = abs(step)
+                if size <= rtol * x:
+                    return newton
+                if (abs(slope - last_slope) * size * size
+                        <= 1e-3 * rtol * x * abs(x - last_x) * slope):
+                    return newton
+                last_x, last_slope, x = x, slope, newton
+            elif hi - lo <= rtol * x:
+                return x
+            else:
+                last_x, last_slope, x = x, _NAN, 0.5 * (lo + hi)
+        return x
 
     def absorbency(self, speed: float, dp: float, port: bool, p_ex: float,
                    flow_guess: float | None) -> Point:
@@ -272,61 +298,79 @@ class PointEvaluator:
         q_lfg, q_c, q_ex = self.leakage(dp_i, p_ex)
         return self._point(None, speed, dp if port else None, dp_i, q_lfg, q_c, q_ex, status)
 
-    def _absorbed(self, speed: float, dp_cap: float, p_ex: float,
-                  flow: float) -> tuple[float, float]:
-        """Return the flow eq. (36) absorbs when Q = `flow` sets dp_i, and its slope in Q."""
-        d = self.d
-        dp_i = dp_cap - (d.ch_a * flow + d.ch_b) * flow
-        if dp_i <= 0.0:
-            dp_i = 0.0
-        q_lfg, q_c, q_ex = self.leakage(dp_i, p_ex)
-        loss = self.displacement_loss(speed, dp_i)
-        absorbed = d.qt * speed + (loss + q_lfg + q_c + q_ex)
-        if dp_i == 0.0:
-            return absorbed, 0.0
-        h = d.h0 - d.compliance * dp_i
-        d_leak = q_lfg * d.lfg_e * (1.0 / dp_i - 3.0 * d.compliance / h) + q_c * d.com_e / dp_i
-        if self.empirical:
-            d_loss = (loss * d.c2_39 / math.sqrt(speed / RPM) / dp_i
-                      if speed > 0.0 and dp_i > EMPIRICAL_DP_FLOOR else 0.0)
-        else:
-            d_loss = d.k_p * speed
-        return absorbed, -(d_leak + d_loss) * (2.0 * d.ch_a * flow + d.ch_b)
-
     def _solve_flow(self, speed: float, dp: float, p_ex: float,
                     guess: float | None) -> float:
         """
         Solve eqs. (34)-(36) together for Q at given n and port dp.
 
-        The flow absorbed falls as Q rises (more channel drop, less chamber
-        drop), so each evaluation at Q brackets the root between Q and the
-        flow absorbed there; Newton steps from `guess` stay inside it.
+        The flow absorbed, A(Q), falls as Q rises (more channel drop, less
+        chamber drop), so every evaluation brackets the root of f = Q - A(Q)
+        between Q and A(Q); Newton steps from `guess` stay inside the bracket.
+        Once two evaluations give the curvature, a step whose predicted error
+        (curvature * step^2) is far below the tolerance ends the solve without
+        one more evaluation to confirm it.
         """
         d = self.d
         dp_cap = dp if dp < d.dp_limit else d.dp_limit
-        lo, hi = d.qt * speed, _INF
-        x = guess if guess is not None and lo < guess < _INF else None
-        if x is None:
-            x = self._absorbed(speed, dp_cap, p_ex, 0.0)[0]  # no channel drop: an upper bound
-            hi = x
+        ch_a, ch_b, h0, compliance = d.ch_a, d.ch_b, d.h0, d.compliance
+        lfg_k, lfg_e, com_k, com_e = d.lfg_k, d.lfg_e, d.com_k, d.com_e
+        base = d.qt * speed + 0.0  # q_t n
+        q_ex = d.k_ex * p_ex if d.k_ex else 0.0
+        empirical = self.empirical
+        if empirical:
+            inv_sqrt_n = 1.0 / math.sqrt(speed / RPM) if speed > 0.0 else 0.0
+            c1, c2 = d.c1_39 * inv_sqrt_n, d.c2_39 * inv_sqrt_n
+        else:
+            k_pn, ine = d.k_p * speed, d.k_i * math.sqrt(speed)
         rtol = self.rtol
+        lo, hi = base, _INF
+        x = guess if guess is not None and lo < guess < _INF else dp_cap * 0.0
+        last_x = last_slope = _NAN
         for _ in range(60):
-            absorbed, d_absorbed = self._absorbed(speed, dp_cap, p_ex, x)
+            dp_i = dp_cap - (ch_a * x + ch_b) * x
+            if dp_i <= 0.0:
+                dp_i = 0.0
+            h = h0 - compliance * dp_i
+            q_lfg = lfg_k * (h * h * h * dp_i) ** lfg_e
+            q_c = com_k * dp_i ** com_e
+            if empirical:
+                above = dp_i > EMPIRICAL_DP_FLOOR
+                dp_mpa = dp_i / MPA if above else _FLOOR_MPA
+                loss = (c1 * dp_mpa ** c2 * _CM3_PER_REV) * speed
+                d_loss = loss * c2 / dp_i if above else 0.0
+            else:
+                loss = k_pn * dp_i + ine
+                d_loss = k_pn
+            absorbed = base + (loss + q_lfg + q_c + q_ex)
             f = x - absorbed
             if f < 0.0:
-                lo, hi = x, min(hi, absorbed)
+                lo = x if x > lo else lo
+                hi = absorbed if absorbed < hi else hi
             elif f > 0.0:
-                lo, hi = max(lo, absorbed), x
+                hi = x if x < hi else hi
+                lo = absorbed if absorbed > lo else lo
             else:
                 return x
-            slope = 1.0 - d_absorbed
-            newton = x - f / slope
+            if dp_i > 0.0:
+                d_leak = (q_lfg * lfg_e * (1.0 / dp_i - 3.0 * compliance / h)
+                          + q_c * com_e / dp_i)
+                slope = 1.0 + (d_leak + d_loss) * (2.0 * ch_a * x + ch_b)
+            else:
+                slope = _NAN  # the kink at dp_i = 0: no curvature estimate across it
+            step = f / slope if dp_i > 0.0 else f
+            newton = x - step
             if lo <= newton <= hi:
-                if abs(newton - x) <= rtol * x:
+                size = abs(step)
+                if size <= rtol * x:
                     return newton
-                x = newton
+                # two Newton evaluations on the smooth side give the curvature, and with it
+                # the error left after this step
+                if (abs(slope - last_slope) * size * size
+                        <= 1e-3 * rtol * x * abs(x - last_x) * slope):
+                    return newton
+                last_x, last_slope, x = x, slope, newton
             elif hi - lo <= rtol * x:
                 return x
             else:
-                x = 0.5 * (lo + hi)
+                last_x, last_slope, x = x, _NAN, 0.5 * (lo + hi)
         return x
