@@ -88,13 +88,13 @@ def main() -> None:
     cases = [
         ('floor: fused numpy, breakdown + speed', lambda: floor(model, flow, dp)),
         ('speed(): breakdown + closed-form eq. (40)',
-         lambda: full(model, lambda: model.speed(flow, dp))),
+         lambda: full(model, lambda: model.speed(flow, dp, errors='mask'))),
         ('speed(): iterative, eq. (39)',
-         lambda: full(model39, lambda: model39.speed(flow, dp))),
+         lambda: full(model39, lambda: model39.speed(flow, dp, errors='mask'))),
         ('speed(): iterative, eq. (33) forced',
-         lambda: full(model, lambda: model.speed(flow, dp, method='iterative'))),
+         lambda: full(model, lambda: model.speed(flow, dp, method='iterative', errors='mask'))),
         ('absorbency(): dp_ich coupled to Q, iterative',
-         lambda: full(model, lambda: model.absorbency(speed, dp))),
+         lambda: full(model, lambda: model.absorbency(speed, dp, errors='mask'))),
     ]
     print(f'satmotor_ros model benchmark: {n_pts:,} points, best of {args.repeat}, '
           f'numpy {np.__version__}, Python {platform.python_version()}, {platform.machine()}')

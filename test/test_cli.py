@@ -26,7 +26,7 @@ def test_operating_point_json_has_speed_loss_and_breakdown(capsys):
     assert set(losses) == {'flat_clearance', 'commutation', 'compressibility', 'deformation',
                            'backlash', 'inertia', 'external', 'total'}
     assert losses['total'] == pytest.approx(sum(v for k, v in losses.items() if k != 'total'))
-    assert result['status'] == 'OK'
+    assert result['status'] == 'EXTRAPOLATED'  # 74.6 rpm: below the 100 rpm measured
 
 
 @pytest.mark.parametrize(('flow', 'dp'), [('5', '25'), ('8.333333333e-5m^3/s', '250bar'),

@@ -72,7 +72,8 @@ def test_zero_flow_and_flow_swallowed_by_leakage_give_zero_speed(oil):
 def test_zero_pressure_drop_is_a_valid_unloaded_point(oil):
     op = oil.speed(5 * LPM, 0.0)
     assert 0.0 < float(op.speed) < 5 * LPM / oil.geometry.displacement
-    assert op.status == PointStatus.CHANNEL_LIMITED  # 5 l/min need some channel drop
+    # 5 l/min need some channel drop; 0 MPa is below the 2 MPa measured
+    assert op.status == PointStatus.CHANNEL_LIMITED | PointStatus.EXTRAPOLATED
     assert float(op.dp_i) == 0.0
 
 
@@ -123,3 +124,72 @@ def test_mask_mode_over_many_chunks_keeps_every_field_aligned(oil):
         assert np.isnan(value[[3, 30_000]]).all()
         assert np.isfinite(np.delete(value, [3, 30_000])).all()
     assert (op.losses.external[op.losses.external == op.losses.external] == 0.0).all()
+
+
+def test_results_own_their_data_and_are_read_only(oil):
+    flow = np.full(5, 10 * LPM)
+    dp_i = np.full(5, 10 * MPA)
+    speed = np.full(5, 300 * RPM)
+    for op in (oil.speed(flow, dp_i=dp_i), oil.absorbency(speed, dp_i=dp_i),
+               oil.speed(flow, dp_i=dp_i, errors='mask'), oil.absorbency(speed, dp=dp_i)):
+        arrays = [op.flow, op.speed, op.dp, op.dp_i, op.status, *op.losses.as_dict().values()]
+        for value in arrays:
+            assert not any(np.may_share_memory(value, a) for a in (flow, dp_i, speed))
+            assert not value.flags.writeable
+            with pytest.raises(ValueError, match='read-only'):
+                value[...] = 0.0
+    before = oil.speed(flow, dp_i=dp_i).speed.copy()
+    flow[:] = 20 * LPM  # the caller reuses its buffer: earlier results do not change
+    dp_i[:] = 0.0
+    op = oil.speed(10 * LPM, dp_i=10 * MPA)
+    assert float(op.speed) == pytest.approx(before[0])
+
+
+def test_mismatched_shapes_raise_the_librarys_own_error(oil):
+    with pytest.raises(InvalidInputError,
+                       match=r'^the shapes of the arguments do not broadcast together: '
+                             r'flow \(3,\), dp \(4,\), p_ex \(\)$'):
+        oil.speed(np.ones(3) * LPM, np.ones(4) * MPA)
+    with pytest.raises(ModelError, match='do not broadcast'):
+        oil.absorbency(np.ones((2, 3)), dp_i=np.ones(2))
+
+
+@pytest.mark.parametrize(('kwargs', 'match'), [
+    ({'flow': '5', 'dp': 1e6}, r"^flow = '5': expected numbers, got str$"),
+    ({'flow': 1e-4, 'dp': ['1', '2']}, r"^dp = \['1', '2'\]: expected numbers, got an array of"),
+    ({'flow': True, 'dp': 1e6}, r'^flow = True: expected numbers, got bool$'),
+    ({'flow': None, 'dp': 1e6}, r'^flow = None: expected numbers, got NoneType$'),
+    ({'flow': 1e-4, 'dp': 1e6, 'p_ex': 1j}, r'^p_ex = 1j: expected numbers, got complex$'),
+])
+def test_strings_and_other_non_numbers_are_refused(oil, kwargs, match):
+    with pytest.raises(InvalidInputError, match=match):
+        oil.speed(**kwargs)
+
+
+def test_extrapolated_below_the_measured_range_as_well_as_above(oil):
+    dp_i = np.array([1.0, 2.0, 10.0, 25.0, 26.0]) * MPA
+    op = oil.absorbency(500 * RPM, dp_i=dp_i)
+    extrapolated = (op.status & PointStatus.EXTRAPOLATED) != 0
+    assert extrapolated.tolist() == [True, False, False, False, True]
+    slow = oil.absorbency(np.array([0.0, 99.0, 100.0, 1500.0, 1501.0]) * RPM, dp_i=10 * MPA)
+    slow_flags = ((slow.status & PointStatus.EXTRAPOLATED) != 0).tolist()
+    assert slow_flags == [True, True, False, False, True]
+    assert oil.speed_point(5 * LPM, dp_i=25 * MPA).status == PointStatus.OK
+    assert oil.speed_point(2 * LPM, dp_i=25 * MPA).status == PointStatus.EXTRAPOLATED
+
+
+def test_a_user_liquid_outside_the_fitted_viscosity_is_extrapolated():
+    from dataclasses import replace
+
+    from satmotor_ros.model import Liquid, load_motor
+    spec = load_motor()
+    oil_set = spec.sets['oil']
+    same = Liquid('same', 40e-6, 880.0, 1.5e9)  # another density, the fitted viscosity
+    thin = Liquid('hot oil', 20e-6, 873.0, 1.6e9)
+    assert MotorModel.from_spec(spec, 'oil', same).speed_point(20 * LPM, 10 * MPA).status == 0
+    hot = MotorModel.from_spec(spec, 'oil', thin)
+    assert hot.speed(20 * LPM, 10 * MPA).status == PointStatus.EXTRAPOLATED
+    assert hot.speed_point(20 * LPM, 10 * MPA).status == PointStatus.EXTRAPOLATED
+    widened = replace(oil_set, viscosity_range=(15e-6, 60e-6))
+    model = MotorModel(spec.geometry, widened, spec.valid_range, thin)
+    assert model.speed(20 * LPM, 10 * MPA).status == PointStatus.OK

@@ -23,6 +23,9 @@ def test_default_spec_is_the_sm075_25_for_oil_and_water():
     assert spec.geometry.m2h == pytest.approx(14.0625)
     assert spec.sets['water'].liquid.kinematic_viscosity == pytest.approx(0.853e-6)
     assert spec.valid_range.dp_max == 25 * MPA
+    assert spec.valid_range.dp_min == 2 * MPA
+    assert spec.valid_range.speed_min == pytest.approx(100 * 2 * 3.141592653589793 / 60)
+    assert spec.sets['oil'].fitted_viscosity == pytest.approx((40e-6, 40e-6))
 
 
 @pytest.mark.parametrize(('path', 'value', 'match'), [
@@ -39,6 +42,13 @@ def test_default_spec_is_the_sm075_25_for_oil_and_water():
      r'compressed_volume_fraction = 50\.0 gives C_fc\*beta_l'),
     (('coefficient_sets', 'oil', 'coefficients', 'gamma'), True,
      r'coefficients\.gamma = True: expected a number'),
+    (('coefficient_sets', 'oil', 'viscosity_range'), ['50 cSt', '10 cSt'],
+     r'coefficient_sets\.oil\.viscosity_range\[1\] = 9\.99+e-06 is outside \[4\.9+6e-05'),
+    (('coefficient_sets', 'oil', 'viscosity_range'), '40 cSt',
+     r"coefficient_sets\.oil\.viscosity_range = '40 cSt': expected \[low, high\]"),
+    (('coefficient_sets', 'oil', 'viscosity'), 1.0,
+     r'coefficient_sets\.oil has unknown key\(s\): viscosity'),
+    (('valid_range', 'dp_min'), '30 MPa', r'valid_range\.dp_min = 30000000\.0 is outside'),
 ])
 def test_bad_values_are_named_by_key_and_value(document, path, value, match):
     doc = copy.deepcopy(document)

@@ -92,12 +92,15 @@ def test_no_nan_anywhere_in_the_valid_domain(liquid, law, n, dp, q):
 
 
 @PROPERTY
-@given(liquid=liquids, n=speeds, dp=drops)
-def test_losses_are_continuous_in_pressure(liquid, n, dp):
-    model = MODELS[liquid, 'eq33']
+@given(liquid=liquids, law=laws, n=speeds, dp=st.floats(0.0, 25.0))
+def test_losses_are_continuous_in_pressure(liquid, law, n, dp):
+    # both laws, down to dp_i = 0, where eq. (39) as printed jumps (0^x = 0)
+    model = MODELS[liquid, law]
     step = 1e-6 * MPA
     q = model.absorbency(n * RPM, dp_i=np.array([dp * MPA, dp * MPA + step])).losses.total
     assert abs(q[1] - q[0]) < 1e-4 * LPM
+    point = model.breakdown_point(n * RPM, dp * MPA + step).total
+    assert abs(point - q[0]) < 1e-4 * LPM
 
 
 def test_components_add_up_to_total_and_split_keeps_lumped_c():

@@ -15,6 +15,7 @@ from dataclasses import dataclass, fields
 import math
 
 from satmotor_ros.model.errors import ConfigError
+from satmotor_ros.model.units import CM3_PER_REV
 
 
 class FieldError(ConfigError):
@@ -88,7 +89,7 @@ class MotorGeometry:
     @property
     def displacement_cm3_per_rev(self) -> float:
         """Theoretical displacement q_t in the paper's unit, [cm^3/rev]."""
-        return self.displacement * 2.0 * math.pi * 1.0e6
+        return self.displacement / CM3_PER_REV
 
 
 @dataclass(frozen=True)
@@ -141,20 +142,46 @@ class ValidRange:
 
     dp_max: float  # largest chamber pressure drop measured [Pa]
     speed_max: float  # largest shaft speed measured [rad/s]
+    dp_min: float = 0.0  # smallest chamber pressure drop measured [Pa]
+    speed_min: float = 0.0  # smallest shaft speed measured [rad/s]
 
     def __post_init__(self) -> None:
         """Reject an empty or non-finite range."""
         _check('valid_range', 'dp_max', self.dp_max, 0.0, 1.0e10)
         _check('valid_range', 'speed_max', self.speed_max, 0.0, 1.0e6)
+        _check('valid_range', 'dp_min', self.dp_min, 0.0, self.dp_max, closed_low=True)
+        _check('valid_range', 'speed_min', self.speed_min, 0.0, self.speed_max, closed_low=True)
 
 
 @dataclass(frozen=True)
 class CoefficientSet:
-    """Loss coefficients together with the liquid they were fitted on."""
+    """
+    Loss coefficients together with the liquid they were fitted on.
+
+    ``viscosity_range`` is the span of kinematic viscosity the fit covers; by
+    default only the fitted liquid's own. A model run on a liquid outside it
+    flags every point EXTRAPOLATED.
+    """
 
     name: str
     liquid: Liquid
     coefficients: LossCoefficients
+    viscosity_range: tuple[float, float] | None = None  # (nu_min, nu_max) [m^2/s]
+
+    def __post_init__(self) -> None:
+        """Reject an empty or non-physical viscosity range."""
+        if self.viscosity_range is not None:
+            low, high = self.viscosity_range
+            _check(self.name, 'viscosity_range[0]', low, 0.0, 1.0)
+            _check(self.name, 'viscosity_range[1]', high, low, 1.0, closed_low=True)
+
+    @property
+    def fitted_viscosity(self) -> tuple[float, float]:
+        """Return the span of kinematic viscosity the fit covers, [m^2/s]."""
+        if self.viscosity_range is None:
+            nu = self.liquid.kinematic_viscosity
+            return nu, nu
+        return self.viscosity_range
 
 
 def field_names(record: type) -> tuple[str, ...]:

@@ -32,7 +32,8 @@ _GEOMETRY_KINDS = {
     'height': ('length', 'm'), 'clearance_rotor': ('length', 'm'),
     'clearance_satellites': ('length', 'm'), 'commutation_diameter': ('length', 'm'),
 }
-_RANGE_KINDS = {'dp_max': ('pressure', 'Pa'), 'speed_max': ('speed', 'rad/s')}
+_RANGE_KINDS = {'dp_max': ('pressure', 'Pa'), 'speed_max': ('speed', 'rad/s'),
+                'dp_min': ('pressure', 'Pa'), 'speed_min': ('speed', 'rad/s')}
 _LIQUID_KINDS = {
     'kinematic_viscosity': ('viscosity', 'm^2/s'), 'density': ('density', 'kg/m^3'),
     'bulk_modulus': ('pressure', 'Pa'),
@@ -181,7 +182,13 @@ def coefficient_set_from_mapping(doc: Any, name: str, geometry: MotorGeometry) -
     """
     where = f'coefficient_sets.{name}'
     doc = _mapping(doc, where, {'liquid', 'coefficients'})
+    unknown = sorted(set(doc) - {'liquid', 'coefficients', 'viscosity_range'})
+    if unknown:
+        msg = (f'{where} has unknown key(s): {", ".join(map(str, unknown))} '
+               '(known: liquid, coefficients, viscosity_range)')
+        raise ConfigError(msg)
     liquid = liquid_from_mapping(doc['liquid'], f'{where}.liquid', default_name=name)
+    span = _viscosity_range(doc.get('viscosity_range'), f'{where}.viscosity_range')
     coef = _record(LossCoefficients, doc['coefficients'], f'{where}.coefficients',
                    _COEFFICIENT_KINDS)
     c_fc = compressibility_coefficient(liquid.bulk_modulus, geometry, coef)
@@ -190,7 +197,19 @@ def coefficient_set_from_mapping(doc: Any, name: str, geometry: MotorGeometry) -
                f'{coef.compressed_volume_fraction!r} gives C_fc*beta_l = {c_fc:.4g} > '
                f'c = {coef.c!r}: the compressibility share cannot exceed the lumped C')
         raise ConfigError(msg)
-    return CoefficientSet(name, liquid, coef)
+    return _construct(CoefficientSet, where, name=name, liquid=liquid, coefficients=coef,
+                      viscosity_range=span)
+
+
+def _viscosity_range(doc: Any, where: str) -> tuple[float, float] | None:
+    if doc is None:
+        return None
+    if not isinstance(doc, (list, tuple)) or len(doc) != 2:
+        msg = f'{where} = {doc!r}: expected [low, high]'
+        raise ConfigError(msg)
+    low, high = (_number(v, f'{where}[{i}]', _LIQUID_KINDS['kinematic_viscosity'])
+                 for i, v in enumerate(doc))
+    return low, high
 
 
 def liquid_from_mapping(doc: Any, where: str = 'liquid', default_name: str = 'liquid') -> Liquid:

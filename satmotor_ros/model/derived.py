@@ -50,6 +50,9 @@ class DerivedCoefficients:
     dp_limit: float  # chamber drop where eq. (1) would start to fall with pressure [Pa]
     dp_max: float  # validated range: largest chamber drop [Pa]
     speed_max: float  # validated range: largest speed [rad/s]
+    dp_min: float  # validated range: smallest chamber drop [Pa]
+    speed_min: float  # validated range: smallest speed [rad/s]
+    liquid_extrapolated: bool  # the liquid's viscosity is outside the fitted span
 
 
 def derive(geometry: MotorGeometry, coefficient_set: CoefficientSet, valid_range: ValidRange,
@@ -76,6 +79,7 @@ def derive(geometry: MotorGeometry, coefficient_set: CoefficientSet, valid_range
     """
     coef = coefficient_set.coefficients
     nu, rho = liquid.kinematic_viscosity, liquid.density
+    low, high = coefficient_set.fitted_viscosity
     c_fc_ref = eq.compressibility_coefficient(coefficient_set.liquid.bulk_modulus, geometry, coef)
     c_fc_beta = eq.compressibility_coefficient(liquid.bulk_modulus, geometry, coef)
     rest = coef.c - c_fc_ref
@@ -99,4 +103,6 @@ def derive(geometry: MotorGeometry, coefficient_set: CoefficientSet, valid_range
         k_i=eq.inertia_coefficient(coef.c_id, geometry), k_ex=coef.external_leakage,
         ch_a=float(ch_a), ch_b=float(ch_b), es_a0=es[0], es_a1=es[1], es_scale=es[2],
         es_b=es[3], c1_39=coef.c1_39, c2_39=coef.c2_39, dp_limit=dp_limit,
-        dp_max=valid_range.dp_max, speed_max=valid_range.speed_max)
+        dp_max=valid_range.dp_max, speed_max=valid_range.speed_max,
+        dp_min=valid_range.dp_min, speed_min=valid_range.speed_min,
+        liquid_extrapolated=not low * (1.0 - 1e-9) <= nu <= high * (1.0 + 1e-9))

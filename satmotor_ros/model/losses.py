@@ -22,10 +22,7 @@ import numpy as np
 
 from satmotor_ros.model._typing import ArrayLike, FloatArray
 from satmotor_ros.model.coefficients import LossCoefficients, MotorGeometry
-from satmotor_ros.model.units import LPM, MPA, RPM
-
-_CM3_PER_MIN = 1.0e-6 / 60.0  # one cm^3/min in m^3/s
-_CM3_PER_REV = 1.0e-6 / (2.0 * np.pi)  # one cm^3/rev in m^3/rad
+from satmotor_ros.model.units import CM3_PER_MIN, CM3_PER_REV, LPM, MPA, RPM
 
 EMPIRICAL_DP_FLOOR = 1.0 * MPA
 """Chamber drop below which eq. (39) holds its value at this drop, [Pa] (see eq. 39)."""
@@ -292,7 +289,7 @@ def pressure_speed_coefficient(c: float, geometry: MotorGeometry) -> float:
         k, for dp_i in Pa and n in rad/s, [m^3/(Pa*rad)]
 
     """
-    return c * geometry.m2h * _CM3_PER_MIN / (MPA * RPM)
+    return c * geometry.m2h * CM3_PER_MIN / (MPA * RPM)
 
 
 def _pressure_speed_loss(c: float, dp_i: ArrayLike, speed: ArrayLike,
@@ -426,7 +423,7 @@ def inertia_coefficient(c_id: float, geometry: MotorGeometry) -> float:
         k, for n in rad/s, [m^3/s / (rad/s)^0.5]
 
     """
-    return c_id * geometry.m2h * _CM3_PER_MIN / math.sqrt(RPM)
+    return c_id * geometry.m2h * CM3_PER_MIN / math.sqrt(RPM)
 
 
 def displacement_change(dp_i: ArrayLike, speed: ArrayLike, c: float, c_id: float,
@@ -467,7 +464,7 @@ def displacement_change(dp_i: ArrayLike, speed: ArrayLike, c: float, c_id: float
     """
     n_rpm = np.asarray(speed, dtype=float) / RPM
     dq_cm3 = (c * np.asarray(dp_i, dtype=float) / MPA + c_id / np.sqrt(n_rpm)) * geometry.m2h
-    return dq_cm3 * _CM3_PER_REV
+    return dq_cm3 * CM3_PER_REV
 
 
 def displacement_loss(dp_i: ArrayLike, speed: ArrayLike, c: float, c_id: float,
@@ -541,7 +538,7 @@ def displacement_change_empirical(dp_i: ArrayLike, speed: ArrayLike,
     """
     inv_sqrt_n = 1.0 / np.sqrt(np.asarray(speed, dtype=float) / RPM)
     dp_mpa = np.maximum(np.asarray(dp_i, dtype=float) / MPA, EMPIRICAL_DP_FLOOR / MPA)
-    return coef.c1_39 * inv_sqrt_n * dp_mpa ** (coef.c2_39 * inv_sqrt_n) * _CM3_PER_REV
+    return coef.c1_39 * inv_sqrt_n * dp_mpa ** (coef.c2_39 * inv_sqrt_n) * CM3_PER_REV
 
 
 def displacement_loss_empirical(dp_i: ArrayLike, speed: ArrayLike,

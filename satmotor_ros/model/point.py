@@ -17,11 +17,12 @@ import math
 
 from satmotor_ros.model.derived import DerivedCoefficients
 from satmotor_ros.model.errors import InvalidInputError
+from satmotor_ros.model.inverse import ROOT_ATOL, RTOL
 from satmotor_ros.model.losses import EMPIRICAL_DP_FLOOR
 from satmotor_ros.model.results import Point, PointStatus
-from satmotor_ros.model.units import MPA, RPM
+from satmotor_ros.model.screening import CHECK, FLOW_ATOL
+from satmotor_ros.model.units import CM3_PER_REV, MPA, RPM
 
-_CM3_PER_REV = 1.0e-6 / (2.0 * math.pi)  # one cm^3/rev in m^3/rad, as in losses.py
 _NOT_FINITE = int(PointStatus.NOT_FINITE)
 _NEGATIVE = int(PointStatus.NEGATIVE)
 _BEYOND_LIMIT = int(PointStatus.BEYOND_LIMIT)
@@ -29,6 +30,8 @@ _STALLED = int(PointStatus.STALLED)
 _CHANNEL_LIMITED = int(PointStatus.CHANNEL_LIMITED)
 _EXTRAPOLATED = int(PointStatus.EXTRAPOLATED)
 _FLOOR_MPA = EMPIRICAL_DP_FLOOR / MPA
+_NO_ROOT = int(PointStatus.NO_ROOT)
+_NOT_CONVERGED = int(PointStatus.NOT_CONVERGED)
 _INF = math.inf
 _NAN = math.nan
 _new_point = tuple.__new__
@@ -88,16 +91,13 @@ class PointEvaluator:
         The model's constants, [-]
     empirical : bool
         True for Delta q from eq. (39), False for eq. (33), [-]
-    rtol : float
-        Relative tolerance of the iterative solves, [-]
 
     """
 
-    def __init__(self, derived: DerivedCoefficients, empirical: bool, rtol: float) -> None:
-        """Keep the constants as attributes for quick access."""
+    def __init__(self, derived: DerivedCoefficients, empirical: bool) -> None:
+        """Keep the constants and the law."""
         self.d = derived
         self.empirical = empirical
-        self.rtol = rtol
 
     # -- equations ------------------------------------------------------------------------
 
@@ -115,7 +115,7 @@ class PointEvaluator:
         inv_sqrt_n = 1.0 / math.sqrt(speed / RPM)
         d = self.d
         dp_mpa = dp_i / MPA if dp_i > EMPIRICAL_DP_FLOOR else _FLOOR_MPA
-        return (d.c1_39 * inv_sqrt_n * dp_mpa ** (d.c2_39 * inv_sqrt_n) * _CM3_PER_REV) * speed
+        return (d.c1_39 * inv_sqrt_n * dp_mpa ** (d.c2_39 * inv_sqrt_n) * CM3_PER_REV) * speed
 
     def displacement_loss(self, speed: float, dp_i: float) -> float:
         """Return Delta Q_vl of eq. (33) or (39), [m^3/s]."""
@@ -146,7 +146,8 @@ class PointEvaluator:
             scale = self.empirical_loss(speed, dp_i) / physical if physical > 0.0 else 0.0
             fc, dch, bl, ine = fc * scale, dch * scale, bl * scale, ine * scale
         total = q_lfg + q_c + q_ex + ((fc + dch) + (bl + ine))
-        if dp_i > d.dp_max or speed > d.speed_max:
+        if (dp_i > d.dp_max or speed > d.speed_max or dp_i < d.dp_min or speed < d.speed_min
+                or d.liquid_extrapolated):
             status |= _EXTRAPOLATED
         if flow is None:
             flow = d.qt * speed + total
@@ -194,7 +195,9 @@ class PointEvaluator:
         q_lfg, q_c, q_ex = self.leakage(dp_i, p_ex)
         leak = q_lfg + q_c + q_ex
         if self.empirical:
-            speed = self._solve_speed(flow, dp_i, leak)
+            speed, failed = self._solve_speed(flow, dp_i, leak)
+            if failed:
+                return _invalid(failed)
         else:
             x = flow - leak
             x = x * d.es_scale if x > 0.0 else 0.0
@@ -206,9 +209,13 @@ class PointEvaluator:
                 speed = root * root
         if speed == 0.0:
             status |= _STALLED
-        return self._point(flow, speed, dp if port else None, dp_i, q_lfg, q_c, q_ex, status)
+        point = self._point(flow, speed, dp if port else None, dp_i, q_lfg, q_c, q_ex, status)
+        if self.empirical and speed > 0.0 and not (
+                abs(d.qt * speed + point.total - flow) <= CHECK * flow + FLOW_ATOL):
+            return _invalid(_NO_ROOT)
+        return point
 
-    def _solve_speed(self, flow: float, dp_i: float, leak: float) -> float:
+    def _solve_speed(self, flow: float, dp_i: float, leak: float) -> tuple[float, int]:
         """
         Solve eq. (36) with eq. (39) for n at given flow and dp_i (Newton, bracketed).
 
@@ -220,40 +227,42 @@ class PointEvaluator:
         hi = max(flow - leak, 0.0) / qt
         lo = self.speed_floor(dp_i)
         if not (qt * lo + (self.empirical_loss(lo, dp_i) + leak) < flow and hi > lo):
-            return 0.0
+            return 0.0, (_NO_ROOT if hi > 0.0 and lo > 0.0 else 0)
         above = dp_i > EMPIRICAL_DP_FLOOR
         dp_mpa = dp_i / MPA if above else _FLOOR_MPA
         log_dp = math.log(dp_mpa)
         c1, c2 = d.c1_39, d.c2_39
-        rtol = self.rtol
+        # solved in x = sqrt(n), where the loss is nearly linear at low speed
+        lo, hi = math.sqrt(lo), math.sqrt(hi)
         x = hi
         last_x = last_slope = _NAN
         for _ in range(60):
-            inv_sqrt_n = 1.0 / math.sqrt(x / RPM)
-            loss = (c1 * inv_sqrt_n * dp_mpa ** (c2 * inv_sqrt_n) * _CM3_PER_REV) * x
-            f = qt * x + (loss + leak) - flow
+            n = x * x
+            inv_sqrt_n = 1.0 / math.sqrt(n / RPM)
+            loss = (c1 * inv_sqrt_n * dp_mpa ** (c2 * inv_sqrt_n) * CM3_PER_REV) * n
+            f = qt * n + (loss + leak) - flow
             if f < 0.0:
                 lo = x
             elif f > 0.0:
                 hi = x
             else:
-                return x
-            slope = qt + loss * (1.0 - c2 * log_dp * inv_sqrt_n) / (2.0 * x)
+                return n, 0
+            slope = (qt + loss * (1.0 - c2 * log_dp * inv_sqrt_n) / (2.0 * n)) * 2.0 * x
             step = f / slope
             newton = x - step
-            if lo < newton < hi:
+            if lo <= newton <= hi:
                 size = abs(step)
-                if size <= rtol * x:
-                    return newton
+                if size <= (RTOL * x + ROOT_ATOL):
+                    return newton * newton, 0
                 if (abs(slope - last_slope) * size * size
-                        <= 1e-3 * rtol * x * abs(x - last_x) * slope):
-                    return newton
+                        <= 1e-3 * (RTOL * x + ROOT_ATOL) * abs(x - last_x) * slope):
+                    return newton * newton, 0
                 last_x, last_slope, x = x, slope, newton
-            elif hi - lo <= rtol * x:
-                return x
+            elif hi - lo <= (RTOL * x + ROOT_ATOL):
+                return n, 0
             else:
                 last_x, last_slope, x = x, _NAN, 0.5 * (lo + hi)
-        return x
+        return x * x, _NOT_CONVERGED
 
     def absorbency(self, speed: float, dp: float, port: bool, p_ex: float,
                    flow_guess: float | None) -> Point:
@@ -284,8 +293,10 @@ class PointEvaluator:
             return _invalid(status)
         d = self.d
         if port:
-            flow = self._solve_flow(speed, dp, p_ex, flow_guess)
-            dp_i = dp - (d.ch_a * flow + d.ch_b) * flow
+            root, failed = self._solve_flow(speed, dp, p_ex, flow_guess)
+            if failed:
+                return _invalid(failed)
+            dp_i = dp - (d.ch_a * root + d.ch_b) * root
             if dp_i < 0.0:
                 status = _CHANNEL_LIMITED
                 dp_i = 0.0
@@ -296,10 +307,13 @@ class PointEvaluator:
         if self.empirical and 0.0 < speed < self.speed_floor(dp_i):
             return _invalid(_BEYOND_LIMIT)
         q_lfg, q_c, q_ex = self.leakage(dp_i, p_ex)
-        return self._point(None, speed, dp if port else None, dp_i, q_lfg, q_c, q_ex, status)
+        point = self._point(None, speed, dp if port else None, dp_i, q_lfg, q_c, q_ex, status)
+        if port and not abs(point.flow - root) <= CHECK * root + FLOW_ATOL:
+            return _invalid(_NO_ROOT)
+        return point
 
     def _solve_flow(self, speed: float, dp: float, p_ex: float,
-                    guess: float | None) -> float:
+                    guess: float | None) -> tuple[float, int]:
         """
         Solve eqs. (34)-(36) together for Q at given n and port dp.
 
@@ -322,7 +336,6 @@ class PointEvaluator:
             c1, c2 = d.c1_39 * inv_sqrt_n, d.c2_39 * inv_sqrt_n
         else:
             k_pn, ine = d.k_p * speed, d.k_i * math.sqrt(speed)
-        rtol = self.rtol
         lo, hi = base, _INF
         x = guess if guess is not None and lo < guess < _INF else dp_cap * 0.0
         last_x = last_slope = _NAN
@@ -336,7 +349,7 @@ class PointEvaluator:
             if empirical:
                 above = dp_i > EMPIRICAL_DP_FLOOR
                 dp_mpa = dp_i / MPA if above else _FLOOR_MPA
-                loss = (c1 * dp_mpa ** c2 * _CM3_PER_REV) * speed
+                loss = (c1 * dp_mpa ** c2 * CM3_PER_REV) * speed
                 d_loss = loss * c2 / dp_i if above else 0.0
             else:
                 loss = k_pn * dp_i + ine
@@ -350,7 +363,7 @@ class PointEvaluator:
                 hi = x if x < hi else hi
                 lo = absorbed if absorbed > lo else lo
             else:
-                return x
+                return x, 0
             if dp_i > 0.0:
                 d_leak = (q_lfg * lfg_e * (1.0 / dp_i - 3.0 * compliance / h)
                           + q_c * com_e / dp_i)
@@ -361,16 +374,16 @@ class PointEvaluator:
             newton = x - step
             if lo <= newton <= hi:
                 size = abs(step)
-                if size <= rtol * x:
-                    return newton
+                if size <= (RTOL * x + 0.01 * FLOW_ATOL):
+                    return newton, 0
                 # two Newton evaluations on the smooth side give the curvature, and with it
                 # the error left after this step
                 if (abs(slope - last_slope) * size * size
-                        <= 1e-3 * rtol * x * abs(x - last_x) * slope):
-                    return newton
+                        <= 1e-3 * (RTOL * x + 0.01 * FLOW_ATOL) * abs(x - last_x) * slope):
+                    return newton, 0
                 last_x, last_slope, x = x, slope, newton
-            elif hi - lo <= rtol * x:
-                return x
+            elif hi - lo <= (RTOL * x + 0.01 * FLOW_ATOL):
+                return x, 0
             else:
                 last_x, last_slope, x = x, _NAN, 0.5 * (lo + hi)
-        return x
+        return x, _NOT_CONVERGED

@@ -25,9 +25,12 @@ class PointStatus(enum.IntFlag):
     NOT_FINITE = 8  # NaN or inf input (invalid: output NaN)
     NEGATIVE = 16  # negative flow, speed or pressure drop (invalid: output NaN)
     BEYOND_LIMIT = 32  # where the equations stop being physical (invalid: output NaN)
+    NOT_CONVERGED = 64  # an iterative solve ran out of iterations (invalid: output NaN)
+    NO_ROOT = 128  # the equations have no solution at this point (invalid: output NaN)
 
 
-INVALID = PointStatus.NOT_FINITE | PointStatus.NEGATIVE | PointStatus.BEYOND_LIMIT
+INVALID = (PointStatus.NOT_FINITE | PointStatus.NEGATIVE | PointStatus.BEYOND_LIMIT
+           | PointStatus.NOT_CONVERGED | PointStatus.NO_ROOT)
 """The flags that make an element invalid (its outputs are NaN)."""
 
 COMPONENTS = ('flat_clearance', 'commutation', 'compressibility', 'deformation', 'backlash',

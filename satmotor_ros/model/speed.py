@@ -9,9 +9,7 @@ import numpy as np
 
 from satmotor_ros.model._typing import ArrayLike, FloatArray
 from satmotor_ros.model.coefficients import MotorGeometry
-from satmotor_ros.model.units import MPA, RPM
-
-_CM3_PER_MIN = 1.0e-6 / 60.0  # one cm^3/min in m^3/s
+from satmotor_ros.model.units import CM3_PER_MIN, MPA, RPM
 
 
 def absorbency(speed: ArrayLike, losses: ArrayLike, geometry: MotorGeometry) -> FloatArray:
@@ -114,7 +112,7 @@ def effective_speed_coefficients(c: float, c_id: float,
     m2h = geometry.m2h
     k = 2.0 / math.sqrt(RPM)
     return (k * geometry.displacement_cm3_per_rev, k * c * m2h / MPA,
-            4.0 / (k * _CM3_PER_MIN), c_id * m2h)
+            4.0 / (k * CM3_PER_MIN), c_id * m2h)
 
 
 def speed_loss(flow: ArrayLike, speed: ArrayLike, geometry: MotorGeometry) -> FloatArray:

@@ -27,6 +27,12 @@ RPM = 2.0 * math.pi / 60.0
 CST = 1.0e-6
 """One centistokes in m^2/s."""
 
+CM3_PER_MIN = 1.0e-6 / 60.0
+"""One cm^3/min in m^3/s (eq. 32's Delta Q_vl in the paper's unit)."""
+
+CM3_PER_REV = 1.0e-6 / (2.0 * math.pi)
+"""One cm^3/rev in m^3/rad (eq. 33's and eq. 39's Delta q in the paper's unit)."""
+
 # kind -> unit -> (scale, offset): si = value * scale + offset
 _UNITS: dict[str, dict[str, tuple[float, float]]] = {
     'flow': {
@@ -38,14 +44,14 @@ _UNITS: dict[str, dict[str, tuple[float, float]]] = {
         'bar': (1.0e5, 0.0),
     },
     'speed': {
-        'rad/s': (1.0, 0.0), 'rpm': (RPM, 0.0), 'rev/min': (RPM, 0.0), 'rev/s': (2 * math.pi, 0.0),
+        'rad/s': (1.0, 0.0), 'rpm': (RPM, 0.0), 'rev/min': (RPM, 0.0), 'rev/s': (60.0 * RPM, 0.0),
     },
     'viscosity': {'m^2/s': (1.0, 0.0), 'cSt': (CST, 0.0), 'mm^2/s': (CST, 0.0)},
     'density': {'kg/m^3': (1.0, 0.0), 'g/cm^3': (1.0e3, 0.0)},
     'length': {'m': (1.0, 0.0), 'mm': (1.0e-3, 0.0), 'um': (1.0e-6, 0.0), 'µm': (1.0e-6, 0.0)},
     'displacement': {
         'm^3/rad': (1.0, 0.0), 'm^3/rev': (1.0 / (2 * math.pi), 0.0),
-        'cm^3/rev': (1.0e-6 / (2 * math.pi), 0.0),
+        'cm^3/rev': (CM3_PER_REV, 0.0),
     },
     'temperature': {'degC': (1.0, 0.0), 'K': (1.0, -273.15)},
     'time': {'s': (1.0, 0.0), 'ms': (1.0e-3, 0.0), 'min': (60.0, 0.0)},

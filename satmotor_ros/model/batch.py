@@ -1,0 +1,111 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Batch evaluation: chunks for the iterative maps, one pass for closed forms, owned results."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from satmotor_ros.model._typing import FloatArray
+from satmotor_ros.model.coefficients import MotorGeometry
+from satmotor_ros.model.results import COMPONENTS, INVALID, LossBreakdown, OperatingPoints
+from satmotor_ros.model.screening import Status
+
+CHUNK = 8192
+"""
+Elements solved at once by the iterative maps.
+
+Temporaries of this size stay in cache, and a chunk stops iterating as soon as
+its own elements converge: 3-4x faster than solving a whole batch at once. A
+closed-form evaluation is a single pass, where chunking would only add a copy.
+"""
+
+Chunk = dict[str, np.ndarray]
+"""Results of one chunk by field name: OperatingPoints fields and COMPONENTS."""
+
+
+def _join(parts: list[Chunk], shape: tuple[int, ...]) -> Chunk:
+    joined = {}
+    for key in parts[0]:
+        values = [p[key] for p in parts]
+        scalar = [np.ndim(v) == 0 for v in values]
+        if all(scalar):  # a component that is 0 throughout (no Q_ex)
+            joined[key] = np.zeros(shape)  # calloc'd: no pages written
+            continue
+        if any(scalar):  # 0 in some chunks, masked to NaN in others
+            values = [np.broadcast_to(v, p['status'].shape) for v, p in zip(values, parts)]
+        joined[key] = (np.concatenate(values) if len(values) > 1 else values[0]).reshape(shape)
+    return joined
+
+
+def mask_invalid(chunk: Chunk, status: Status) -> Chunk:
+    """
+    Put NaN in every field of the invalid elements and keep only their INVALID flags.
+
+    Parameters
+    ----------
+    chunk : dict
+        Fields of one chunk, [SI]
+    status : ndarray of uint8
+        Flags of the chunk, updated in place, [-]
+
+    Returns
+    -------
+    dict
+        The fields, with ``status`` added.
+
+    """
+    invalid = (status & int(INVALID)) != 0 if status.any() else None
+    if invalid is not None and invalid.any():
+        status &= np.where(invalid, np.uint8(INVALID), np.uint8(0xFF))  # no STALLED etc.
+        chunk = {k: np.where(invalid, np.nan, v) for k, v in chunk.items()}
+    chunk['status'] = status
+    return chunk
+
+
+def run(core: Callable[..., Chunk], arrays: list[FloatArray], status: Status,
+        given: dict[str, FloatArray], iterative: bool,
+        geometry: MotorGeometry) -> OperatingPoints:
+    """
+    Evaluate a map's `core` over a batch and assemble the result.
+
+    Parameters
+    ----------
+    core : callable
+        ``core(*arrays, status, at) -> Chunk`` for one chunk of flat arrays, [-]
+    arrays : list of ndarray
+        The screened arguments, broadcast to one shape, [SI]
+    status : ndarray of uint8
+        Flags from screening, [-]
+    given : dict
+        Inputs that come back as fields (copies), by field name, [SI]
+    iterative : bool
+        Evaluate in chunks of :data:`CHUNK` (for the solves), [-]
+    geometry : MotorGeometry
+        The motor, [-]
+
+    Returns
+    -------
+    OperatingPoints
+        The result; its arrays are its own and read-only.
+
+    """
+    shape = status.shape
+    bad = status != 0 if status.any() else None
+    clean = arrays if bad is None else [np.where(bad, 0.0, a) for a in arrays]
+    flat = [a.reshape(-1) for a in clean]  # a view where it can be, e.g. broadcast scalars
+    flat_status = status.ravel()
+    chunk = CHUNK if iterative else max(flat_status.size, 1)
+    parts = [core(*(a[i:i + chunk] for a in flat), flat_status[i:i + chunk], (i, shape))
+             for i in range(0, max(flat_status.size, 1), chunk)]
+    fields_ = _join(parts, shape)
+    invalid = (fields_['status'] & int(INVALID)) != 0
+    for name, value in given.items():
+        fields_[name] = np.where(invalid, np.nan, value) if invalid.any() else value
+    for name, value in fields_.items():  # the results own their data, read-only
+        if any(np.may_share_memory(value, a) for a in arrays):
+            value = fields_[name] = value.copy()
+        value.flags.writeable = False
+    losses = LossBreakdown(**{k: fields_.pop(k) for k in COMPONENTS})
+    return OperatingPoints(losses=losses, geometry=geometry, **fields_)

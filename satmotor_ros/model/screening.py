@@ -1,0 +1,295 @@
+# SPDX-License-Identifier: Apache-2.0
+"""
+Screening of operating points: what is refused, what is flagged, and the messages.
+
+With ``errors='raise'`` the first bad element raises :class:`InvalidInputError`
+naming the argument, its index in the batch and its value; with
+``errors='mask'`` it is flagged in the element's :class:`PointStatus` and the
+rest of the batch is computed.
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+import numpy as np
+import numpy.typing as npt
+
+from satmotor_ros.model._typing import ArrayLike, FloatArray
+from satmotor_ros.model.derived import DerivedCoefficients
+from satmotor_ros.model.errors import InvalidInputError, ModelError
+from satmotor_ros.model.laws import DisplacementLaw
+from satmotor_ros.model.results import INVALID, PointStatus
+from satmotor_ros.model.units import MPA
+
+Errors = Literal['raise', 'mask']
+"""Raise on the first invalid element, or return it as NaN."""
+
+At = tuple[int, tuple[int, ...]]
+"""Where a chunk sits in the batch: flat offset and the batch's shape (for error messages)."""
+
+Status = npt.NDArray[np.uint8]
+"""PointStatus flags per element."""
+
+CHECK = 1e-10
+"""Largest relative residual an iterative solve may leave before its point is flagged."""
+
+FLOW_ATOL = 1e-20
+"""Absolute resolution of flows in the solves and their check, [m^3/s] (6e-16 l/min)."""
+
+
+def numbers(name: str, value: ArrayLike) -> FloatArray:
+    """
+    Return one argument as a float array, refusing what is not real numbers.
+
+    Parameters
+    ----------
+    name : str
+        Argument name, for the message, [-]
+    value : float or array_like
+        The argument, [SI]
+
+    Returns
+    -------
+    ndarray
+        The values as float64 (the caller's array itself when it already is one).
+
+    Raises
+    ------
+    InvalidInputError
+        For strings, booleans, None, complex numbers and other non-numbers.
+
+    """
+    raw = np.asarray(value)
+    if raw.dtype.kind not in 'iuf':
+        got = type(value).__name__ if raw.ndim == 0 else f'an array of {raw.dtype}'
+        text = repr(value)
+        text = text if len(text) <= 60 else text[:57] + '...'
+        msg = f'{name} = {text}: expected numbers, got {got}'
+        raise InvalidInputError(msg)
+    return raw.astype(float, copy=False)
+
+
+def raise_first(name: str, unit: str, value: FloatArray, bad: npt.NDArray[np.bool_], why: str,
+                at: At) -> None:
+    """
+    Raise :class:`InvalidInputError` for the first element flagged in `bad`.
+
+    Parameters
+    ----------
+    name : str
+        Argument name, [-]
+    unit : str
+        Its SI unit, [-]
+    value : ndarray
+        The argument's values in this chunk, [SI]
+    bad : ndarray of bool
+        The elements to report, [-]
+    why : str
+        What is wrong with them, [-]
+    at : tuple
+        The chunk's flat offset and the batch's shape, [-]
+
+    """
+    first = int(np.flatnonzero(bad)[0])
+    offset, shape = at
+    index = ', '.join(str(i) for i in np.unravel_index(offset + first, shape)) if shape else ''
+    where = f'{name}[{index}]' if shape else name
+    count = int(bad.sum())
+    tail = f' ({count} element{"s" if count > 1 else ""} of this kind)' if len(shape) else ''
+    msg = f'{where} = {float(value.flat[first])!r} {unit}: {why}{tail}'
+    raise InvalidInputError(msg)
+
+
+def _screen(name: str, unit: str, value: FloatArray, errors: Errors) -> Status | None:
+    """Flag non-finite and negative elements; None when there are none (the usual case)."""
+    if value.size == 0 or (value.min() >= 0.0 and value.max() < np.inf):
+        return None
+    not_finite = ~np.isfinite(value)
+    negative = value < 0.0
+    if errors == 'raise':
+        at = (0, value.shape)
+        if not_finite.any():
+            raise_first(name, unit, value, not_finite, 'not finite', at)
+        raise_first(name, unit, value, negative, 'negative', at)
+    return (not_finite * np.uint8(PointStatus.NOT_FINITE)
+            | negative * np.uint8(PointStatus.NEGATIVE)).astype(np.uint8)
+
+
+def prepare(named: dict[str, tuple[ArrayLike, str]],
+            errors: Errors) -> tuple[list[FloatArray], Status]:
+    """
+    Convert, screen and broadcast the arguments of a map.
+
+    Parameters
+    ----------
+    named : dict
+        Argument name -> (value, SI unit), [-]
+    errors : {'raise', 'mask'}
+        What to do with a bad element, [-]
+
+    Returns
+    -------
+    arrays : list of ndarray
+        The arguments, broadcast to one shape (views, possibly of the caller's arrays).
+    status : ndarray of uint8
+        NOT_FINITE / NEGATIVE flags per element.
+
+    """
+    if errors not in ('raise', 'mask'):
+        msg = f"errors = {errors!r}: use 'raise' or 'mask'"
+        raise ModelError(msg)
+    values = [numbers(name, v) for name, (v, _) in named.items()]
+    flags = [_screen(name, unit, value, errors)
+             for (name, (_, unit)), value in zip(named.items(), values)]
+    try:
+        arrays = np.broadcast_arrays(*values)
+    except ValueError:
+        shapes = ', '.join(f'{name} {value.shape}' for name, value in zip(named, values))
+        msg = f'the shapes of the arguments do not broadcast together: {shapes}'
+        raise InvalidInputError(msg) from None
+    status = np.zeros(arrays[0].shape, dtype=np.uint8)
+    for flag in flags:
+        if flag is not None:
+            status |= flag
+    return arrays, status
+
+
+def check_limit(dp_i: FloatArray, dp_limit: float, name: tuple[str, FloatArray],
+                status: Status, errors: Errors, at: At) -> FloatArray:
+    """
+    Flag BEYOND_LIMIT where the chamber drop passes the model's limit.
+
+    Parameters
+    ----------
+    dp_i : ndarray
+        Chamber pressure drop, [Pa]
+    dp_limit : float
+        The limit, [Pa]
+    name : tuple
+        The pressure argument's name and values, for the message, [-]
+    status : ndarray of uint8
+        Flags, updated in place, [-]
+    errors : {'raise', 'mask'}
+        What to do with a bad element, [-]
+    at : tuple
+        The chunk's place in the batch, [-]
+
+    Returns
+    -------
+    ndarray
+        `dp_i`, with 0 where it is beyond the limit.
+
+    """
+    if dp_i.size == 0 or dp_i.max() <= dp_limit:
+        return dp_i
+    beyond = dp_i > dp_limit
+    if errors == 'raise':
+        raise_first(name[0], 'Pa', name[1], beyond,
+                    f'chamber pressure drop beyond the model limit {dp_limit / MPA:.1f} MPa, '
+                    'where eq. (2) closes the clearance so fast that eq. (1) would fall with '
+                    'pressure', at)
+    status |= beyond * np.uint8(PointStatus.BEYOND_LIMIT)
+    return np.where(beyond, 0.0, dp_i)
+
+
+def check_floor(speed: FloatArray, law: DisplacementLaw, dp_i: FloatArray, status: Status,
+                errors: Errors, at: At) -> None:
+    """
+    Flag BEYOND_LIMIT where a turning shaft is below the law's floor speed.
+
+    Parameters
+    ----------
+    speed : ndarray
+        Shaft speed, [rad/s]
+    law : DisplacementLaw
+        The displacement law, [-]
+    dp_i : ndarray
+        Chamber pressure drop, [Pa]
+    status : ndarray of uint8
+        Flags, updated in place, [-]
+    errors : {'raise', 'mask'}
+        What to do with a bad element, [-]
+    at : tuple
+        The chunk's place in the batch, [-]
+
+    """
+    below = (speed > 0.0) & (speed < law.floor(dp_i))
+    if below.any():
+        if errors == 'raise':
+            raise_first('speed', 'rad/s', speed, below,
+                        f'below the floor of eq. ({law.name[2:]}), where its loss diverges', at)
+        status |= below * np.uint8(PointStatus.BEYOND_LIMIT)
+
+
+def check_solution(value: FloatArray, target: FloatArray, converged: npt.NDArray[np.bool_],
+                   checked: npt.NDArray[np.bool_], status: Status, errors: Errors,
+                   name: tuple[str, str, FloatArray, At], what: str) -> None:
+    """
+    Flag the points where an iterative solve left a residual, or did not converge.
+
+    A solve that converged yet leaves a residual has closed its bracket on a
+    jump: NO_ROOT. One that ran out of iterations is NOT_CONVERGED. Invalid
+    points keep their flags; with ``errors='raise'`` the first flagged point
+    raises, NO_ROOT (also flagged by the solve itself) first.
+
+    Parameters
+    ----------
+    value : ndarray
+        The flow eq. (36) gives at the solution, [m^3/s]
+    target : ndarray
+        The flow it had to match, [m^3/s]
+    converged : ndarray of bool
+        What the solver reported, [-]
+    checked : ndarray of bool
+        The points to check, [-]
+    status : ndarray of uint8
+        Flags, updated in place, [-]
+    errors : {'raise', 'mask'}
+        What to do with a bad element, [-]
+    name : tuple
+        Argument name, unit, values and the chunk's place, for the message, [-]
+    what : str
+        The equations solved, for the message, [-]
+
+    """
+    with np.errstate(invalid='ignore'):
+        off = ~(np.abs(value - target) <= CHECK * np.abs(target) + FLOW_ATOL)
+    open_ = checked & ((status & int(INVALID)) == 0)
+    status |= (off & converged & open_) * np.uint8(PointStatus.NO_ROOT)
+    status |= (~converged & open_) * np.uint8(PointStatus.NOT_CONVERGED)
+    if errors == 'raise':
+        arg, unit, values, at = name
+        no_root = (status & np.uint8(PointStatus.NO_ROOT)) != 0
+        if no_root.any():
+            raise_first(arg, unit, values, no_root, f'{what} has no root here', at)
+        not_converged = (status & np.uint8(PointStatus.NOT_CONVERGED)) != 0
+        if not_converged.any():
+            raise_first(arg, unit, values, not_converged, f'{what} did not converge', at)
+
+
+def flag_extrapolated(derived: DerivedCoefficients, speed: FloatArray, dp_i: FloatArray,
+                      status: Status) -> None:
+    """
+    Flag EXTRAPOLATED outside the validated range or the fitted viscosity.
+
+    Parameters
+    ----------
+    derived : DerivedCoefficients
+        The model's range and liquid, [-]
+    speed : ndarray
+        Shaft speed, [rad/s]
+    dp_i : ndarray
+        Chamber pressure drop, [Pa]
+    status : ndarray of uint8
+        Flags, updated in place, [-]
+
+    """
+    d = derived
+    if d.liquid_extrapolated:
+        status |= np.uint8(PointStatus.EXTRAPOLATED)
+    elif speed.size and (dp_i.max() > d.dp_max or speed.max() > d.speed_max
+                         or dp_i.min() < d.dp_min or speed.min() < d.speed_min):
+        with np.errstate(invalid='ignore'):
+            status |= ((dp_i > d.dp_max) | (speed > d.speed_max) | (dp_i < d.dp_min)
+                       | (speed < d.speed_min)) * np.uint8(PointStatus.EXTRAPOLATED)
