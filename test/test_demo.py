@@ -30,6 +30,7 @@ def test_demo_writes_a_report_with_its_plots(demo_run):
     report = (out / 'report.md').read_text()
     assert 'external_leakage = 2e-12' in report
     assert '| water | model |' in report and '| water | none (PI alone) |' in report
+    assert 'Prediction from the motor_model node' in report
     for name in ('tracking_water.png', 'prediction_water.png', 'losses_water.png'):
         assert f']({name})' in report
         data = (out / name).read_bytes()
@@ -46,7 +47,8 @@ def test_demo_bags_hold_every_topic_at_its_rate(demo_run, run):
         counts = {c.topic: c.msgcount for c in reader.connections}
         for topic in ('/flow_command', '/inlet_pressure', '/outlet_pressure', '/case_pressure',
                       '/flow_measured', '/joint_states', '/fluid_temperature', '/load_torque',
-                      '/speed_setpoint', '/diagnostics', '/clock'):
+                      '/speed_setpoint', '/diagnostics', '/clock', '/predicted_joint_state',
+                      '/speed_residual', '/losses/total', '/losses/flat_clearance'):
             assert counts.get(topic, 0) > 0, topic
         assert counts['/joint_states'] == pytest.approx(400, abs=20)
         joints = [c for c in reader.connections if c.topic == '/joint_states']

@@ -16,6 +16,7 @@ from rclpy.parameter import Parameter
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock
 from satmotor_ros.cli.demo import CONTROL_RATE, RECORDED, RunResult
+from satmotor_ros.nodes.motor_model import MotorModelNode
 from satmotor_ros.nodes.speed_controller import SpeedControllerNode
 from satmotor_ros.nodes.virtual_motor import VirtualMotorNode
 from satmotor_ros.plant.scenario import Cycle
@@ -114,10 +115,12 @@ def run_cycle(liquid: str, feedforward: str, cycle: Cycle, effects: dict[str, An
                                              *sim, Parameter('liquid', value=liquid),
                                              Parameter('feedforward', value=feedforward),
                                              Parameter('rate', value=CONTROL_RATE)])
+        predictor = MotorModelNode(context=context, namespace=namespace, parameter_overrides=[
+            *sim, Parameter('liquid', value=liquid)])
         script = Script(cycle, context=context, namespace=namespace, parameter_overrides=sim)
         recorder = Recorder(list(RECORDED), lambda: motor.plant.state.time, context=context,
                             namespace=namespace)
-        nodes = [recorder, script, controller, motor]
+        nodes = [recorder, script, controller, predictor, motor]
         for node in nodes:
             executor.add_node(node)
         label = f'{liquid}/{"ff" if feedforward == "model" else "pi"}'

@@ -40,8 +40,13 @@ RECORDED = (  # topic relative to the run's namespace, type, reliable publisher?
     ('fluid_temperature', 'sensor_msgs/msg/Temperature', False),
     ('/diagnostics', 'diagnostic_msgs/msg/DiagnosticArray', True),
     ('/clock', 'rosgraph_msgs/msg/Clock', True),
+    ('predicted_joint_state', 'sensor_msgs/msg/JointState', True),
+    ('speed_residual', 'std_msgs/msg/Float64', True),
+    *((f'losses/{c}', 'std_msgs/msg/Float64', True) for c in (
+        'flat_clearance', 'commutation', 'compressibility', 'deformation', 'backlash',
+        'inertia', 'external', 'total')),
 )
-"""Every topic of a run; the motor_model node's are added when it is available."""
+"""Every topic of a run, relative to its namespace (DESIGN.md names and types)."""
 
 
 class RunResult(NamedTuple):

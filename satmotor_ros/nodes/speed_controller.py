@@ -15,7 +15,7 @@ import dataclasses
 import math
 from typing import Any
 
-from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+from diagnostic_msgs.msg import DiagnosticArray
 from rcl_interfaces.msg import SetParametersResult
 import rclpy
 from rclpy.executors import ExternalShutdownException
@@ -23,9 +23,10 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import qos_profile_sensor_data
 from satmotor_ros.model import load_motor, MotorModel
-from satmotor_ros.model.units import LPM, RPM
-from satmotor_ros.nodes.virtual_motor import descriptor
-from satmotor_ros.plant.config import ParameterSpec
+from satmotor_ros.model.units import RPM
+from satmotor_ros.nodes import _diagnostics as diag
+from satmotor_ros.nodes import _parameters as params
+from satmotor_ros.nodes._parameters import ParamSpec
 from satmotor_ros.plant.controller import ControllerParams, FEEDFORWARDS, SpeedController
 from satmotor_ros.plant.errors import PlantError
 from sensor_msgs.msg import FluidPressure, JointState
@@ -35,31 +36,26 @@ MAX_SETPOINT = 3000.0 * RPM
 """Largest speed set-point accepted, [rad/s]."""
 
 _DEFAULTS = ControllerParams()
-PARAMETERS: tuple[ParameterSpec, ...] = (
-    ParameterSpec('setpoint', 0.0, 'speed set-point until one arrives on speed_setpoint',
-                  'rad/s', 0.0, MAX_SETPOINT),
-    ParameterSpec('rate', 100.0, 'control rate on the node clock', 'Hz', 1.0, 1000.0),
-    ParameterSpec('kp', _DEFAULTS.kp, 'proportional gain', 'm^3/rad', 0.0, 1.0e-3),
-    ParameterSpec('ki', _DEFAULTS.ki, 'integral gain', 'm^3/(s*rad)', 0.0, 1.0e-2),
-    ParameterSpec('setpoint_weight', _DEFAULTS.setpoint_weight,
-                  'share of the set-point in the proportional part', '-', 0.0, 1.0),
-    ParameterSpec('flow_min', _DEFAULTS.flow_min, 'smallest flow command', 'm^3/s', 0.0,
-                  1.0e-2),
-    ParameterSpec('flow_max', _DEFAULTS.flow_max, 'largest flow command', 'm^3/s', 1.0e-7,
-                  1.0e-2),
-    ParameterSpec('feedforward', _DEFAULTS.feedforward, ' or '.join(FEEDFORWARDS), '-', None,
-                  None),
-    ParameterSpec('anti_windup', _DEFAULTS.anti_windup, 'back-calculation at the limits', '-',
-                  None, None),
-    ParameterSpec('liquid', 'oil', 'coefficient set of the feed-forward model', '-', None,
-                  None),
-    ParameterSpec('motor_file', '', 'motor YAML; empty: the packaged SM-0,75/25', '-', None,
-                  None),
-    ParameterSpec('joint_name', 'motor_shaft', 'joint whose velocity is controlled', '-', None,
-                  None),
-    ParameterSpec('measurement_timeout', 0.5, 'older speed: hold the command, warn', 's', 0.001,
-                  60.0),
-    ParameterSpec('diagnostics_period', 1.0, 'period of /diagnostics', 's', 0.01, 60.0),
+PARAMETERS: tuple[ParamSpec, ...] = (
+    ParamSpec('setpoint', 0.0, 'speed set-point until one arrives on speed_setpoint', 'rad/s',
+              0.0, MAX_SETPOINT),
+    ParamSpec('rate', 100.0, 'control rate on the node clock', 'Hz', 1.0, 1000.0),
+    ParamSpec('kp', _DEFAULTS.kp, 'proportional gain', 'm^3/rad', 0.0, 1.0e-3),
+    ParamSpec('ki', _DEFAULTS.ki, 'integral gain', 'm^3/(s*rad)', 0.0, 1.0e-2),
+    ParamSpec('setpoint_weight', _DEFAULTS.setpoint_weight,
+              'share of the set-point in the proportional part', '-', 0.0, 1.0),
+    ParamSpec('flow_min', _DEFAULTS.flow_min, 'smallest flow command', 'm^3/s', 0.0, 1.0e-2),
+    ParamSpec('flow_max', _DEFAULTS.flow_max, 'largest flow command', 'm^3/s', 1.0e-7,
+              1.0e-2),
+    ParamSpec('feedforward', _DEFAULTS.feedforward, 'feed-forward in front of the PI',
+              choices=FEEDFORWARDS),
+    ParamSpec('anti_windup', _DEFAULTS.anti_windup, 'back-calculation at the limits'),
+    ParamSpec('liquid', 'oil', 'coefficient set of the feed-forward model'),
+    ParamSpec('motor_file', '', 'motor YAML; empty: the packaged SM-0,75/25'),
+    ParamSpec('joint_name', 'motor_shaft', 'joint whose velocity is controlled'),
+    ParamSpec('measurement_timeout', 0.5, 'older speed: hold the command, warn', 's', 0.001,
+              60.0),
+    ParamSpec('diagnostics_period', 1.0, 'period of /diagnostics', 's', 0.01, 60.0),
 )
 """Every parameter of the node."""
 
@@ -82,9 +78,10 @@ class SpeedControllerNode(Node):
     def __init__(self, node_name: str = 'speed_controller', **kwargs: Any) -> None:
         """Declare parameters, build the law, open topics, start the control timer."""
         super().__init__(node_name, **kwargs)
-        for spec in PARAMETERS:
-            self.declare_parameter(spec.name, spec.default, descriptor(spec))
-        self.values = {spec.name: self.get_parameter(spec.name).value for spec in PARAMETERS}
+        self._specs = {spec.name: spec for spec in PARAMETERS}
+        for problem in params.declare(self, PARAMETERS).values():
+            self.get_logger().error(f'parameter {problem}')
+        self.values = params.values(self, PARAMETERS)
         self.law = self._build(self.values)  # invalid start-up parameters raise here
         self.add_on_set_parameters_callback(self._validate)
         self.add_post_set_parameters_callback(self._apply)
@@ -116,6 +113,10 @@ class SpeedControllerNode(Node):
         return SpeedController(params, model)
 
     def _validate(self, changes: list[Parameter]) -> SetParametersResult:
+        result = params.check(self._specs, changes)
+        if not result.successful:
+            self.get_logger().warning(f'parameter change refused: {result.reason}')
+            return result
         values = dict(self.values)
         values.update({p.name: p.value for p in changes})
         try:
@@ -194,30 +195,26 @@ class SpeedControllerNode(Node):
         if t < self._next_diagnostics:
             return
         self._next_diagnostics = t + self.values['diagnostics_period']
-        level, message = DiagnosticStatus.OK, 'tracking'
+        level, message = 0, 'tracking'
         if stale:
-            level, message = DiagnosticStatus.WARN, 'speed measurement is stale; command held'
+            level, message = 1, 'speed measurement is stale; command held'
         elif self._rejected_since:
-            level = DiagnosticStatus.WARN
+            level = 1
             message = f'refused {self._rejected_since} input(s): {self.last_rejection}'
         elif self.law.saturated:
-            level, message = DiagnosticStatus.WARN, 'flow command saturated'
+            level, message = 1, 'flow command saturated'
         self._rejected_since = 0
         values = {
-            'setpoint [rpm]': f'{self.setpoint / RPM:.1f}',
-            'speed [rpm]': f'{(self.speed or 0.0) / RPM:.1f}',
-            'flow_command [l/min]': f'{self.command / LPM:.3f}',
-            'feedforward [l/min]': f'{self.law.feedforward_flow / LPM:.3f}',
-            'integral [l/min]': f'{self.law.integral / LPM:.3f}',
-            'feedforward': self.law.params.feedforward, 'rejected_inputs': str(self.rejected),
+            'setpoint [rad/s]': self.setpoint, 'speed [rad/s]': self.speed or 0.0,
+            'flow_command [m^3/s]': self.command,
+            'feedforward [m^3/s]': self.law.feedforward_flow,
+            'integral [m^3/s]': self.law.integral,
+            'feedforward': self.law.params.feedforward, 'rejected_inputs': self.rejected,
             'last_rejection': self.last_rejection,
         }
-        status = DiagnosticStatus(
-            level=level, name=f'{self.get_fully_qualified_name()}: speed loop',
-            message=message, values=[KeyValue(key=k, value=v) for k, v in values.items()])
-        array = DiagnosticArray(status=[status])
-        array.header.stamp = now.to_msg()
-        self._diag.publish(array)
+        status = diag.status(f'{self.get_fully_qualified_name()}: speed loop', 'speed loop',
+                             level, message, values)
+        self._diag.publish(diag.array(now, [status]))
 
     def controller_params(self) -> ControllerParams:
         """

@@ -21,52 +21,54 @@ import time
 from typing import Any
 
 from builtin_interfaces.msg import Time
-from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
-from rcl_interfaces.msg import (FloatingPointRange, IntegerRange, ParameterDescriptor,
-                                SetParametersResult)
+from diagnostic_msgs.msg import DiagnosticArray
+from rcl_interfaces.msg import SetParametersResult
 import rclpy
 from rclpy.clock import Clock, ClockType
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import qos_profile_sensor_data, QoSProfile
+from rclpy.time import Time as RosTime
 from rosgraph_msgs.msg import Clock as ClockMsg
 from satmotor_ros.model import describe_status, load_motor, MotorModel
 from satmotor_ros.model.units import LPM
+from satmotor_ros.nodes import _diagnostics as diag
+from satmotor_ros.nodes import _parameters as params
+from satmotor_ros.nodes._parameters import ParamSpec
 from satmotor_ros.plant import make_load, Plant
-from satmotor_ros.plant.config import parameter_specs, ParameterSpec, params_from_flat
+from satmotor_ros.plant.config import parameter_specs, params_from_flat
 from satmotor_ros.plant.load import LOAD_KINDS
 from sensor_msgs.msg import FluidPressure, JointState, Temperature
 from std_msgs.msg import Float64
 
-NODE_PARAMETERS: tuple[ParameterSpec, ...] = (
-    ParameterSpec('liquid', 'oil', 'coefficient set and its liquid', '-', None, None),
-    ParameterSpec('motor_file', '', 'motor YAML; empty: the packaged SM-0,75/25', '-', None,
-                  None),
-    ParameterSpec('displacement_law', 'eq33', "'eq33' or 'eq39'", '-', None, None),
-    ParameterSpec('clock_mode', 'wall', "'wall' (real time) or 'sim' (fast, publishes /clock)",
-                  '-', None, None),
-    ParameterSpec('max_speedup', 0.0, 'sim mode: at most this many times real time; 0: '
-                  'as fast as possible', '-', 0.0, 1.0e6),
-    ParameterSpec('publish_rate', 100.0, 'rate of the sensor topics', 'Hz', 1.0, 1000.0),
-    ParameterSpec('diagnostics_period', 1.0, 'period of /diagnostics', 's', 0.01, 60.0),
-    ParameterSpec('max_flow_command', 100.0 * LPM, 'commands above are refused', 'm^3/s',
-                  1.0e-6, 1.0e-2),
-    ParameterSpec('joint_name', 'motor_shaft', 'joint name in joint_states', '-', None, None),
-    ParameterSpec('frame_id', 'motor', 'frame_id of the sensor headers', '-', None, None),
-    ParameterSpec('load.kind', 'constant', 'load profile: ' + ', '.join(LOAD_KINDS), '-',
-                  None, None),
-    ParameterSpec('load.torque', 0.0, 'constant load torque', 'N*m', -1.0e4, 1.0e4),
-    ParameterSpec('load.before', 0.0, 'step load: torque before', 'N*m', -1.0e4, 1.0e4),
-    ParameterSpec('load.after', 0.0, 'step load: torque after', 'N*m', -1.0e4, 1.0e4),
-    ParameterSpec('load.time', 0.0, 'step load: time of the step', 's', 0.0, 1.0e9),
-    ParameterSpec('load.start', 0.0, 'ramp load: torque at t_start', 'N*m', -1.0e4, 1.0e4),
-    ParameterSpec('load.end', 0.0, 'ramp load: torque at t_end', 'N*m', -1.0e4, 1.0e4),
-    ParameterSpec('load.t_start', 0.0, 'ramp load: start', 's', 0.0, 1.0e9),
-    ParameterSpec('load.t_end', 1.0, 'ramp load: end', 's', 0.0, 1.0e9),
-    ParameterSpec('load.coefficient', 0.0, 'speed load: torque per speed', 'N*m*s/rad', 0.0,
-                  1.0e3),
-    ParameterSpec('load.offset', 0.0, 'speed load: torque at rest', 'N*m', -1.0e4, 1.0e4),
+NODE_PARAMETERS: tuple[ParamSpec, ...] = (
+    ParamSpec('liquid', 'oil', 'coefficient set and its liquid'),
+    ParamSpec('motor_file', '', 'motor YAML; empty: the packaged SM-0,75/25'),
+    ParamSpec('displacement_law', 'eq33', 'change of displacement law',
+              choices=('eq33', 'eq39')),
+    ParamSpec('clock_mode', 'wall', "'wall' (real time) or 'sim' (fast, publishes /clock)",
+              choices=('wall', 'sim')),
+    ParamSpec('max_speedup', 0.0, 'sim mode: at most this many times real time; 0: as fast '
+              'as possible', '-', 0.0, 1.0e6),
+    ParamSpec('publish_rate', 100.0, 'rate of the sensor topics', 'Hz', 1.0, 1000.0),
+    ParamSpec('diagnostics_period', 1.0, 'period of /diagnostics', 's', 0.01, 60.0),
+    ParamSpec('max_flow_command', 100.0 * LPM, 'commands above are refused', 'm^3/s',
+              1.0e-6, 1.0e-2),
+    ParamSpec('joint_name', 'motor_shaft', 'joint name in joint_states'),
+    ParamSpec('frame_id', 'motor', 'frame_id of the sensor headers'),
+    ParamSpec('load.kind', 'constant', 'load profile', choices=tuple(LOAD_KINDS)),
+    ParamSpec('load.torque', 0.0, 'constant load torque', 'N*m', -1.0e4, 1.0e4),
+    ParamSpec('load.before', 0.0, 'step load: torque before', 'N*m', -1.0e4, 1.0e4),
+    ParamSpec('load.after', 0.0, 'step load: torque after', 'N*m', -1.0e4, 1.0e4),
+    ParamSpec('load.time', 0.0, 'step load: time of the step', 's', 0.0, 1.0e9),
+    ParamSpec('load.start', 0.0, 'ramp load: torque at t_start', 'N*m', -1.0e4, 1.0e4),
+    ParamSpec('load.end', 0.0, 'ramp load: torque at t_end', 'N*m', -1.0e4, 1.0e4),
+    ParamSpec('load.t_start', 0.0, 'ramp load: start', 's', 0.0, 1.0e9),
+    ParamSpec('load.t_end', 1.0, 'ramp load: end', 's', 0.0, 1.0e9),
+    ParamSpec('load.coefficient', 0.0, 'speed load: torque per speed', 'N*m*s/rad', 0.0,
+              1.0e3),
+    ParamSpec('load.offset', 0.0, 'speed load: torque at rest', 'N*m', -1.0e4, 1.0e4),
 )
 """The node's own parameters; the plant's follow (:func:`parameter_specs`)."""
 
@@ -76,42 +78,23 @@ MAX_LOAD_TORQUE = 1.0e4
 """Largest load torque accepted on the topic, [N*m]."""
 
 
-def all_parameters() -> tuple[ParameterSpec, ...]:
+_CHOICES = {'effects.leakage_driver': ('case', 'outlet')}
+
+
+def all_parameters() -> tuple[ParamSpec, ...]:
     """
     List every parameter the node declares.
 
     Returns
     -------
-    tuple of ParameterSpec
-        Node parameters, then the plant's.
+    tuple of ParamSpec
+        Node parameters, then the plant's (from the plant records: unit, range).
 
     """
-    return NODE_PARAMETERS + parameter_specs()
-
-
-def descriptor(spec: ParameterSpec) -> ParameterDescriptor:
-    """
-    Build the descriptor of a parameter: description with unit, and its range.
-
-    Parameters
-    ----------
-    spec : ParameterSpec
-        The parameter, [-]
-
-    Returns
-    -------
-    ParameterDescriptor
-        With a floating-point or integer range for numbers.
-
-    """
-    text = f'{spec.description} [{spec.unit}]'
-    if isinstance(spec.default, bool) or spec.low is None:
-        return ParameterDescriptor(description=text)
-    if isinstance(spec.default, int):
-        return ParameterDescriptor(description=text, integer_range=[
-            IntegerRange(from_value=int(spec.low), to_value=int(spec.high), step=1)])
-    return ParameterDescriptor(description=text, floating_point_range=[
-        FloatingPointRange(from_value=float(spec.low), to_value=float(spec.high), step=0.0)])
+    plant = tuple(ParamSpec(s.name, s.default, s.description, s.unit, s.low, s.high,
+                            choices=_CHOICES.get(s.name, ()))
+                  for s in parameter_specs())
+    return NODE_PARAMETERS + plant
 
 
 def _stamp(seconds: float) -> Time:
@@ -166,9 +149,10 @@ class VirtualMotorNode(Node):
     def __init__(self, node_name: str = 'virtual_motor', **kwargs: Any) -> None:
         """Declare parameters, build the plant, open topics and start stepping."""
         super().__init__(node_name, **kwargs)
-        for spec in all_parameters():
-            self.declare_parameter(spec.name, spec.default, descriptor(spec))
-        self._setup = Setup(self._values())  # invalid start-up parameters raise here
+        self._specs = {spec.name: spec for spec in all_parameters()}
+        for problem in params.declare(self, self._specs.values()).values():
+            self.get_logger().error(f'parameter {problem}')
+        self._setup = Setup(self._values())  # an inconsistent set-up raises here
         self.plant = Plant(self._setup.model, self._setup.params, self._setup.load)
         self.add_on_set_parameters_callback(self._validate)
         self.add_post_set_parameters_callback(self._apply)
@@ -194,12 +178,16 @@ class VirtualMotorNode(Node):
     # -- parameters --------------------------------------------------------------------
 
     def _values(self, changes: list[Parameter] | None = None) -> dict[str, Any]:
-        values = {spec.name: self.get_parameter(spec.name).value for spec in all_parameters()}
+        values = params.values(self, self._specs.values())
         for p in changes or []:
             values[p.name] = p.value
         return values
 
     def _validate(self, changes: list[Parameter]) -> SetParametersResult:
+        result = params.check(self._specs, changes)
+        if not result.successful:
+            self.get_logger().warning(f'parameter change refused: {result.reason}')
+            return result
         try:
             self._pending = Setup(self._values(changes))
         except (ValueError, OSError) as err:  # PlantError, ModelError and ConfigError too
@@ -313,35 +301,30 @@ class VirtualMotorNode(Node):
         wall0, sim0 = self._ticks_wall
         factor = (now_sim - sim0) / (now_wall - wall0) if now_wall > wall0 else 0.0
         self._ticks_wall = (now_wall, now_sim)
-        level, message = DiagnosticStatus.OK, 'running'
+        level, message = 0, 'running'
         if self._rejected_since_diagnostics:
-            level = DiagnosticStatus.WARN
+            level = 1
             message = f'refused {self._rejected_since_diagnostics} input(s): ' \
                       f'{self.last_rejection}'
         elif flows.relief > 0.0:
-            level, message = DiagnosticStatus.WARN, 'relief valve open'
+            level, message = 1, 'relief valve open'
         if plant.invalid_points:
-            level = DiagnosticStatus.ERROR
+            level = 2
             message = f'model refused {plant.invalid_points} point(s): ' \
                       f'{describe_status(plant.model_status)}'
         self._rejected_since_diagnostics = 0
         values = {
-            'sim_time [s]': f'{now_sim:.3f}', 'realtime_factor [-]': f'{factor:.1f}',
-            'flow_command [l/min]': f'{self._command / LPM:.3f}',
-            'load_torque [N*m]': 'profile' if self._load_torque is None
-            else f'{self._load_torque:.3f}',
-            'rejected_inputs': str(self.rejected), 'last_rejection': self.last_rejection,
-            'relief_flow [l/min]': f'{flows.relief / LPM:.3f}',
+            'sim_time [s]': now_sim, 'realtime_factor [-]': factor,
+            'flow_command [m^3/s]': self._command,
+            'load_torque [N*m]': 'profile' if self._load_torque is None else self._load_torque,
+            'rejected_inputs': self.rejected, 'last_rejection': self.last_rejection,
+            'relief_flow [m^3/s]': flows.relief,
             'model_status': describe_status(plant.model_status),
-            'model_rebuilds': str(plant.rebuilds), 'liquid': plant.model.liquid.name,
+            'model_rebuilds': plant.rebuilds, 'liquid': plant.model.liquid.name,
         }
-        status = DiagnosticStatus(
-            level=level, name=f'{self.get_fully_qualified_name()}: plant', message=message,
-            hardware_id=plant.model.name,
-            values=[KeyValue(key=k, value=v) for k, v in values.items()])
-        array = DiagnosticArray(status=[status])
-        array.header.stamp = stamp
-        self._diag_pub.publish(array)
+        status = diag.status(f'{self.get_fully_qualified_name()}: plant', plant.model.name,
+                             level, message, values)
+        self._diag_pub.publish(diag.array(RosTime.from_msg(stamp), [status]))
 
 
 def main(args: list[str] | None = None) -> None:
