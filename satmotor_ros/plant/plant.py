@@ -148,6 +148,8 @@ class Plant:
         self._nu_ref = model.liquid.kinematic_viscosity
         self._drifts = fx.viscosity_temperature > 0.0 or fx.clearance_wear > 0.0
         self._lag = dt / (p.pump_lag + dt)
+        self._solve_constants = (self._qt, self._a, self._c, self._e0, self._e1, self._gr,
+                                 self._pr0, self._kv, self._pcr)
 
     def reset(self, inlet_pressure: float | None = None, outlet_pressure: float | None = None,
               speed: float = 0.0, temperature: float | None = None) -> None:
@@ -347,19 +349,18 @@ class Plant:
         its last state and switched once if the solution contradicts it.
         """
         g, h, _, qx = lin
-        qt = self._qt
+        qt, a, c, e0, e1, gr, pr0, kv, pcr = self._solve_constants
         qwk = qt * wk
-        a11 = self._a + g + qwk
-        a12 = self._e1 - g - qwk
+        qw0 = qt * w0
+        a11 = a + g + qwk
+        a12 = e1 - g - qwk
         a21 = -g - qwk
-        a22 = self._c + g + self._gr + qwk
-        b1 = self._a * self._p_in + q_cmd - h - self._e0 - qt * w0
-        b2 = self._c * self._p_out + h - qx + self._gr * self._pr0 + qt * w0
-        pcr = self._pcr
+        a22 = c + g + gr + qwk
+        b1 = a * self._p_in + q_cmd - h - e0 - qw0
+        b2 = c * self._p_out + h - qx + gr * pr0 + qw0
         p = r = 0.0
         for _ in range(3):
             if relief:
-                kv = self._kv
                 c11, d1 = a11 + kv, b1 + kv * pcr
             else:
                 c11, d1 = a11, b1
