@@ -4,6 +4,7 @@
 import dataclasses
 import math
 
+from hypothesis import given, settings, strategies as st
 import pytest
 
 from satmotor_ros.model import MotorModel
@@ -194,3 +195,31 @@ def test_parameter_records_reject_bad_values_naming_the_field():
     with pytest.raises(PlantError, match=r'PlantParams.step'):
         PlantParams(step=math.nan)
     assert dataclasses.replace(PlantParams(), step=2e-3).step == 2e-3
+
+
+@settings(max_examples=25, deadline=None, derandomize=True)
+@given(liquid=st.sampled_from(['oil', 'water']),
+       flows=st.lists(st.floats(0.0, 60.0), min_size=3, max_size=6),
+       loads=st.lists(st.floats(0.0, 150.0), min_size=3, max_size=6))
+def test_any_command_sequence_keeps_the_plant_finite_bounded_and_balanced(liquid, flows,
+                                                                          loads):
+    """Random flow and brake steps: finite, p within [vapour, relief], speed bounded, balanced."""
+    params = PlantParams()
+    plant = Plant(MODELS[liquid], params)
+    lines, relief = params.lines, params.relief
+    ceiling = lines.tank_pressure + relief.cracking_pressure + 60.0 * LPM / relief.conductance
+    dt = params.step
+    for flow, load in zip(flows, loads):
+        for _ in range(150):
+            before_in, before_out = _volumes(plant)
+            plant.step(flow * LPM, load)
+            state, f = plant.state, plant.flows
+            assert all(math.isfinite(v) for v in state)
+            assert lines.vapour_pressure <= state.inlet_pressure <= ceiling
+            assert lines.vapour_pressure <= state.outlet_pressure <= ceiling
+            # bounded: the compressed lines may overshoot the speed the largest flow drives
+            # or creep a released shaft backwards, but never run it away
+            assert abs(state.speed) <= 2.0 * 60.0 * LPM / MODELS[liquid].geometry.displacement
+            after_in, after_out = _volumes(plant)
+            net_in = dt * (f.command - f.motor - f.relief - f.leakage + f.cavitation_in)
+            assert after_in - before_in == pytest.approx(net_in, abs=1e-9 * dt * 1e-3)

@@ -227,7 +227,8 @@ def predicted(tr: Tracking) -> tuple[np.ndarray, dict[str, np.ndarray], str]:
     return op.speed, op.losses.as_dict(), 'the model library on the recorded flow and pressures'
 
 
-def _plot_prediction(out: Path, liquid: str, tr: Tracking) -> tuple[str, str, str, float]:
+def _plot_prediction(out: Path, liquid: str, tr: Tracking,
+                     after: float) -> tuple[str, str, str, tuple[float, float]]:
     n_pred, losses, source = predicted(tr)
     fig, (top, bottom) = plt.subplots(2, 1, figsize=(10, 6), sharex=True,
                                       gridspec_kw={'height_ratios': [2, 1]})
@@ -261,9 +262,13 @@ def _plot_prediction(out: Path, liquid: str, tr: Tracking) -> tuple[str, str, st
     loss_name = f'losses_{liquid}.png'
     fig.savefig(out / loss_name, dpi=110)
     plt.close(fig)
-    rms = float(np.sqrt(np.nanmean(residual[settled(tr)] ** 2))) if settled(tr).any() \
-        else np.nan
-    return name, loss_name, source, rms
+    quiet = settled(tr, after)
+    if quiet.any():
+        stats = (float(np.nanmedian(residual[quiet])),
+                 float(np.sqrt(np.nanmean(residual[quiet] ** 2))))
+    else:
+        stats = (np.nan, np.nan)
+    return name, loss_name, source, stats
 
 
 def write_report(out: Path, runs: list[RunResult], cycle: Cycle,
@@ -321,11 +326,14 @@ def write_report(out: Path, runs: list[RunResult], cycle: Cycle,
                          f'{s["iae_loads"]:.2f} | {s["iae"]:.2f} |')
         tracking = _plot_tracking(out, liquid, tracks)
         main = tracks.get('model') or next(iter(tracks.values()))
-        pred, losses, source, rms = _plot_prediction(out, liquid, main)
+        after = min(1.0, 0.5 * min(s.duration for s in cycle.segments))
+        pred, losses, source, (bias, rms) = _plot_prediction(out, liquid, main, after)
         sections += [f'## {liquid.capitalize()}', '', f'![tracking]({tracking})', '',
                      f'![predicted against measured]({pred})', '',
-                     f'Prediction from {source}. RMS of measured - predicted over the '
-                     f'samples at least 1 s after a step: {rms:.3f} rpm. The spikes are '
+                     f'Prediction from {source}. Over the samples at least {after:.2g} s '
+                     f'after a step, measured - predicted has a median of {bias:.3f} rpm '
+                     f'(RMS {rms:.3f} rpm): an effect the model does not know shows up as '
+                     'this bias. The spikes are '
                      'transients: the model is a steady-state map and predicts from the '
                      'commanded flow, while the plant has a pump lag, line compliance '
                      'and shaft inertia.', '',
