@@ -159,3 +159,16 @@ def test_shipped_parameter_file_lists_every_parameter_at_its_default():
     doc = yaml.safe_load(path.read_text())
     flat = dict(_flatten(doc['/**/virtual_motor']['ros__parameters']))
     assert flat == {spec.name: spec.default for spec in all_parameters()}
+
+
+def test_wall_clock_mode_keeps_pace_with_the_wall_clock(ros):
+    """clock_mode 'wall': simulated time follows the wall clock; no /clock is published."""
+    context, executor, probe = ros
+    node = VirtualMotorNode(context=context, namespace=NAMESPACE)
+    executor.add_node(node)
+    clock = _collect(probe, Clock, '/clock', qos_profile_sensor_data)
+    start = time.monotonic()
+    _spin_until(executor, lambda: time.monotonic() - start > 1.5, timeout=3.0)
+    elapsed = time.monotonic() - start
+    assert node.plant.state.time == pytest.approx(elapsed, abs=0.3)
+    assert not clock
