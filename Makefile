@@ -35,11 +35,11 @@ $(STAMP): requirements.txt setup.py setup.cfg
 	$(PY) -m pip install -e .
 	touch $@
 
+# The main job: virtual motor, controller and model over ROS through a cycle of speed and
+# load steps on water and oil; bags and report.md with plots in out/demo (replaced each run).
 run: $(STAMP)
-	$(VENV)/bin/satmotor operating-point --liquid oil --flow 5 --dp-i 25
-	$(VENV)/bin/satmotor operating-point --liquid water --flow 5 --dp-i 25
-	$(VENV)/bin/satmotor characteristics --liquid oil --out out/characteristics_oil
-	$(VENV)/bin/satmotor characteristics --liquid water --out out/characteristics_water
+	rm -rf out/demo
+	$(VENV)/bin/satmotor demo --out out/demo
 
 test: $(STAMP)
 	ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST ROS_DOMAIN_ID=$(ROS_DOMAIN_ID) $(PY) -m pytest -q

@@ -1,0 +1,254 @@
+# SPDX-License-Identifier: Apache-2.0
+"""
+``satmotor demo``: virtual motor, controller and model over real ROS topics, recorded.
+
+For each liquid, the scripted cycle of speed and load steps runs twice, with the
+controller's model-based feed-forward and with the PI alone, in one process: the
+nodes share a single-threaded executor, talk over DDS topics in a namespace of their
+own and run on the virtual motor's ``/clock``, faster than real time. Every topic goes
+into an MCAP rosbag2 per run; ``report.md`` gets the plots and the metrics table.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import os
+from pathlib import Path
+import sys
+import time
+from typing import Any, NamedTuple
+
+from satmotor_ros.cli._common import CliError, fail
+from satmotor_ros.plant.params import EffectParams
+from satmotor_ros.plant.scenario import default_cycle
+
+LIQUIDS = ('water', 'oil')
+FEEDFORWARDS = ('model', 'none')
+CONTROL_RATE = 100.0
+"""Rate of the controller and of the set-point script, [Hz]."""
+
+RECORDED = (  # topic relative to the run's namespace, type, reliable publisher?
+    ('flow_command', 'std_msgs/msg/Float64', True),
+    ('load_torque', 'std_msgs/msg/Float64', True),
+    ('speed_setpoint', 'std_msgs/msg/Float64', True),
+    ('inlet_pressure', 'sensor_msgs/msg/FluidPressure', False),
+    ('outlet_pressure', 'sensor_msgs/msg/FluidPressure', False),
+    ('case_pressure', 'sensor_msgs/msg/FluidPressure', False),
+    ('flow_measured', 'std_msgs/msg/Float64', False),
+    ('joint_states', 'sensor_msgs/msg/JointState', False),
+    ('fluid_temperature', 'sensor_msgs/msg/Temperature', False),
+    ('/diagnostics', 'diagnostic_msgs/msg/DiagnosticArray', True),
+    ('/clock', 'rosgraph_msgs/msg/Clock', True),
+    ('predicted_joint_state', 'sensor_msgs/msg/JointState', True),
+    ('speed_residual', 'std_msgs/msg/Float64', True),
+    *((f'losses/{c}', 'std_msgs/msg/Float64', True) for c in (
+        'flat_clearance', 'commutation', 'compressibility', 'deformation', 'backlash',
+        'inertia', 'external', 'total')),
+)
+"""Every topic of a run, relative to its namespace (DESIGN.md names and types)."""
+
+
+class RunResult(NamedTuple):
+    """One run of the cycle: where its bag is and what was recorded."""
+
+    liquid: str
+    feedforward: str
+    bag: Path
+    messages: dict[str, list[tuple[int, bytes]]]  # topic -> (log time [ns], CDR)
+    types: dict[str, str]  # topic -> message type
+    wall: float  # wall-clock duration of the run [s]
+    sim: float  # simulated duration [s]
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    """
+    Register the subcommand.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The ``satmotor`` subparsers, [-]
+
+    """
+    parser = sub.add_parser(
+        'demo', help='run virtual motor, model and controller over ROS; bag + report',
+        description='Runs the virtual motor, the motor_model node and the speed controller '
+                    'together over real ROS topics through a cycle of speed and load steps, '
+                    'with and without feed-forward, faster than real time; records every '
+                    'topic to an MCAP bag per run and writes report.md with plots.')
+    parser.add_argument('--liquid', choices=(*LIQUIDS, 'both'), default='both',
+                        help='liquid(s) to run (default: both)')
+    parser.add_argument('--duration', default='24',
+                        help='length of the cycle per run in seconds of simulated time '
+                             '(default 24; the steps scale with it)')
+    parser.add_argument('--effect', action='append', default=[], metavar='NAME=VALUE',
+                        help='inject a plant effect the model does not know, SI value, e.g. '
+                             'external_leakage=2e-12, viscosity_temperature=0.03, '
+                             'clearance_wear=1e-9, flow_sensor_gain=0.03 (repeatable)')
+    parser.add_argument('--out', default='out/demo', metavar='DIR',
+                        help='output directory (default out/demo)')
+    parser.add_argument('--quiet', action='store_true', help='no progress bar')
+    parser.set_defaults(command=command)
+
+
+def parse_effects(items: list[str]) -> dict[str, Any]:
+    """
+    Parse ``NAME=VALUE`` effect options into plant parameter values.
+
+    Parameters
+    ----------
+    items : list of str
+        As typed, [-]
+
+    Returns
+    -------
+    dict
+        ``effects.<name>`` -> value, validated by :class:`EffectParams`.
+
+    Raises
+    ------
+    CliError
+        Naming the option and the value.
+
+    """
+    known = {f.name: f.type for f in dataclasses.fields(EffectParams)}
+    values: dict[str, Any] = {}
+    for item in items:
+        name, sep, text = item.partition('=')
+        if not sep or name not in known:
+            msg = f'--effect {item!r}: use NAME=VALUE with NAME one of {", ".join(known)}'
+            raise CliError(msg)
+        if name == 'leakage_driver':
+            values[name] = text
+            continue
+        try:
+            values[name] = float(text)
+        except ValueError:
+            raise CliError(f'--effect {item!r}: {text!r} is not a number') from None
+    try:
+        EffectParams(**values)
+    except ValueError as err:
+        raise CliError(f'--effect: {err}') from None
+    return {f'effects.{k}': v for k, v in values.items()}
+
+
+def command(liquid: str, duration: str, effect: list[str], out: str, quiet: bool) -> int:
+    """
+    Run the demo.
+
+    Parameters
+    ----------
+    liquid : str
+        ``'water'``, ``'oil'`` or ``'both'``, [-]
+    duration : str
+        Cycle length as typed, [s]
+    effect : list of str
+        ``NAME=VALUE`` effects to inject, [-]
+    out : str
+        Output directory, [-]
+    quiet : bool
+        Suppress the progress bar, [-]
+
+    Returns
+    -------
+    int
+        0 on success, 1 on an error (one line on stderr).
+
+    """
+    try:
+        try:
+            seconds = float(duration)
+        except ValueError:
+            raise CliError(f'--duration {duration!r}: not a number of seconds') from None
+        if not 2.0 <= seconds <= 3600.0:
+            raise CliError(f'--duration {duration!r}: must be within 2..3600 s')
+        effects = parse_effects(effect)
+        out_dir = Path(out)
+        bags = out_dir / 'bags'
+        liquids = LIQUIDS if liquid == 'both' else (liquid,)
+        existing = [bags / f'{q}_{ff}' for q in liquids for ff in FEEDFORWARDS
+                    if (bags / f'{q}_{ff}').exists()]
+        if existing:
+            raise CliError(f'--out {out!r}: {existing[0]} exists; choose a new directory')
+        out_dir.mkdir(parents=True, exist_ok=True)
+    except (CliError, OSError) as err:
+        return fail(err)
+    cycle = default_cycle().scaled(seconds)
+    os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
+    from satmotor_ros.cli import _demo_report as report
+    from satmotor_ros.cli._demo_ros import run_cycle
+    runs = []
+    progress = None if quiet else Progress(len(liquids) * len(FEEDFORWARDS) * cycle.duration)
+    for q in liquids:
+        for ff in FEEDFORWARDS:
+            runs.append(run_cycle(q, ff, cycle, effects, bags / f'{q}_{ff}', progress))
+    if progress is not None:
+        progress.done()
+    path = report.write_report(out_dir, runs, cycle, effects)
+    wall = sum(r.wall for r in runs)
+    sim = sum(r.sim for r in runs)
+    print(f'satmotor demo: {len(runs)} runs, {sim:.0f} s simulated in {wall:.1f} s '
+          f'({sim / wall:.1f}x real time); report: {path}; bags: {bags}')
+    return 0
+
+
+class Progress:
+    """
+    A one-line progress bar on stderr.
+
+    Parameters
+    ----------
+    total : float
+        Simulated seconds of all runs, [s]
+
+    """
+
+    def __init__(self, total: float) -> None:
+        """Start the clock."""
+        self.total = total
+        self.finished = 0.0
+        self.start = time.monotonic()
+        self._shown = 0.0
+
+    def show(self, label: str, sim: float) -> None:
+        """
+        Redraw at most five times a second.
+
+        Parameters
+        ----------
+        label : str
+            Current run, [-]
+        sim : float
+            Simulated seconds of the current run, [s]
+
+        """
+        now = time.monotonic()
+        if now - self._shown < 0.2:
+            return
+        self._shown = now
+        done = min((self.finished + sim) / self.total, 1.0)
+        bar = '#' * int(30 * done)
+        speed = (self.finished + sim) / max(now - self.start, 1e-9)
+        sys.stderr.write(f'\r[{bar:<30}] {done * 100:5.1f} % {label:<14} '
+                         f'{speed:5.1f}x real time ')
+        sys.stderr.flush()
+
+    def run_done(self, sim: float) -> None:
+        """
+        Count a finished run.
+
+        Parameters
+        ----------
+        sim : float
+            Its simulated seconds, [s]
+
+        """
+        self.finished += sim
+
+    def done(self) -> None:
+        """End the line."""
+        sys.stderr.write('\n')
+
+
+__all__ = ['RunResult', 'add_parser', 'command', 'parse_effects']

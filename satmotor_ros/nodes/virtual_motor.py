@@ -1,0 +1,360 @@
+# SPDX-License-Identifier: Apache-2.0
+"""
+The ``virtual_motor`` node: the plant behind the topics of a real SM-0,75/25 test rig.
+
+Subscribes ``flow_command`` and ``load_torque`` (std_msgs/Float64, m^3/s and N*m);
+publishes ``inlet_pressure``, ``outlet_pressure``, ``case_pressure``
+(sensor_msgs/FluidPressure, Pa absolute), ``flow_measured`` (std_msgs/Float64, m^3/s),
+``joint_states`` (rad, rad/s, N*m), ``fluid_temperature`` (sensor_msgs/Temperature, degC)
+with sensor-data QoS, and ``/diagnostics``. All physics is in :mod:`satmotor_ros.plant`.
+
+``clock_mode`` ``wall`` steps the plant with the wall clock; ``sim`` steps it as fast as
+possible (or ``max_speedup`` times real time) and publishes ``/clock``, so every other
+node runs on ``use_sim_time``. A bad command (NaN, negative, above ``max_flow_command``)
+is refused: the last good one is held, the reason logged and put on ``/diagnostics``.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from typing import Any
+
+from builtin_interfaces.msg import Time
+from diagnostic_msgs.msg import DiagnosticArray
+from rcl_interfaces.msg import SetParametersResult
+import rclpy
+from rclpy.clock import Clock, ClockType
+from rclpy.executors import ExternalShutdownException
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+from rclpy.qos import qos_profile_sensor_data, QoSProfile
+from rclpy.time import Time as RosTime
+from rosgraph_msgs.msg import Clock as ClockMsg
+from satmotor_ros.model import describe_status, load_motor, MotorModel
+from satmotor_ros.model.units import LPM
+from satmotor_ros.nodes import _diagnostics as diag
+from satmotor_ros.nodes import _parameters as params
+from satmotor_ros.nodes._parameters import ParamSpec
+from satmotor_ros.plant import make_load, Plant
+from satmotor_ros.plant.config import parameter_specs, params_from_flat
+from satmotor_ros.plant.load import LOAD_KINDS
+from sensor_msgs.msg import FluidPressure, JointState, Temperature
+from std_msgs.msg import Float64
+
+NODE_PARAMETERS: tuple[ParamSpec, ...] = (
+    ParamSpec('liquid', 'oil', 'coefficient set and its liquid'),
+    ParamSpec('motor_file', '', 'motor YAML; empty: the packaged SM-0,75/25'),
+    ParamSpec('displacement_law', 'eq33', 'change of displacement law',
+              choices=('eq33', 'eq39')),
+    ParamSpec('clock_mode', 'wall', "'wall' (real time) or 'sim' (fast, publishes /clock)",
+              choices=('wall', 'sim')),
+    ParamSpec('max_speedup', 0.0, 'sim mode: at most this many times real time; 0: as fast '
+              'as possible', '-', 0.0, 1.0e6),
+    ParamSpec('publish_rate', 100.0, 'rate of the sensor topics', 'Hz', 1.0, 1000.0),
+    ParamSpec('diagnostics_period', 1.0, 'period of /diagnostics', 's', 0.01, 60.0),
+    ParamSpec('max_flow_command', 100.0 * LPM, 'commands above are refused', 'm^3/s',
+              1.0e-6, 1.0e-2),
+    ParamSpec('joint_name', 'motor_shaft', 'joint name in joint_states'),
+    ParamSpec('frame_id', 'motor', 'frame_id of the sensor headers'),
+    ParamSpec('load.kind', 'constant', 'load profile', choices=tuple(LOAD_KINDS)),
+    ParamSpec('load.torque', 0.0, 'constant load torque', 'N*m', -1.0e4, 1.0e4),
+    ParamSpec('load.before', 0.0, 'step load: torque before', 'N*m', -1.0e4, 1.0e4),
+    ParamSpec('load.after', 0.0, 'step load: torque after', 'N*m', -1.0e4, 1.0e4),
+    ParamSpec('load.time', 0.0, 'step load: time of the step', 's', 0.0, 1.0e9),
+    ParamSpec('load.start', 0.0, 'ramp load: torque at t_start', 'N*m', -1.0e4, 1.0e4),
+    ParamSpec('load.end', 0.0, 'ramp load: torque at t_end', 'N*m', -1.0e4, 1.0e4),
+    ParamSpec('load.t_start', 0.0, 'ramp load: start', 's', 0.0, 1.0e9),
+    ParamSpec('load.t_end', 1.0, 'ramp load: end', 's', 0.0, 1.0e9),
+    ParamSpec('load.coefficient', 0.0, 'speed load: torque per speed', 'N*m*s/rad', 0.0,
+              1.0e3),
+    ParamSpec('load.offset', 0.0, 'speed load: torque at rest', 'N*m', -1.0e4, 1.0e4),
+)
+"""The node's own parameters; the plant's follow (:func:`parameter_specs`)."""
+
+_LOAD_FIELDS = {'constant': ('torque',), 'step': ('before', 'after', 'time'),
+                'ramp': ('start', 'end', 't_start', 't_end'), 'speed': ('coefficient', 'offset')}
+MAX_LOAD_TORQUE = 1.0e4
+"""Largest load torque accepted on the topic, [N*m]."""
+
+
+_CHOICES = {'effects.leakage_driver': ('case', 'outlet')}
+
+
+def all_parameters() -> tuple[ParamSpec, ...]:
+    """
+    List every parameter the node declares.
+
+    Returns
+    -------
+    tuple of ParamSpec
+        Node parameters, then the plant's (from the plant records: unit, range).
+
+    """
+    plant = tuple(ParamSpec(s.name, s.default, s.description, s.unit, s.low, s.high,
+                            choices=_CHOICES.get(s.name, ()))
+                  for s in parameter_specs())
+    return NODE_PARAMETERS + plant
+
+
+def _stamp(seconds: float) -> Time:
+    nanoseconds = int(round(seconds * 1e9))
+    return Time(sec=nanoseconds // 1_000_000_000, nanosec=nanoseconds % 1_000_000_000)
+
+
+class Setup:
+    """What the parameters decide: motor model, plant parameters, load; built and validated."""
+
+    def __init__(self, values: dict[str, Any]) -> None:
+        """
+        Build everything from the parameter values; raise ValueError naming the bad one.
+
+        Parameters
+        ----------
+        values : dict
+            Parameter name -> value, [-]
+
+        """
+        self.values = values
+        for name, allowed in (('clock_mode', ('wall', 'sim')),
+                              ('displacement_law', ('eq33', 'eq39')),
+                              ('load.kind', tuple(LOAD_KINDS))):
+            if values[name] not in allowed:
+                msg = f'{name} = {values[name]!r}: use one of {", ".join(allowed)}'
+                raise ValueError(msg)
+        if not values['joint_name']:
+            raise ValueError('joint_name is empty')
+        spec = load_motor(values['motor_file'] or None)
+        self.model = MotorModel.from_spec(spec, values['liquid'], None,
+                                          values['displacement_law'])
+        plant_names = {s.name for s in parameter_specs()}
+        self.params = params_from_flat({k: v for k, v in values.items() if k in plant_names})
+        kind = values['load.kind']
+        self.load = make_load(kind, **{f: values[f'load.{f}'] for f in _LOAD_FIELDS[kind]})
+
+
+class VirtualMotorNode(Node):
+    """
+    The virtual motor as a ROS node.
+
+    Parameters
+    ----------
+    node_name : str
+        Node name, [-]
+    **kwargs
+        Passed to :class:`rclpy.node.Node` (context, namespace, parameter_overrides, ...), [-]
+
+    """
+
+    def __init__(self, node_name: str = 'virtual_motor', **kwargs: Any) -> None:
+        """Declare parameters, build the plant, open topics and start stepping."""
+        super().__init__(node_name, **kwargs)
+        self._specs = {spec.name: spec for spec in all_parameters()}
+        for problem in params.declare(self, self._specs.values()).values():
+            self.get_logger().error(f'parameter {problem}')
+        self._setup = Setup(self._values())  # an inconsistent set-up raises here
+        self.plant = Plant(self._setup.model, self._setup.params, self._setup.load)
+        self.add_on_set_parameters_callback(self._validate)
+        self.add_post_set_parameters_callback(self._apply)
+        self._command = 0.0
+        self._load_torque: float | None = None
+        self.rejected = 0
+        self.last_rejection = ''
+        self._rejected_since_diagnostics = 0
+        sensor = qos_profile_sensor_data
+        self._pub = {name: self.create_publisher(FluidPressure, name, sensor)
+                     for name in ('inlet_pressure', 'outlet_pressure', 'case_pressure')}
+        self._flow_pub = self.create_publisher(Float64, 'flow_measured', sensor)
+        self._joint_pub = self.create_publisher(JointState, 'joint_states', sensor)
+        self._temp_pub = self.create_publisher(Temperature, 'fluid_temperature', sensor)
+        self._diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
+        self._clock_pub = self.create_publisher(ClockMsg, '/clock', QoSProfile(depth=10))
+        self.create_subscription(Float64, 'flow_command', self._on_command, 10)
+        self.create_subscription(Float64, 'load_torque', self._on_load, 10)
+        self._steady = Clock(clock_type=ClockType.STEADY_TIME)
+        self._timer = None
+        self._start_timer()
+
+    # -- parameters --------------------------------------------------------------------
+
+    def _values(self, changes: list[Parameter] | None = None) -> dict[str, Any]:
+        values = params.values(self, self._specs.values())
+        for p in changes or []:
+            values[p.name] = p.value
+        return values
+
+    def _validate(self, changes: list[Parameter]) -> SetParametersResult:
+        result = params.check(self._specs, changes)
+        if not result.successful:
+            self.get_logger().warning(f'parameter change refused: {result.reason}')
+            return result
+        try:
+            self._pending = Setup(self._values(changes))
+        except (ValueError, OSError) as err:  # PlantError, ModelError and ConfigError too
+            reason = str(err)
+            self.get_logger().warning(f'parameter change refused: {reason}')
+            return SetParametersResult(successful=False, reason=reason)
+        return SetParametersResult(successful=True)
+
+    def _apply(self, changes: list[Parameter]) -> None:
+        setup, old = self._pending, self._setup
+        model_changed = any(setup.values[k] != old.values[k]
+                            for k in ('liquid', 'motor_file', 'displacement_law'))
+        self.plant.reconfigure(setup.params, setup.model if model_changed else None)
+        self.plant.load = setup.load
+        self._setup = setup
+        if any(setup.values[k] != old.values[k]
+               for k in ('clock_mode', 'max_speedup', 'publish_rate', 'step')):
+            self._start_timer()
+
+    # -- inputs ------------------------------------------------------------------------
+
+    def _refuse(self, what: str) -> None:
+        self.rejected += 1
+        self._rejected_since_diagnostics += 1
+        self.last_rejection = what
+        self.get_logger().warning(f'{what}; holding {self._command!r} m^3/s',
+                                  throttle_duration_sec=1.0)
+
+    def _on_command(self, msg: Float64) -> None:
+        value = msg.data
+        problem = self.plant.check_command(value)
+        limit = self._setup.values['max_flow_command']
+        if problem is None and value > limit:
+            problem = f'flow command {value!r} m^3/s is above max_flow_command = {limit!r}'
+        if problem is not None:
+            self._refuse(problem)
+            return
+        self._command = value
+
+    def _on_load(self, msg: Float64) -> None:
+        value = msg.data
+        if not (math.isfinite(value) and abs(value) <= MAX_LOAD_TORQUE):
+            self._refuse(f'load torque {value!r} N*m is not finite or beyond '
+                         f'{MAX_LOAD_TORQUE} N*m')
+            return
+        self._load_torque = value
+
+    # -- stepping ----------------------------------------------------------------------
+
+    def _start_timer(self) -> None:
+        if self._timer is not None:
+            self.destroy_timer(self._timer)
+        values = self._setup.values
+        self._steps_per_publish = max(1, round(1.0 / (values['publish_rate']
+                                                      * self.plant.params.step)))
+        period = self._steps_per_publish * self.plant.params.step
+        self._sim = values['clock_mode'] == 'sim'
+        if self._sim:
+            speedup = values['max_speedup']
+            period = period / speedup if speedup > 0.0 else 0.0
+        self._wall_start = time.monotonic() - self.plant.state.time
+        self._next_diagnostics = self.plant.state.time
+        self._timer = self.create_timer(period, self._tick, clock=self._steady)
+        self._ticks_wall = (time.monotonic(), self.plant.state.time)
+
+    def _tick(self) -> None:
+        plant = self.plant
+        if self._sim:
+            steps = self._steps_per_publish
+        else:  # catch up with the wall clock, at most one second at a time
+            behind = (time.monotonic() - self._wall_start) - plant.state.time
+            steps = min(int(behind / plant.params.step), round(1.0 / plant.params.step))
+        command, load = self._command, self._load_torque
+        step = plant.step
+        for _ in range(steps):
+            step(command, load)
+        if self._sim:
+            self._clock_pub.publish(ClockMsg(clock=_stamp(plant.state.time)))
+        self._publish()
+
+    def _publish(self) -> None:
+        plant = self.plant
+        reading = plant.measure()
+        values = self._setup.values
+        stamp = (_stamp(reading.time) if self._sim else self.get_clock().now().to_msg())
+        frame = values['frame_id']
+        sensors = plant.params.sensors
+        for name, value in (('inlet_pressure', reading.inlet_pressure),
+                            ('outlet_pressure', reading.outlet_pressure),
+                            ('case_pressure', reading.case_pressure)):
+            msg = FluidPressure(fluid_pressure=value, variance=getattr(sensors, name).noise ** 2)
+            msg.header.stamp, msg.header.frame_id = stamp, frame
+            self._pub[name].publish(msg)
+        self._flow_pub.publish(Float64(data=reading.flow))
+        joint = JointState(name=[values['joint_name']], position=[reading.angle],
+                           velocity=[reading.speed], effort=[reading.torque])
+        joint.header.stamp, joint.header.frame_id = stamp, frame
+        self._joint_pub.publish(joint)
+        temp = Temperature(temperature=reading.temperature,
+                           variance=sensors.temperature.noise ** 2)
+        temp.header.stamp, temp.header.frame_id = stamp, frame
+        self._temp_pub.publish(temp)
+        if reading.time >= self._next_diagnostics:
+            self._next_diagnostics = reading.time + values['diagnostics_period']
+            self._diagnose(stamp)
+
+    def _diagnose(self, stamp: Time) -> None:
+        plant = self.plant
+        flows = plant.flows
+        now_wall, now_sim = time.monotonic(), plant.state.time
+        wall0, sim0 = self._ticks_wall
+        factor = (now_sim - sim0) / (now_wall - wall0) if now_wall > wall0 else 0.0
+        self._ticks_wall = (now_wall, now_sim)
+        level, message = 0, 'running'
+        if self._rejected_since_diagnostics:
+            level = 1
+            message = f'refused {self._rejected_since_diagnostics} input(s): ' \
+                      f'{self.last_rejection}'
+        elif flows.relief > 0.0:
+            level, message = 1, 'relief valve open'
+        if plant.invalid_points:
+            level = 2
+            message = f'model refused {plant.invalid_points} point(s): ' \
+                      f'{describe_status(plant.model_status)}'
+        self._rejected_since_diagnostics = 0
+        values = {
+            'sim_time [s]': now_sim, 'realtime_factor [-]': factor,
+            'flow_command [m^3/s]': self._command,
+            'load_torque [N*m]': 'profile' if self._load_torque is None else self._load_torque,
+            'rejected_inputs': self.rejected, 'last_rejection': self.last_rejection,
+            'relief_flow [m^3/s]': flows.relief,
+            'model_status': describe_status(plant.model_status),
+            'model_rebuilds': plant.rebuilds, 'liquid': plant.model.liquid.name,
+        }
+        status = diag.status(f'{self.get_fully_qualified_name()}: plant', plant.model.name,
+                             level, message, values)
+        self._diag_pub.publish(diag.array(RosTime.from_msg(stamp), [status]))
+
+
+def main(args: list[str] | None = None) -> None:
+    """
+    Run the node until shut down.
+
+    Parameters
+    ----------
+    args : list of str, optional
+        Command-line arguments (ROS arguments included), [-]
+
+    """
+    rclpy.init(args=args)
+    node = None
+    try:
+        node = VirtualMotorNode()
+        rclpy.spin(node)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    except (ValueError, OSError) as err:  # bad start-up parameters: one line, no traceback
+        print(f'virtual_motor: {err}')
+        raise SystemExit(1) from None
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
+
+
+__all__ = ['VirtualMotorNode', 'all_parameters', 'main']
+
+
+if __name__ == '__main__':
+    main()

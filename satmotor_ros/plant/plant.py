@@ -1,0 +1,485 @@
+# SPDX-License-Identifier: Apache-2.0
+"""
+The virtual motor: lines, relief valve, shaft and heat around the model's motor.
+
+State: inlet-line pressure p_in, outlet-line pressure p_out (both absolute),
+shaft speed omega and angle theta, liquid temperature T. Per step of dt:
+
+0. the pump delivers the flow command through a first-order lag;
+1. the motor model gives the absorbency Q_m(omega, dp) at the start of the step
+   (eqs. (34)-(36) of Śliwiński 2017, through the model's single-point path);
+2. a linearly implicit (backward Euler) step solves the line pressures (P1),
+   the relief valve (P2), the return valve (P3) and the shaft (P4), (P5)
+   together, with Q_m linearised as
+   ``Q_m' = Q_m + q_t (omega' - omega) + G (dp' - dp)``, G >= 0 the secant
+   leakage conductance. Stiff terms (line compliance against valves and
+   displacement) are implicit, so the step is stable for water and small
+   volumes at any dt; at a steady state the linearisation is exact, so the
+   plant settles on the model's eqs. (36)/(40);
+3. dry friction sticks and slips (Karnopp): a resting shaft stays at rest
+   while the net torque is within the static limit;
+4. the temperature follows the lost power (P8), explicitly.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numpy as np
+
+from satmotor_ros.model import MotorModel
+from satmotor_ros.plant.equations import case_pressure, friction_torque, viscosity_at
+from satmotor_ros.plant.errors import PlantError
+from satmotor_ros.plant.load import ConstantLoad, LoadProfile
+from satmotor_ros.plant.motor import mirrored_point, MotorCache
+from satmotor_ros.plant.params import PlantParams
+from satmotor_ros.plant.sensors import Sensor
+
+_DP_REF = 0.1e6
+"""Pressure drop below which the leakage conductance is taken as secant to this value, [Pa]."""
+
+MAX_FLOW_COMMAND = 1.0e-2
+"""Largest flow command the plant accepts (600 l/min), [m^3/s]."""
+
+
+class PlantState(NamedTuple):
+    """The plant's state (SI, absolute pressures)."""
+
+    time: float  # [s]
+    inlet_pressure: float  # p_in [Pa]
+    outlet_pressure: float  # p_out [Pa]
+    speed: float  # omega [rad/s]
+    angle: float  # theta [rad]
+    temperature: float  # T [degC]
+
+
+class StepFlows(NamedTuple):
+    """The flows of the last step, as the integrator balanced them, [m^3/s]."""
+
+    command: float  # from the pump into the inlet line (the command after the pump's lag)
+    motor: float  # into the motor's inlet port (model absorbency, linearised)
+    relief: float  # relief valve, inlet line to tank
+    leakage: float  # external-leakage effect, inlet line to tank
+    model_external: float  # the model's own external leakage Q_ex (eq. 24)
+    returned: float  # return valve, outlet line to tank
+    cavitation_in: float  # make-up that held p_in at the vapour pressure
+    cavitation_out: float  # make-up that held p_out at the vapour pressure
+
+
+class Measurement(NamedTuple):
+    """What the sensors read (SI, absolute pressures, degC)."""
+
+    time: float  # [s]
+    inlet_pressure: float  # [Pa]
+    outlet_pressure: float  # [Pa]
+    case_pressure: float  # [Pa]
+    flow: float  # flow into the motor [m^3/s]
+    speed: float  # [rad/s]
+    angle: float  # [rad]
+    torque: float  # shaft torque delivered to the load [N*m]
+    temperature: float  # [degC]
+
+
+class Plant:
+    """
+    The virtual SM-0,75/25 on its test rig, stepped at a fixed dt.
+
+    Parameters
+    ----------
+    model : MotorModel
+        The motor and liquid; the only source of the volumetric losses, [-]
+    params : PlantParams, optional
+        Lines, valves, shaft, heat, effects and sensors, [-]
+    load : LoadProfile, optional
+        Load torque law; no load when omitted. A passive load (the default,
+        ``params.active_load`` False) brakes: its torque opposes the motion and
+        holds a resting shaft like dry friction. An active load drives the
+        shaft backwards when the pressure cannot hold it, [-]
+
+    Examples
+    --------
+    >>> from satmotor_ros.model import MotorModel
+    >>> plant = Plant(MotorModel.default('oil'))
+    >>> plant.run(100, 20e-3 / 60.0)
+    >>> plant.state.speed > 0.0
+    True
+
+    """
+
+    def __init__(self, model: MotorModel, params: PlantParams | None = None,
+                 load: LoadProfile | None = None) -> None:
+        """Fold the parameters into the constants of the step."""
+        self.params = params if params is not None else PlantParams()
+        self.load = load if load is not None else ConstantLoad()
+        self._motor = MotorCache(model, self.params.rebuild_tolerance)
+        self._point = model.absorbency_point
+        self._set_constants()
+        self.reset()
+
+    def _set_constants(self) -> None:
+        p = self.params
+        model = self._motor.model
+        dt = self._dt = p.step
+        k = model.liquid.bulk_modulus
+        lines, relief, shaft, case, fx = p.lines, p.relief, p.shaft, p.case, p.effects
+        self._qt = model.geometry.displacement
+        self._a = lines.inlet_volume / (k * dt)
+        self._c = lines.outlet_volume / (k * dt)
+        self._m = shaft.inertia / dt
+        self._b = shaft.viscous_friction
+        self._tc = shaft.coulomb_friction
+        self._cp = shaft.pressure_friction
+        self._locked = shaft.locked
+        self._active_load = p.active_load
+        self._pt = lines.tank_pressure
+        self._pv = lines.vapour_pressure
+        self._gr = lines.return_conductance
+        self._pr0 = lines.tank_pressure + lines.back_pressure
+        self._kv = relief.conductance
+        self._pcr = lines.tank_pressure + relief.cracking_pressure
+        share = case.outlet_share if fx.leakage_driver == 'case' else 1.0
+        offset = case.offset if fx.leakage_driver == 'case' else 0.0
+        # external-leakage effect, k_x * driver gauge pressure = e1 * p_out + e0
+        self._e1 = fx.external_leakage * share
+        self._e0 = fx.external_leakage * (offset - share * lines.tank_pressure)
+        th = p.thermal
+        self._heat = (th.heat_capacity, th.cooling, th.ambient)
+        self._nu_ref = model.liquid.kinematic_viscosity
+        self._drifts = fx.viscosity_temperature > 0.0 or fx.clearance_wear > 0.0
+        self._lag = dt / (p.pump_lag + dt)
+        self._solve_constants = (self._qt, self._a, self._c, self._e0, self._e1, self._gr,
+                                 self._pr0, self._kv, self._pcr)
+
+    def reset(self, inlet_pressure: float | None = None, outlet_pressure: float | None = None,
+              speed: float = 0.0, temperature: float | None = None) -> None:
+        """
+        Put the plant at rest (or at a given state) at t = 0, sensors reseeded.
+
+        Parameters
+        ----------
+        inlet_pressure : float, optional
+            p_in, absolute; the return back pressure when omitted, [Pa]
+        outlet_pressure : float, optional
+            p_out, absolute; the return back pressure when omitted, [Pa]
+        speed : float
+            omega, [rad/s]
+        temperature : float, optional
+            T; the thermal parameters' initial value when omitted, [degC]
+
+        """
+        self._n = 0
+        self._t = 0.0
+        self._q_pump = 0.0  # flow the pump delivers [m^3/s]
+        self._p_in = self._pr0 if inlet_pressure is None else float(inlet_pressure)
+        self._p_out = self._pr0 if outlet_pressure is None else float(outlet_pressure)
+        self._w = 0.0 if self._locked else float(speed)
+        self._theta = 0.0
+        self._temp = self.params.thermal.initial if temperature is None else float(temperature)
+        self._revolutions = 0.0
+        self._q_guess: float | None = None
+        self._lin = (0.0, 0.0, 0.0, 0.0)  # last good (G, h, channel drop, model Q_ex)
+        self._last = (0.0, self._p_in, self._p_out, False)  # q_cmd, P, R, relief open
+        self._torque = 0.0
+        self._dp_i = 0.0
+        self.model_status = 0  # PointStatus flags of the last model evaluation
+        self.invalid_points = 0  # steps that fell back on the last good linearisation
+        self._make_sensors()
+
+    def reconfigure(self, params: PlantParams, model: MotorModel | None = None) -> None:
+        """
+        Change parameters (and optionally the motor) and keep the state.
+
+        Parameters
+        ----------
+        params : PlantParams
+            New parameters, [-]
+        model : MotorModel, optional
+            A new motor or liquid; the drifting effects restart from it, [-]
+
+        """
+        self.params = params
+        if model is not None or params.rebuild_tolerance != self._motor.tolerance:
+            self._motor = MotorCache(model or self._motor.base, params.rebuild_tolerance)
+            self._point = self._motor.model.absorbency_point
+            self._q_guess = None
+        self._set_constants()
+        if self._locked:
+            self._w = 0.0
+        self._make_sensors()
+
+    def _make_sensors(self) -> None:
+        p = self.params
+        rng = np.random.default_rng(p.seed)
+        s, fx = p.sensors, p.effects
+        self._sensors = (
+            Sensor(s.inlet_pressure, rng), Sensor(s.outlet_pressure, rng),
+            Sensor(s.case_pressure, rng),
+            Sensor(s.flow, rng, fx.flow_sensor_gain, fx.flow_sensor_offset),
+            Sensor(s.speed, rng, fx.speed_sensor_gain), Sensor(s.temperature, rng))
+
+    @property
+    def model(self) -> MotorModel:
+        """Motor model in use now (rebuilt by the drifting effects)."""
+        return self._motor.model
+
+    @property
+    def rebuilds(self) -> int:
+        """How many times the drifting effects rebuilt the motor model."""
+        return self._motor.rebuilds
+
+    @property
+    def state(self) -> PlantState:
+        """State after the last step."""
+        return PlantState(self._t, self._p_in, self._p_out, self._w, self._theta, self._temp)
+
+    def step(self, flow_command: float, load_torque: float | None = None) -> None:
+        """
+        Advance the plant by one step dt.
+
+        Parameters
+        ----------
+        flow_command : float
+            Flow from the pump into the inlet line, 0..MAX_FLOW_COMMAND, [m^3/s]
+        load_torque : float, optional
+            Load torque for this step instead of the load profile, [N*m]
+
+        Raises
+        ------
+        PlantError
+            If the command is not finite or outside 0..MAX_FLOW_COMMAND (the state is unchanged).
+
+        """
+        if not 0.0 <= flow_command <= MAX_FLOW_COMMAND:
+            msg = f'flow_command = {flow_command!r} m^3/s: outside [0, {MAX_FLOW_COMMAND}]'
+            raise PlantError(msg)
+        if load_torque is None:
+            tl0, tls = self.load.at(self._t)
+        elif load_torque - load_torque == 0.0:  # finite
+            tl0, tls = load_torque, 0.0
+        else:
+            msg = f'load_torque = {load_torque!r} N*m: not finite'
+            raise PlantError(msg)
+        tc = self._tc
+        if not self._active_load:  # a brake: |t0| adds to the dry friction
+            tc, tl0 = tc + abs(tl0), 0.0
+        # the pump follows the command with a first-order lag (implicit: any lag >= 0)
+        flow_command = self._q_pump = self._q_pump + self._lag * (flow_command - self._q_pump)
+        w = self._w
+        dp = self._p_in - self._p_out
+        qt = self._qt
+
+        # 1. the motor at the start of the step, linearised as Q_m' = q_t w' + G dp' + h
+        if w >= 0.0 and dp >= 0.0:
+            pt = self._point(w, dp, flow_guess=self._q_guess)
+            q, dp_i, q_id, qx, self.model_status = pt[0], pt[3], pt[9], pt[10], pt[12]
+        else:
+            q, dp_i, qx, q_id, self.model_status = mirrored_point(self._motor.model, w, dp,
+                                                                  self._q_guess)
+        if q == q:
+            self._q_guess = q
+            qtw = qt * w
+            g = abs(q - qtw - (q_id if w >= 0.0 else -q_id)) / max(abs(dp), _DP_REF)
+            lin = self._lin = (g, q - qtw - g * dp, dp - dp_i, qx)
+        else:  # NaN: the model refused the point; keep the last good linearisation
+            self.invalid_points += 1
+            lin = self._lin
+        dich = lin[2]
+
+        # 2. the implicit step: sliding, sticking or breaking away (Karnopp)
+        relief = self._p_in > self._pcr
+        if w == 0.0:
+            p, r, relief = self._solve(flow_command, lin, 0.0, 0.0, relief)
+            w_new = 0.0
+            sign = 0.0 if self._locked else self._breakaway(p - r - dich, tl0, tc)
+        else:
+            sign = 1.0 if w > 0.0 else -1.0
+        if sign != 0.0:
+            kt = qt * (1.0 - self._cp * sign * (1.0 if dp >= dich else -1.0))
+            m = self._m
+            den = m + self._b + tls
+            w0 = (m * w - kt * dich - sign * tc - tl0) / den
+            wk = kt / den
+            p, r, relief = self._solve(flow_command, lin, w0, wk, relief)
+            w_new = w0 + wk * (p - r)
+            if w_new * sign < 0.0:  # friction stops the shaft within the step
+                p, r, relief = self._solve(flow_command, lin, 0.0, 0.0, relief)
+                w_new = 0.0
+
+        # 3. cavitation floor, torque, heat, angle, time
+        self._last = (flow_command, p, r, relief)  # as solved: the flows balance with these
+        pv = self._pv
+        if p < pv:
+            p = pv
+        if r < pv:
+            r = pv
+        dt = self._dt
+        dp_i = self._dp_i = p - r - dich
+        torque = 0.0
+        if w_new != 0.0:
+            torque = qt * dp_i - friction_torque(w_new, dp_i, qt, self._b, self._tc, self._cp)
+        self._torque = torque
+        heat_capacity, cooling, ambient = self._heat
+        temp = self._temp
+        loss_power = flow_command * (p - self._pt) - w_new * torque
+        self._temp = temp + dt * (loss_power - cooling * (temp - ambient)) / heat_capacity
+        self._p_in, self._p_out, self._w = p, r, w_new
+        self._theta += w_new * dt
+        n = self._n = self._n + 1
+        self._t = n * dt
+        if self._drifts:
+            self._revolutions += abs(w_new) * dt / (2.0 * math.pi)
+            self._drift()
+
+    def _breakaway(self, dp_i: float, load: float, dry: float) -> float:
+        """Return 0 while static friction holds the shaft, else the direction it breaks away."""
+        drive = self._qt * dp_i - load
+        if abs(drive) <= dry + self._cp * self._qt * abs(dp_i):
+            return 0.0
+        return 1.0 if drive > 0.0 else -1.0
+
+    def _solve(self, q_cmd: float, lin: tuple[float, float, float, float], w0: float,
+               wk: float, relief: bool) -> tuple[float, float, bool]:
+        """
+        Solve the implicit line pressures with omega' = w0 + wk (P - R).
+
+        Inlet:  a (P - p_in)  = Q_cmd - Q_m' - Q_rv(P) - Q_x(R)        (P1), (P2)
+        Outlet: c (R - p_out) = Q_m' - Q_ex - Q_r(R)                    (P1), (P3)
+        with Q_m' = q_t omega' + G (P - R) + h. The relief valve is tried in
+        its last state and switched once if the solution contradicts it.
+        """
+        g, h, _, qx = lin
+        qt, a, c, e0, e1, gr, pr0, kv, pcr = self._solve_constants
+        qwk = qt * wk
+        qw0 = qt * w0
+        a11 = a + g + qwk
+        a12 = e1 - g - qwk
+        a21 = -g - qwk
+        a22 = c + g + gr + qwk
+        b1 = a * self._p_in + q_cmd - h - e0 - qw0
+        b2 = c * self._p_out + h - qx + gr * pr0 + qw0
+        p = r = 0.0
+        for _ in range(3):
+            if relief:
+                c11, d1 = a11 + kv, b1 + kv * pcr
+            else:
+                c11, d1 = a11, b1
+            det = c11 * a22 - a12 * a21
+            p = (d1 * a22 - a12 * b2) / det
+            r = (c11 * b2 - a21 * d1) / det
+            if (p > pcr) == relief:
+                break
+            relief = not relief
+        return p, r, relief
+
+    def _drift(self) -> None:
+        fx = self.params.effects
+        nu = viscosity_at(self._temp, self._nu_ref, self.params.thermal.reference,
+                          fx.viscosity_temperature)
+        if self._motor.update(nu, fx.clearance_wear * self._revolutions):
+            self._q_guess = None
+            self._point = self._motor.model.absorbency_point
+
+    def run(self, steps: int, flow_command: float, load_torque: float | None = None) -> None:
+        """
+        Advance by `steps` steps at a constant command.
+
+        Parameters
+        ----------
+        steps : int
+            Number of steps, [-]
+        flow_command : float
+            Flow from the pump, [m^3/s]
+        load_torque : float, optional
+            Load torque instead of the load profile, [N*m]
+
+        """
+        step = self.step
+        for _ in range(steps):
+            step(flow_command, load_torque)
+
+    @property
+    def flows(self) -> StepFlows:
+        """Flows the last step balanced (constant over the step)."""
+        q_cmd, p, r, relief = self._last
+        g, h, _, qx = self._lin
+        # a line solved below the vapour pressure was held there by make-up flow
+        cav_in = max(self._pv - p, 0.0) * self._a
+        cav_out = max(self._pv - r, 0.0) * self._c
+        motor = self._qt * self._w + g * (p - r) + h
+        return StepFlows(
+            command=q_cmd, motor=motor,
+            relief=self._kv * (p - self._pcr) if relief else 0.0,
+            leakage=self._e1 * r + self._e0, model_external=qx,
+            returned=self._gr * (r - self._pr0),
+            cavitation_in=cav_in, cavitation_out=cav_out)
+
+    @property
+    def chamber_pressure_drop(self) -> float:
+        """Pressure drop in the working chambers dp_i after the last step, [Pa]."""
+        return self._dp_i
+
+    @property
+    def shaft_torque(self) -> float:
+        """Torque the shaft delivers to the load, after friction, [N*m]."""
+        return self._torque
+
+    def case_pressure(self) -> float:
+        """
+        Compute the case pressure now, eq. (P6).
+
+        Returns
+        -------
+        float
+            Case pressure, absolute, [Pa]
+
+        """
+        case = self.params.case
+        return case_pressure(self._p_out, self._pt, case.offset, case.outlet_share)
+
+    def measure(self) -> Measurement:
+        """
+        Read every sensor at the current time.
+
+        Returns
+        -------
+        Measurement
+            The readings, with the sensor and effect errors applied.
+
+        """
+        t = self._t
+        s_in, s_out, s_case, s_flow, s_speed, s_temp = self._sensors
+        flows = self.flows
+        return Measurement(
+            time=t, inlet_pressure=s_in.read(t, self._p_in),
+            outlet_pressure=s_out.read(t, self._p_out),
+            case_pressure=s_case.read(t, self.case_pressure()),
+            flow=s_flow.read(t, flows.motor + flows.leakage), speed=s_speed.read(t, self._w),
+            angle=self._theta, torque=self._torque, temperature=s_temp.read(t, self._temp))
+
+    def check_command(self, flow_command: float) -> str | None:
+        """
+        Say what is wrong with a flow command, if anything.
+
+        Parameters
+        ----------
+        flow_command : float
+            A candidate command, [m^3/s]
+
+        Returns
+        -------
+        str or None
+            The reason it would be refused, or None when it is acceptable.
+
+        """
+        if not isinstance(flow_command, (int, float)) or not math.isfinite(flow_command):
+            return f'flow command {flow_command!r} is not a finite number'
+        if flow_command < 0.0:
+            return f'flow command {flow_command!r} m^3/s is negative'
+        if flow_command > MAX_FLOW_COMMAND:
+            return f'flow command {flow_command!r} m^3/s is above {MAX_FLOW_COMMAND} m^3/s'
+        return None
+
+
+__all__ = ['MAX_FLOW_COMMAND', 'Measurement', 'Plant', 'PlantError', 'PlantState',
+           'StepFlows']

@@ -1,0 +1,174 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The virtual_motor node in-process: real topics, parameters refused with a reason, bad input."""
+
+import math
+import os
+import time
+
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+import pytest
+import rclpy
+from rclpy.context import Context
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.parameter import Parameter
+from rclpy.qos import qos_profile_sensor_data
+from rosgraph_msgs.msg import Clock
+from satmotor_ros.model import MotorModel
+from satmotor_ros.model.units import LPM, MPA
+from satmotor_ros.nodes.virtual_motor import all_parameters, VirtualMotorNode
+from sensor_msgs.msg import FluidPressure, JointState, Temperature
+from std_msgs.msg import Float64
+
+NAMESPACE = f'/vm_node_test_{os.getpid()}'
+
+
+@pytest.fixture()
+def ros():
+    """Give a fresh context, an executor on it, and a probe node; shut all down after."""
+    context = Context()
+    context.init()
+    executor = SingleThreadedExecutor(context=context)
+    probe = rclpy.create_node('probe', namespace=NAMESPACE, context=context)
+    executor.add_node(probe)
+    try:
+        yield context, executor, probe
+    finally:
+        executor.shutdown()
+        probe.destroy_node()
+        context.try_shutdown()
+
+
+def _motor(context, executor, **overrides):
+    params = [Parameter(k, value=v) for k, v in {'clock_mode': 'sim', **overrides}.items()]
+    node = VirtualMotorNode(context=context, namespace=NAMESPACE, parameter_overrides=params)
+    executor.add_node(node)
+    return node
+
+
+def _spin_until(executor, done, timeout=10.0):
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline and not done():
+        executor.spin_once(timeout_sec=0.01)
+    return done()
+
+
+def _collect(probe, kind, topic, qos=qos_profile_sensor_data):
+    got = []
+    probe.create_subscription(kind, topic, got.append, qos)
+    return got
+
+
+def test_commanded_flow_turns_the_shaft_at_the_models_speed(ros):
+    """Pressures, flow, speed and temperature come out; the speed settles on eq. (40)."""
+    context, executor, probe = ros
+    node = _motor(context, executor, **{'load.torque': 40.0, 'liquid': 'water'})
+    command = probe.create_publisher(Float64, 'flow_command', 10)
+    joints = _collect(probe, JointState, 'joint_states')
+    inlet = _collect(probe, FluidPressure, 'inlet_pressure')
+    outlet = _collect(probe, FluidPressure, 'outlet_pressure')
+    case = _collect(probe, FluidPressure, 'case_pressure')
+    flow = _collect(probe, Float64, 'flow_measured')
+    temperature = _collect(probe, Temperature, 'fluid_temperature')
+    clock = _collect(probe, Clock, '/clock', 10)
+
+    def settled():
+        command.publish(Float64(data=15.0 * LPM))
+        return node.plant.state.time > 3.0 and len(joints) > 10 and len(outlet) > 10
+    assert _spin_until(executor, settled)
+    assert all(len(x) > 10 for x in (inlet, case, flow, temperature, clock))
+    speed = joints[-1].velocity[0]
+    assert joints[-1].name == ['motor_shaft']
+    dp = inlet[-1].fluid_pressure - outlet[-1].fluid_pressure
+    expected = float(MotorModel.default('water').speed(15.0 * LPM, dp).speed)
+    assert speed == pytest.approx(expected, rel=1e-3)
+    assert 1.0 * MPA < dp < 27.0 * MPA
+    assert flow[-1].data == pytest.approx(15.0 * LPM, rel=1e-3)
+    assert case[-1].fluid_pressure > 101325.0
+    stamps = [c.clock.sec + 1e-9 * c.clock.nanosec for c in clock]
+    assert stamps == sorted(stamps) and stamps[-1] > 2.5
+
+
+def test_bad_commands_are_refused_held_and_reported(ros):
+    """NaN, negative and absurd flows: the node keeps the last good command and says so."""
+    context, executor, probe = ros
+    node = _motor(context, executor, diagnostics_period=0.05)
+    command = probe.create_publisher(Float64, 'flow_command', 10)
+    load = probe.create_publisher(Float64, 'load_torque', 10)
+    diagnostics = _collect(probe, DiagnosticArray, '/diagnostics', 10)
+    assert _spin_until(executor, lambda: (command.publish(Float64(data=10.0 * LPM)),
+                                          node.plant.state.time > 0.5)[1])
+    for bad in (math.nan, -1.0, 1.0, math.inf):
+        command.publish(Float64(data=bad))
+    assert _spin_until(executor, lambda: node.rejected >= 4)
+    load.publish(Float64(data=math.nan))
+    assert _spin_until(executor, lambda: node.rejected >= 5)
+    assert 'load torque nan' in node.last_rejection
+    assert _spin_until(executor, lambda: any(
+        s.level == DiagnosticStatus.WARN and 'refused' in s.message
+        for d in diagnostics for s in d.status))
+    assert node._command == pytest.approx(10.0 * LPM)
+    before = node.plant.state.time
+    assert _spin_until(executor, lambda: node.plant.state.time > before + 0.5)
+    assert node.plant.state.speed > 0.0
+
+
+def test_parameters_are_refused_with_a_reason_and_the_old_value_kept(ros):
+    """Out of range, unknown liquid, bad enum: refused with a reason; a good change applies."""
+    context, executor, _ = ros
+    node = _motor(context, executor)
+    cases = [('shaft.inertia', -1.0, 'shaft.inertia'), ('liquid', 'honey', 'honey'),
+             ('effects.leakage_driver', 'nowhere', 'leakage_driver'),
+             ('load.kind', 'wind', 'load.kind'), ('clock_mode', 'lunar', 'clock_mode')]
+    for name, value, reason in cases:
+        before = node.get_parameter(name).value
+        (result,) = node.set_parameters([Parameter(name, value=value)])
+        assert not result.successful and reason in result.reason, result.reason
+        assert node.get_parameter(name).value == before
+    result = node.set_parameters_atomically([
+        Parameter('liquid', value='water'), Parameter('effects.flow_sensor_offset', value=1e-5)])
+    assert result.successful
+    assert node.plant.model.liquid.name == 'tap water'
+    assert node.plant.params.effects.flow_sensor_offset == 1e-5
+
+
+def test_every_parameter_has_a_unit_and_numbers_a_range(ros):
+    """Descriptors carry '[unit]' and a range for every float parameter."""
+    context, executor, _ = ros
+    node = _motor(context, executor)
+    for spec in all_parameters():
+        (desc,) = node.describe_parameters([spec.name])
+        assert desc.description.endswith(']'), spec.name
+        if isinstance(spec.default, float):
+            assert desc.floating_point_range, spec.name
+
+
+def _flatten(tree, prefix=''):
+    for key, value in tree.items():
+        if isinstance(value, dict):
+            yield from _flatten(value, f'{prefix}{key}.')
+        else:
+            yield f'{prefix}{key}', value
+
+
+def test_shipped_parameter_file_lists_every_parameter_at_its_default():
+    """config/virtual_motor.yaml cannot drift from the declared parameters."""
+    from pathlib import Path
+
+    import yaml
+    path = Path(__file__).resolve().parent.parent / 'config' / 'virtual_motor.yaml'
+    doc = yaml.safe_load(path.read_text())
+    flat = dict(_flatten(doc['/**/virtual_motor']['ros__parameters']))
+    assert flat == {spec.name: spec.default for spec in all_parameters()}
+
+
+def test_wall_clock_mode_keeps_pace_with_the_wall_clock(ros):
+    """clock_mode 'wall': simulated time follows the wall clock; no /clock is published."""
+    context, executor, probe = ros
+    node = VirtualMotorNode(context=context, namespace=NAMESPACE)
+    executor.add_node(node)
+    clock = _collect(probe, Clock, '/clock', qos_profile_sensor_data)
+    start = time.monotonic()
+    _spin_until(executor, lambda: time.monotonic() - start > 1.5, timeout=3.0)
+    elapsed = time.monotonic() - start
+    assert node.plant.state.time == pytest.approx(elapsed, abs=0.3)
+    assert not clock

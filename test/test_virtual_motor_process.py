@@ -1,0 +1,127 @@
+# SPDX-License-Identifier: Apache-2.0
+"""
+The installed ``virtual_motor`` in a process of its own, found and started as ``ros2 run`` would.
+
+The package is built with colcon (the fixtures of test_package_build.py), the executable
+looked up through the ament index, and the test talks to it over real DDS: commands in,
+pressures, speed and /clock out, bad commands survived, clean exit on SIGINT.
+"""
+
+import math
+import os
+import signal
+import subprocess
+import time
+
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+import pytest
+import rclpy
+from rclpy.context import Context
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.qos import qos_profile_sensor_data
+from rosgraph_msgs.msg import Clock
+from satmotor_ros.model.units import LPM, MPA
+from sensor_msgs.msg import FluidPressure, JointState
+from std_msgs.msg import Float64
+import test_package_build as build
+
+colcon_build = build.colcon_build  # the module-scoped build, as a fixture of this module
+sourced_install = build.sourced_install
+_executable_path = build._executable_path
+PACKAGE = build.PACKAGE
+
+NAMESPACE = f'/vm_process_test_{os.getpid()}'
+
+
+def _start(sourced_install, tmp_path, name, *ros_args):
+    executable = _executable_path(PACKAGE, name)
+    assert executable is not None, f'{name} is not installed'
+    return subprocess.Popen(
+        [str(executable), '--ros-args', '-r', f'__ns:={NAMESPACE}', *ros_args],
+        cwd=tmp_path, env=sourced_install, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+        text=True)
+
+
+def _stop(process):
+    if process.poll() is None:
+        process.send_signal(signal.SIGINT)
+        try:
+            process.wait(timeout=10.0)
+        except subprocess.TimeoutExpired:
+            process.kill()
+            process.wait()
+    return process.returncode, process.stdout.read()
+
+
+@pytest.fixture()
+def probe():
+    """Give a context, executor and probe node in the test's namespace; shut down after."""
+    context = Context()
+    context.init()
+    executor = SingleThreadedExecutor(context=context)
+    node = rclpy.create_node('probe', namespace=NAMESPACE, context=context)
+    executor.add_node(node)
+    try:
+        yield executor, node
+    finally:
+        executor.shutdown()
+        node.destroy_node()
+        context.try_shutdown()
+
+
+def _spin_until(executor, done, timeout=20.0):
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline and not done():
+        executor.spin_once(timeout_sec=0.02)
+    return done()
+
+
+def test_installed_virtual_motor_runs_on_sim_time_and_survives_bad_commands(
+        sourced_install, tmp_path, probe):
+    """Command in, pressures and speed out, /clock advancing; NaN and -1 refused; SIGINT: 0."""
+    executor, node = probe
+    clock, joints, inlet, diagnostics = [], [], [], []
+    node.create_subscription(Clock, '/clock', clock.append, qos_profile_sensor_data)
+    node.create_subscription(JointState, 'joint_states', joints.append, qos_profile_sensor_data)
+    node.create_subscription(FluidPressure, 'inlet_pressure', inlet.append,
+                             qos_profile_sensor_data)
+    node.create_subscription(DiagnosticArray, '/diagnostics', diagnostics.append, 10)
+    command = node.create_publisher(Float64, 'flow_command', 10)
+    process = _start(sourced_install, tmp_path, 'virtual_motor', '-p', 'clock_mode:=sim',
+                     '-p', 'max_speedup:=5.0', '-p', 'load.torque:=30.0',
+                     '-p', 'diagnostics_period:=0.2')
+    try:
+        def turning():
+            command.publish(Float64(data=10.0 * LPM))
+            return bool(joints) and joints[-1].velocity[0] > 10.0
+        assert _spin_until(executor, turning), 'no speed on joint_states'
+        assert _spin_until(executor, lambda: inlet[-1].fluid_pressure > 1.0 * MPA)
+        assert _spin_until(executor, lambda: len(clock) > 5)
+        sim_time = [c.clock.sec + 1e-9 * c.clock.nanosec for c in clock]
+        assert sim_time == sorted(sim_time)
+        assert _spin_until(executor, lambda: (command.publish(Float64(data=10.0 * LPM)),
+                                              clock[-1].clock.sec >= 3)[1])  # settled
+
+        for bad in (math.nan, -1.0):
+            command.publish(Float64(data=bad))
+        assert _spin_until(executor, lambda: any(
+            s.level == DiagnosticStatus.WARN and 'refused' in s.message
+            for d in diagnostics for s in d.status)), 'bad commands not reported'
+        speed = joints[-1].velocity[0]
+        count = len(clock)
+        assert _spin_until(executor, lambda: len(clock) > count + 20)
+        assert process.poll() is None, 'the node died on a bad command'
+        assert joints[-1].velocity[0] == pytest.approx(speed, rel=0.05)  # command held
+    finally:
+        code, output = _stop(process)
+    assert code == 0, output
+    assert 'not a finite number' in output
+
+
+def test_installed_virtual_motor_refuses_bad_start_parameters_in_one_line(
+        sourced_install, tmp_path):
+    """An unknown liquid at start-up: exit 1 and one line naming the value."""
+    process = _start(sourced_install, tmp_path, 'virtual_motor', '-p', 'liquid:=honey')
+    code, output = process.wait(timeout=30.0), process.stdout.read()
+    assert code == 1, output
+    assert "'honey'" in output and 'Traceback' not in output
