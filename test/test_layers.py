@@ -11,7 +11,8 @@ import pytest
 from satmotor_ros.model import losses, speed
 
 
-@pytest.mark.parametrize('module', ['satmotor_ros.model', 'satmotor_ros.cli'])
+@pytest.mark.parametrize('module', ['satmotor_ros.model', 'satmotor_ros.cli',
+                                    'satmotor_ros.identify'])
 def test_layer_imports_without_rclpy(module):
     code = f'import sys, {module}; assert "rclpy" not in sys.modules, "rclpy imported"'
     subprocess.run([sys.executable, '-c', code], check=True)
