@@ -99,3 +99,11 @@ def test_steady_extraction_without_steady_window_is_a_clear_error():
     raw = generate_series(plan, Injection(), seed=1, samples=400, rate=100.0, hold_s=0.3)
     with pytest.raises(DataError, match='no steady window'):
         extract_steady(raw)
+
+
+def test_table_accepts_semicolons_decimal_commas_and_unit_case(tmp_path):
+    text = 'Speed [RPM];Flow [L/min];p_in [MPa];p_out [mbar]\n600;20,5;10;5000\n'
+    table = read_csv(_write(tmp_path, text))
+    assert table.speed[0] == pytest.approx(600 * RPM)
+    assert table.flow[0] == pytest.approx(20.5 * LPM)
+    assert table.p_out[0] == pytest.approx(5e5)

@@ -30,7 +30,7 @@ from satmotor_ros.identify.errors import IdentificationError
 from satmotor_ros.identify.parts import LossParts, NO_EFFECT, predict_flow, SCALES
 from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.units import LPM, MPA, RPM
-from scipy import optimize, stats
+from scipy import optimize, special
 
 MIN_POINTS = 8
 """Fewest points for 3 coefficients, one effect and a residual estimate."""
@@ -245,7 +245,7 @@ class LossFit:
             raise IdentificationError(msg)
         s2 = self.rss_ / LPM ** 2 / dof
         cov = s2 * np.linalg.inv(jac.T @ jac)
-        half = stats.t.ppf(0.975, dof) * np.sqrt(np.maximum(np.diag(cov), 0.0))
+        half = special.stdtrit(dof, 0.975) * np.sqrt(np.maximum(np.diag(cov), 0.0))
         unit = np.ones(self.n_params)
         if self.candidate is not None:
             unit[3] = self.candidate.typical

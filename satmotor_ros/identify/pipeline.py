@@ -19,7 +19,8 @@ from satmotor_ros.identify.errors import DataError, IdentificationError
 from satmotor_ros.identify.fit import check_identifiable, FitReport
 from satmotor_ros.identify.parts import loss_parts, LossParts, predict_flow
 from satmotor_ros.identify.selection import CrossValidatedSelector, Errors, Selection
-from satmotor_ros.identify.steady import extract_steady, revolutions, SteadyTolerance
+from satmotor_ros.identify.steady import (extract_steady, looks_like_series, revolutions,
+                                          SteadyTolerance)
 from satmotor_ros.identify.table import BenchTable
 from satmotor_ros.identify.viscosity import standard_law, ViscosityLaw
 from satmotor_ros.model import load_motor, MotorModel, MotorSpec
@@ -107,9 +108,10 @@ def steady_points(table: BenchTable, mode: Mode = 'auto',
     """
     Turn a table into steady operating points.
 
-    In ``'auto'`` mode a table with a time column is tried as a time series:
-    if steady windows cover at least 30 % of the rows and average at least
-    3 rows each, their means are the points; otherwise each row is a point.
+    In ``'auto'`` mode a table is a time series when it has a time column and
+    successive rows differ by far less than the operating range
+    (:func:`~satmotor_ros.identify.steady.looks_like_series`); its steady
+    windows then become the points. Otherwise each row is a point.
 
     Parameters
     ----------
@@ -129,15 +131,9 @@ def steady_points(table: BenchTable, mode: Mode = 'auto',
     if mode not in ('auto', 'points', 'series'):
         msg = f"mode = {mode!r}: use 'auto', 'points' or 'series'"
         raise DataError(msg)
-    if mode == 'series' or table.time_series:
+    if mode == 'series' or (mode == 'auto' and (table.time_series
+                                                 or looks_like_series(table))):
         return extract_steady(table, tol)
-    if mode == 'auto' and 'time' in table.channels and len(table) >= 30:
-        try:
-            points = extract_steady(table, tol)
-        except DataError:
-            points = None
-        if points is not None and len(points) >= 3 and len(table) >= 3 * len(points):
-            return points
     if 'time' in table.channels:
         order = np.argsort(table.channels['time'], kind='stable')
         table = table.select(order)

@@ -88,7 +88,8 @@ def plot_residuals(cal: Calibration, path: Path) -> None:
         ax.set_visible(False)
     axes.flat[0].legend(fontsize=8)
     fig.suptitle('Out-of-sample residual of the volumetric losses against each regressor')
-    fig.tight_layout()
+    fig.subplots_adjust(left=0.07, right=0.98, bottom=0.5 / rows, top=1 - 0.35 / rows,
+                        hspace=0.45, wspace=0.3)
     fig.savefig(path, dpi=80)
     plt.close(fig)
 
@@ -147,7 +148,7 @@ def plot_characteristics(cal: Calibration, path: Path) -> None:
     right.set_ylabel('predicted Q_vl, out of sample [l/min]')
     right.legend(fontsize=8)
     right.grid(alpha=0.3)
-    fig.tight_layout()
+    fig.subplots_adjust(left=0.07, right=0.98, bottom=0.12, top=0.93, wspace=0.22)
     fig.savefig(path, dpi=80)
     plt.close(fig)
 
@@ -177,8 +178,9 @@ def plot_ranking(cal: Calibration, path: Path) -> None:
     ax.axvline(cal.selection.baseline.cv_rmse / LPM, color='k', ls='--', label='no effect')
     ax.set_xlabel('cross-validated RMSE of Q_vl [l/min]')
     ax.set_title('Candidate effects (orange: chosen, olive: near tie)', fontsize=10)
-    ax.legend(fontsize=8)
-    fig.tight_layout()
+    ax.legend(fontsize=8, loc='lower right')
+    fig.subplots_adjust(left=0.35, right=0.97, bottom=1.0 / (0.35 * len(ranking) + 1.5),
+                        top=1 - 0.4 / (0.35 * len(ranking) + 1.5))
     fig.savefig(path, dpi=80)
     plt.close(fig)
 

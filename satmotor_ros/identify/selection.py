@@ -26,7 +26,7 @@ from satmotor_ros.identify.fit import LossFit
 from satmotor_ros.identify.parts import LossParts
 from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.units import LPM
-from scipy import stats
+from scipy import special
 
 
 @dataclass(frozen=True)
@@ -211,7 +211,7 @@ class CrossValidatedSelector:
             dof = n - full.n_params
             if dof > 0 and full.rss_ > 0.0:
                 f = max(baseline_rss - full.rss_, 0.0) / (full.rss_ / dof)
-                p_value = float(stats.f.sf(f, 1, dof))
+                p_value = float(special.fdtrc(1, dof, f))
             elif baseline_rss > full.rss_:
                 p_value = 0.0
         return Score(candidate, full, error, float(np.sqrt(np.mean(error ** 2))), p_value)

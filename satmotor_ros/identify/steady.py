@@ -20,7 +20,9 @@ class SteadyTolerance:
 
     A sample is steady when, over the `window` centred on it, the standard
     deviation of each of flow, p_in, p_out and speed is at most
-    ``rel * |mean| + abs`` of that channel. A steady run loses its first
+    ``rel * |mean| + max(abs, 2 sigma)`` of that channel, where sigma is the
+    channel's sample-to-sample noise estimated from the data (see
+    :func:`sample_noise`), so that a noisy sensor does not hide every plateau. A steady run loses its first
     `settle` seconds (the tail of the transient), must then last
     `min_duration`, may not drift by more than the same tolerance between its
     first and last thirds (else it is split), and is cut into points of at
@@ -65,10 +67,59 @@ def _rolling(x: FloatArray, w: int) -> tuple[FloatArray, FloatArray]:
     return mean + x.mean(), np.sqrt(var)
 
 
+def sample_noise(x: FloatArray) -> float:
+    """
+    Estimate the white noise of a sampled signal from its successive differences.
+
+    Parameters
+    ----------
+    x : ndarray
+        Samples in time order, [any]
+
+    Returns
+    -------
+    float
+        1.4826 median|x[i+1] - x[i]| / sqrt(2): the standard deviation of the
+        noise where the signal holds most of the time, [same unit as x]
+
+    """
+    if x.size < 3:
+        return 0.0
+    return float(1.4826 * np.median(np.abs(np.diff(x))) / np.sqrt(2.0))
+
+
+def looks_like_series(table: BenchTable) -> bool:
+    """
+    Tell a time series (plateaus of many samples) from a table of steady points.
+
+    Parameters
+    ----------
+    table : BenchTable
+        Rows as read, [-]
+
+    Returns
+    -------
+    bool
+        True when there is a time column, at least 30 rows, and successive rows
+        of speed and flow differ by far less (< 10 %) than their spread.
+
+    """
+    if 'time' not in table.channels or len(table) < 30:
+        return False
+    order = np.argsort(table.channels['time'], kind='stable')
+    for x in (table.speed[order], table.flow[order]):
+        spread = float(np.std(x))
+        if spread == 0.0 or np.median(np.abs(np.diff(x))) >= 0.1 * spread:
+            return False
+    return True
+
+
 def _channels(table: BenchTable, tol: SteadyTolerance) -> list[tuple[FloatArray, float, float]]:
-    return [(table.flow, tol.flow_rel, tol.flow_abs), (table.p_in, tol.pressure_rel,
-            tol.pressure_abs), (table.p_out, tol.pressure_rel, tol.pressure_abs),
-            (table.speed, tol.speed_rel, tol.speed_abs)]
+    pairs = [(table.flow, tol.flow_rel, tol.flow_abs),
+             (table.p_in, tol.pressure_rel, tol.pressure_abs),
+             (table.p_out, tol.pressure_rel, tol.pressure_abs),
+             (table.speed, tol.speed_rel, tol.speed_abs)]
+    return [(x, rel, max(absolute, 2.0 * sample_noise(x))) for x, rel, absolute in pairs]
 
 
 def steady_mask(table: BenchTable, time: FloatArray, tol: SteadyTolerance) -> np.ndarray:
@@ -90,18 +141,19 @@ def steady_mask(table: BenchTable, time: FloatArray, tol: SteadyTolerance) -> np
         True where every required channel is steady.
 
     """
+    channels = _channels(table, tol)
     dt = float(np.median(np.diff(time))) if time.size > 1 else 1.0
     w = max(3, int(round(tol.window / dt)) if dt > 0 else 3)
     steady = np.ones(time.size, dtype=bool)
-    for x, rel, absolute in _channels(table, tol):
+    for x, rel, absolute in channels:
         mean, std = _rolling(x, w)
         steady &= std <= rel * np.abs(mean) + absolute
     return steady
 
 
-def _drifts(table: BenchTable, lo: int, hi: int, tol: SteadyTolerance) -> bool:
+def _drifts(channels: list[tuple[FloatArray, float, float]], lo: int, hi: int) -> bool:
     third = max((hi - lo) // 3, 1)
-    for x, rel, absolute in _channels(table, tol):
+    for x, rel, absolute in channels:
         a, b = x[lo:lo + third].mean(), x[hi - third:hi].mean()
         if abs(a - b) > rel * abs(0.5 * (a + b)) + absolute:
             return True
@@ -129,6 +181,7 @@ def steady_runs(table: BenchTable, time: FloatArray,
 
     """
     mask = steady_mask(table, time, tol)
+    channels = _channels(table, tol)
     edges = np.flatnonzero(np.diff(np.concatenate(([0], mask.astype(np.int8), [0]))))
     runs = []
     stack = []
@@ -139,7 +192,7 @@ def steady_runs(table: BenchTable, time: FloatArray,
         lo, hi = stack.pop()
         if hi - lo < 3 or time[hi - 1] - time[lo] < tol.min_duration:
             continue
-        if _drifts(table, lo, hi, tol):
+        if _drifts(channels, lo, hi):
             mid = (lo + hi) // 2
             stack.extend([(mid, hi), (lo, mid)])
             continue

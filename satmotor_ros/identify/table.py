@@ -14,7 +14,7 @@ import numpy as np
 
 from satmotor_ros.identify.errors import DataError
 from satmotor_ros.model._typing import FloatArray
-from satmotor_ros.model.units import kinds, to_si, UnitError, units_of
+from satmotor_ros.model.units import kinds, RPM, to_si, UnitError, units_of
 
 REQUIRED = ('speed', 'flow', 'p_in', 'p_out')
 """Columns every bench table must have (DESIGN.md, "Bench tables")."""
@@ -24,8 +24,10 @@ KNOWN_KINDS = {'speed': 'speed', 'flow': 'flow', 'p_in': 'pressure', 'p_out': 'p
                'torque': 'torque'}
 """Kind of quantity of the named columns; any other ``p_*`` column is a pressure too."""
 
-_EXTRA_UNITS = {('pressure', 'psi'): 6894.757293168, ('temperature', '°C'): 1.0,
-                ('temperature', 'C'): 1.0}
+_EXTRA_UNITS = {('pressure', 'psi'): 6894.757293168, ('pressure', 'mbar'): 100.0,
+                ('temperature', '°C'): 1.0, ('temperature', 'C'): 1.0,
+                ('flow', 'm3/s'): 1.0, ('flow', 'm³/s'): 1.0, ('flow', 'l/h'): 1.0e-3 / 3600.0,
+                ('speed', '1/min'): RPM, ('speed', 'min^-1'): RPM, ('time', 'h'): 3600.0}
 """Spellings accepted beyond :mod:`satmotor_ros.model.units` (scale to SI)."""
 
 _HEADER = re.compile(r'^\s*([^\[\]]*?)\s*(?:\[\s*([^\[\]]*?)\s*\])?\s*$')
@@ -121,6 +123,7 @@ def column_to_si(name: str, unit: str, values: FloatArray) -> FloatArray:
                 scale, offset = _affine(unit, other)
                 return values * scale + offset
         return values
+    unit = _known_spelling(kind, unit)
     if (kind, unit) in _EXTRA_UNITS:
         return values * _EXTRA_UNITS[(kind, unit)]
     if not unit:
@@ -134,6 +137,15 @@ def column_to_si(name: str, unit: str, values: FloatArray) -> FloatArray:
                f'(accepted: {", ".join(units_of(kind))})')
         raise DataError(msg) from None
     return values * scale + offset
+
+
+def _known_spelling(kind: str, unit: str) -> str:
+    """Return the accepted spelling of `unit` if it differs only in case (RPM, MPA)."""
+    known = (*units_of(kind), *(u for k, u in _EXTRA_UNITS if k == kind))
+    if unit in known:
+        return unit
+    folded = [u for u in known if u.lower() == unit.lower()]
+    return folded[0] if len(folded) == 1 else unit
 
 
 def _affine(unit: str, kind: str) -> tuple[float, float]:
@@ -167,7 +179,9 @@ def parse_header(header: list[str]) -> list[tuple[str, str]]:
         if match is None or not match.group(1):
             msg = f'column {i + 1} header {cell!r}: expected "name [unit]"'
             raise DataError(msg)
-        columns.append((match.group(1), match.group(2) or ''))
+        name = match.group(1)
+        columns.append((name.lower() if name.lower() in KNOWN_KINDS else name,
+                        match.group(2) or ''))
     names = [name for name, _ in columns]
     for name in names:
         if names.count(name) > 1:
@@ -253,7 +267,8 @@ def read_csv(path: str | Path) -> BenchTable:
     Parameters
     ----------
     path : str or pathlib.Path
-        CSV file with one header row of ``name [unit]`` cells, [-]
+        CSV file with one header row of ``name [unit]`` cells, separated by
+        commas (or semicolons with decimal commas, or tabs), [-]
 
     Returns
     -------
@@ -288,11 +303,18 @@ def read_csv(path: str | Path) -> BenchTable:
     if not lines:
         msg = f'{str(file)!r} is empty: expected a header row and data rows'
         raise DataError(msg)
-    columns = parse_header(next(csv.reader([lines[0]])))
+    delimiter = ','
+    for other in (';', '\t'):
+        if other in lines[0] and ',' not in lines[0]:
+            delimiter = other
+    body = lines[1:]
+    if delimiter == ';':  # a European CSV: decimal commas
+        body = [line.replace(',', '.') for line in body]
+    columns = parse_header(next(csv.reader([lines[0]], delimiter=delimiter)))
     try:
-        data = np.loadtxt(io.StringIO('\n'.join(lines[1:])), delimiter=',', ndmin=2)
+        data = np.loadtxt(io.StringIO('\n'.join(body)), delimiter=delimiter, ndmin=2)
     except ValueError:
-        data = _numbers(list(csv.reader(lines[1:])), columns)
+        data = _numbers(list(csv.reader(body, delimiter=delimiter)), columns)
     if data.shape[0] == 0:
         msg = f'{str(file)!r} has a header but no data rows'
         raise DataError(msg)
