@@ -131,8 +131,8 @@ def steady_points(table: BenchTable, mode: Mode = 'auto',
     if mode not in ('auto', 'points', 'series'):
         msg = f"mode = {mode!r}: use 'auto', 'points' or 'series'"
         raise DataError(msg)
-    if mode == 'series' or (mode == 'auto' and (table.time_series
-                                                 or looks_like_series(table))):
+    series = table.time_series or looks_like_series(table)
+    if mode == 'series' or (mode == 'auto' and series):
         return extract_steady(table, tol)
     if 'time' in table.channels:
         order = np.argsort(table.channels['time'], kind='stable')

@@ -22,12 +22,12 @@ class SteadyTolerance:
     deviation of each of flow, p_in, p_out and speed is at most
     ``rel * |mean| + max(abs, 2 sigma)`` of that channel, where sigma is the
     channel's sample-to-sample noise estimated from the data (see
-    :func:`sample_noise`), so that a noisy sensor does not hide every plateau. A steady run loses its first
-    `settle` seconds (the tail of the transient), must then last
-    `min_duration`, may not drift by more than the same tolerance between its
-    first and last thirds (else it is split), and is cut into points of at
-    most `max_duration` so that slow channels (temperature, time) keep their
-    resolution.
+    :func:`sample_noise`), so that a noisy sensor does not hide every plateau.
+    A steady run loses its first `settle` seconds (the tail of the
+    transient), must then last `min_duration`, may not drift by more than the
+    same tolerance between its first and last thirds (else it is split), and
+    is cut into points of at most `max_duration` so that slow channels
+    (temperature, time) keep their resolution.
     """
 
     flow_rel: float = 0.01  # [-]
