@@ -14,6 +14,7 @@ water), so a test also checks that the library generalises.
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from pathlib import Path
 import re
 
 import numpy as np
@@ -361,3 +362,74 @@ def generate_series(plan: Plan, injection: Injection, seed: int = 0, samples: in
     flow = true_flow(base, injection, speed, dp, {**channels})
     table = _measure(plan, injection, rng, flow, speed, dp, channels, noise)
     return replace(table, time_series=True)
+
+
+def to_columns(table: BenchTable) -> dict[str, tuple[str, FloatArray]]:
+    """
+    Express a generated table in hydraulic units for a bench CSV.
+
+    Parameters
+    ----------
+    table : BenchTable
+        A generated table, [-]
+
+    Returns
+    -------
+    dict of str to (str, ndarray)
+        Column name -> (unit, values in that unit).
+
+    """
+    columns = {'time': ('s', table.channels['time']), 'speed': ('rpm', table.speed / RPM),
+               'flow': ('l/min', table.flow / LPM), 'p_in': ('MPa', table.p_in / MPA),
+               'p_out': ('MPa', table.p_out / MPA),
+               'temperature': ('degC', table.channels['temperature']),
+               'p_case': ('MPa', table.channels['p_case'] / MPA)}
+    for name, values in table.channels.items():
+        if name not in columns and name != 'revolutions':
+            columns[name] = ('-', values)
+    return columns
+
+
+def main(argv: list[str] | None = None) -> int:
+    """
+    Write a synthetic bench CSV: ``python -m satmotor_ros.identify.synthetic``.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        Command-line arguments, [-]
+
+    Returns
+    -------
+    int
+        0.
+
+    """
+    import argparse
+    from satmotor_ros.identify.table import write_csv
+    parser = argparse.ArgumentParser(description='Write a synthetic bench table (CSV) from '
+                                                 'the model with one effect injected.')
+    parser.add_argument('--liquid', default='oil')
+    parser.add_argument('--effect', default='none', help=f'one of {", ".join(REALISTIC)}')
+    parser.add_argument('--scale', type=float, default=1.0,
+                        help='factor on the realistic magnitude')
+    parser.add_argument('--seed', type=int, default=0)
+    parser.add_argument('--points', type=int, default=100)
+    parser.add_argument('--series', type=int, default=0, metavar='SAMPLES',
+                        help='write a 100 Hz time series of this many samples instead')
+    parser.add_argument('--out', required=True, help='CSV file to write')
+    args = parser.parse_args(argv)
+    plan = Plan(liquid=args.liquid, n_points=args.points)
+    injection = Injection.realistic(args.effect, args.scale, args.liquid)
+    table = (generate_series(plan, injection, args.seed, samples=args.series) if args.series
+             else generate(plan, injection, args.seed))
+    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+    write_csv(args.out, to_columns(table))
+    print(f'wrote {args.out}: {len(table)} rows, {args.liquid}, {args.effect} '
+          f'(magnitude {injection.magnitude:.4g}, regressor {injection.regressor or "-"})')
+    return 0
+
+
+if __name__ == '__main__':
+    import sys
+    sys.exit(main())
