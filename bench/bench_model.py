@@ -107,5 +107,51 @@ def main() -> None:
               f'{elapsed / floor_time:8.2f}')
 
 
+def per_call(fn, args: list[tuple], repeat: int) -> float:
+    """Return the best time per call of `fn` over the argument list, [s]."""
+    def run() -> None:
+        for a in args:
+            fn(*a)
+    return best_time(run, repeat) / len(args)
+
+
+def single_points(repeat: int) -> None:
+    """Time one operating point per call: the point path against the array maps."""
+    from satmotor_ros.model import load_motor, MotorModel
+    rng = np.random.default_rng(7)
+    count = 2000
+    flow = (rng.uniform(2.0, 45.0, count) * LPM).tolist()
+    dp = (rng.uniform(4.0, 25.0, count) * MPA).tolist()
+    speed = (rng.uniform(50.0, 1500.0, count) * RPM).tolist()
+    spec = load_motor()
+    print(f'\nsingle operating points: {count} per run, best of {repeat}, microseconds per call')
+    print(f'{"case":58s} {"point":>7s} {"array":>7s} {"ratio":>6s}')
+    for law in ('eq33', 'eq39'):
+        m = MotorModel.from_spec(spec, 'water', None, law)
+        warm = [(n, p, m.absorbency_point(n, p).flow * 1.001) for n, p in zip(speed, dp)]
+        cases = [
+            (f'speed_point(Q, dp), {law}', m.speed_point, m.speed, list(zip(flow, dp))),
+            (f'speed_point(Q, dp_i=), {law}', lambda q, p: m.speed_point(q, dp_i=p),
+             lambda q, p: m.speed(q, dp_i=p), list(zip(flow, dp))),
+            (f'absorbency_point(n, dp), cold start, {law}', m.absorbency_point, m.absorbency,
+             list(zip(speed, dp))),
+            (f'absorbency_point(n, dp), flow_guess 0.1 % off, {law}',
+             lambda n, p, g: m.absorbency_point(n, p, flow_guess=g),
+             lambda n, p, g: m.absorbency(n, p), warm),
+            (f'breakdown_point(n, dp_i), {law}', m.breakdown_point, m.breakdown,
+             list(zip(speed, dp))),
+        ]
+        for name, point, array, args in cases:
+            t_point = per_call(point, args, repeat)
+            t_array = per_call(array, args[:200], max(1, repeat // 3))
+            print(f'{name:58s} {t_point * 1e6:7.2f} {t_array * 1e6:7.1f} '
+                  f'{t_array / t_point:6.0f}')
+    water = spec.sets['water']
+    t_ctor = per_call(lambda: MotorModel(spec.geometry, water, spec.valid_range), [()] * 500,
+                      repeat)
+    print(f'{"MotorModel(...) construction":58s} {t_ctor * 1e6:7.2f}')
+
+
 if __name__ == '__main__':
     main()
+    single_points(7)

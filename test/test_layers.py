@@ -12,6 +12,7 @@ from satmotor_ros.model import losses, speed
 
 
 @pytest.mark.parametrize('module', ['satmotor_ros.model', 'satmotor_ros.cli',
+                                    'satmotor_ros.prediction', 'satmotor_ros.bags',
                                     'satmotor_ros.identify'])
 def test_layer_imports_without_rclpy(module):
     code = f'import sys, {module}; assert "rclpy" not in sys.modules, "rclpy imported"'

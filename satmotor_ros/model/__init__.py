@@ -15,11 +15,11 @@ from satmotor_ros.model.config import (default_config_path, liquid_from_mapping,
 from satmotor_ros.model.errors import ConfigError, InvalidInputError, ModelError, UnitError
 from satmotor_ros.model.motor import MotorModel
 from satmotor_ros.model.results import (COMPONENTS, describe_status, INVALID, LossBreakdown,
-                                        OperatingPoints, PointStatus)
+                                        OperatingPoints, Point, PointStatus)
 
 __all__ = [
     'COMPONENTS', 'CoefficientSet', 'ConfigError', 'INVALID', 'InvalidInputError', 'Liquid',
     'LossBreakdown', 'LossCoefficients', 'ModelError', 'MotorGeometry', 'MotorModel',
-    'MotorSpec', 'OperatingPoints', 'PointStatus', 'UnitError', 'ValidRange',
+    'MotorSpec', 'OperatingPoints', 'Point', 'PointStatus', 'UnitError', 'ValidRange',
     'default_config_path', 'describe_status', 'liquid_from_mapping', 'load_motor',
 ]

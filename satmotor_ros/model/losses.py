@@ -16,6 +16,8 @@ References
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from satmotor_ros.model._typing import ArrayLike, FloatArray
@@ -24,6 +26,9 @@ from satmotor_ros.model.units import LPM, MPA, RPM
 
 _CM3_PER_MIN = 1.0e-6 / 60.0  # one cm^3/min in m^3/s
 _CM3_PER_REV = 1.0e-6 / (2.0 * np.pi)  # one cm^3/rev in m^3/rad
+
+EMPIRICAL_DP_FLOOR = 1.0 * MPA
+"""Chamber drop below which eq. (39) holds its value at this drop, [Pa] (see eq. 39)."""
 
 
 def clearance_height(dp_i: ArrayLike, geometry: MotorGeometry,
@@ -61,9 +66,35 @@ def clearance_height(dp_i: ArrayLike, geometry: MotorGeometry,
     5.14
 
     """
+    h0, slope = clearance_coefficients(geometry, coef)
+    return h0 - slope * np.asarray(dp_i, dtype=float)
+
+
+def clearance_coefficients(geometry: MotorGeometry,
+                           coef: LossCoefficients) -> tuple[float, float]:
+    r"""
+    Compute the constants of eq. (2): h = h_0 - s * dp_i.
+
+    .. math:: h_0 = \frac{h_R + h_S}{2},\quad s = D_C H + D_K
+
+    Parameters
+    ----------
+    geometry : MotorGeometry
+        Motor geometry (h_R, h_S, H), [-]
+    coef : LossCoefficients
+        Coefficient set (D_C, D_K), [-]
+
+    Returns
+    -------
+    h0 : float
+        Unloaded clearance h_0, [m]
+    slope : float
+        Compliance s, [m/Pa]
+
+    """
     h0 = 0.5 * (geometry.clearance_rotor + geometry.clearance_satellites)
     slope = (coef.d_c * geometry.height * 1.0e3 + coef.d_k) * 1.0e-6 / MPA  # [m/Pa]
-    return h0 - slope * np.asarray(dp_i, dtype=float)
+    return h0, slope
 
 
 def flat_clearance_leakage(dp_i: ArrayLike, h: ArrayLike, nu: ArrayLike, rho: ArrayLike,
@@ -102,14 +133,47 @@ def flat_clearance_leakage(dp_i: ArrayLike, h: ArrayLike, nu: ArrayLike, rho: Ar
     Q_Lfg in l/min; beta = 1 is laminar flow, beta -> 0 turbulent.
 
     """
+    prefactor, e = flat_clearance_coefficients(nu, rho, geometry, coef)
+    h = np.asarray(h, dtype=float)
+    return prefactor * (h * h * h * np.asarray(dp_i, dtype=float)) ** e
+
+
+def flat_clearance_coefficients(nu: ArrayLike, rho: ArrayLike, geometry: MotorGeometry,
+                                coef: LossCoefficients) -> tuple[FloatArray, float]:
+    r"""
+    Compute the constants of eq. (1): Q_Lfg = k * (h^3 dp_i)^e.
+
+    .. math::
+        k = A_1 m^{\frac{1-\beta}{2-\beta}} \nu^{-\frac{\beta}{2-\beta}}
+        \left(\frac{2}{K A_2 \rho}\right)^{\frac{1}{2-\beta}},\quad
+        e = \frac{1}{2-\beta}
+
+    Parameters
+    ----------
+    nu : float or ndarray
+        Kinematic viscosity of the liquid, [m^2/s]
+    rho : float or ndarray
+        Density of the liquid, [kg/m^3]
+    geometry : MotorGeometry
+        Motor geometry (tooth module m), [-]
+    coef : LossCoefficients
+        Coefficient set (A_1, A_2, K, beta), [-]
+
+    Returns
+    -------
+    prefactor : ndarray
+        k, for h in m and dp_i in Pa, [m^3/s / (m^3 Pa)^e]
+    exponent : float
+        e, [-]
+
+    """
     e = 1.0 / (2.0 - coef.beta)
     nu_cst = np.asarray(nu, dtype=float) * 1.0e6
     # h^3 [um^3] * dp_i [MPa] = h^3 [m^3] * dp_i [Pa] * 1e12; the 1e12 goes into the prefactor
     prefactor = (coef.a1 * (geometry.module * 1.0e3) ** ((1.0 - coef.beta) * e)
                  * nu_cst ** (-coef.beta * e)
                  * (2.0e12 / (coef.k * coef.a2 * np.asarray(rho, dtype=float))) ** e * LPM)
-    h = np.asarray(h, dtype=float)
-    return prefactor * (h * h * h * np.asarray(dp_i, dtype=float)) ** e
+    return prefactor, e
 
 
 def commutation_leakage(dp_i: ArrayLike, nu: ArrayLike, rho: ArrayLike,
@@ -145,12 +209,39 @@ def commutation_leakage(dp_i: ArrayLike, nu: ArrayLike, rho: ArrayLike,
     is read as m^3/s. It stays below 0.012 l/min for the SM-0,75/25.
 
     """
+    return (commutation_coefficient(nu, rho, geometry, coef)
+            * np.asarray(dp_i, dtype=float) ** coef.gamma)
+
+
+def commutation_coefficient(nu: ArrayLike, rho: ArrayLike, geometry: MotorGeometry,
+                            coef: LossCoefficients) -> FloatArray:
+    r"""
+    Compute the prefactor of eq. (5): Q_C = k * dp_i^gamma.
+
+    .. math:: k = C_1 (D_o h_S)^{C_2} \left(\frac{1}{\rho \nu C_3}\right)^{\gamma}
+
+    Parameters
+    ----------
+    nu : float or ndarray
+        Kinematic viscosity of the liquid, [m^2/s]
+    rho : float or ndarray
+        Density of the liquid, [kg/m^3]
+    geometry : MotorGeometry
+        Motor geometry (D_o, h_S), [-]
+    coef : LossCoefficients
+        Coefficient set (C_1, C_2, C_3, gamma), [-]
+
+    Returns
+    -------
+    ndarray
+        k, for dp_i in Pa, [m^3/s / Pa^gamma]
+
+    """
     nu_cst = np.asarray(nu, dtype=float) * 1.0e6
     base = (geometry.commutation_diameter * 1.0e3) * (geometry.clearance_satellites * 1.0e6)
-    prefactor = (coef.c1 * base ** coef.c2
-                 * (1.0 / (np.asarray(rho, dtype=float) * nu_cst * coef.c3)) ** coef.gamma
-                 * MPA ** -coef.gamma)
-    return prefactor * np.asarray(dp_i, dtype=float) ** coef.gamma
+    return (coef.c1 * base ** coef.c2
+            * (1.0 / (np.asarray(rho, dtype=float) * nu_cst * coef.c3)) ** coef.gamma
+            * MPA ** -coef.gamma)
 
 
 def compressibility_coefficient(bulk_modulus: float, geometry: MotorGeometry,
@@ -182,10 +273,32 @@ def compressibility_coefficient(bulk_modulus: float, geometry: MotorGeometry,
             / (bulk_modulus / MPA * geometry.m2h))
 
 
+def pressure_speed_coefficient(c: float, geometry: MotorGeometry) -> float:
+    r"""
+    Compute k of the common form k * dp_i * n of eqs. (11)-(13).
+
+    .. math:: k = c\,m^2 H
+
+    Parameters
+    ----------
+    c : float
+        One of C_fc*beta_l, C_dch, C_b or their sum C, [1/(MPa*rev)]
+    geometry : MotorGeometry
+        Motor geometry (m, H), [-]
+
+    Returns
+    -------
+    float
+        k, for dp_i in Pa and n in rad/s, [m^3/(Pa*rad)]
+
+    """
+    return c * geometry.m2h * _CM3_PER_MIN / (MPA * RPM)
+
+
 def _pressure_speed_loss(c: float, dp_i: ArrayLike, speed: ArrayLike,
                          geometry: MotorGeometry) -> FloatArray:
     """Evaluate c * m^2 H * dp_i * n, the common form of eqs. (11)-(13), in m^3/s."""
-    scale = c * geometry.m2h * _CM3_PER_MIN / (MPA * RPM)
+    scale = pressure_speed_coefficient(c, geometry)
     return scale * np.asarray(dp_i, dtype=float) * np.asarray(speed, dtype=float)
 
 
@@ -291,8 +404,29 @@ def inertia_loss(speed: ArrayLike, c_id: float, geometry: MotorGeometry) -> Floa
         Delta Q_id, [m^3/s]
 
     """
-    scale = c_id * geometry.m2h * _CM3_PER_MIN / np.sqrt(RPM)
-    return scale * np.sqrt(np.asarray(speed, dtype=float))
+    return inertia_coefficient(c_id, geometry) * np.sqrt(np.asarray(speed, dtype=float))
+
+
+def inertia_coefficient(c_id: float, geometry: MotorGeometry) -> float:
+    r"""
+    Compute k of eq. (14) written as Delta Q_id = k * n^0.5.
+
+    .. math:: k = C_{id}\,m^2 H
+
+    Parameters
+    ----------
+    c_id : float
+        Inertia coefficient C_id, [1/(rev*min)^0.5]
+    geometry : MotorGeometry
+        Motor geometry (m, H), [-]
+
+    Returns
+    -------
+    float
+        k, for n in rad/s, [m^3/s / (rad/s)^0.5]
+
+    """
+    return c_id * geometry.m2h * _CM3_PER_MIN / math.sqrt(RPM)
 
 
 def displacement_change(dp_i: ArrayLike, speed: ArrayLike, c: float, c_id: float,
@@ -397,9 +531,16 @@ def displacement_change_empirical(dp_i: ArrayLike, speed: ArrayLike,
     as n -> 0, so it is used only above ``(C_2 ln dp_i)^2`` rpm, where that
     loss is increasing in n.
 
+    Below :data:`EMPIRICAL_DP_FLOOR` (1 MPa) dp_i is taken as 1 MPa, so that
+    Delta q = C_1/sqrt(n) there. As printed, dp_i^(C_2/sqrt(n)) falls to 0^x = 0
+    at dp_i = 0 but only logarithmically slowly (it is still 0.9 at 1 Pa), so
+    the law would jump at an unloaded motor and eqs. (34)-(36) would have no
+    root near it. The paper fitted eq. (39) on 2-25 MPa; at 0 MPa the eq. (33)
+    counterpart, C_id/sqrt(n), is pressure-independent as well.
+
     """
     inv_sqrt_n = 1.0 / np.sqrt(np.asarray(speed, dtype=float) / RPM)
-    dp_mpa = np.asarray(dp_i, dtype=float) / MPA
+    dp_mpa = np.maximum(np.asarray(dp_i, dtype=float) / MPA, EMPIRICAL_DP_FLOOR / MPA)
     return coef.c1_39 * inv_sqrt_n * dp_mpa ** (coef.c2_39 * inv_sqrt_n) * _CM3_PER_REV
 
 
@@ -522,10 +663,38 @@ def channel_pressure_drop(flow: ArrayLike, nu: ArrayLike, rho: ArrayLike,
     1.76
 
     """
+    turbulent, laminar = channel_coefficients(nu, rho, coef)
+    flow = np.asarray(flow, dtype=float)
+    return (turbulent * flow + laminar) * flow
+
+
+def channel_coefficients(nu: ArrayLike, rho: ArrayLike,
+                         coef: LossCoefficients) -> tuple[FloatArray, FloatArray]:
+    r"""
+    Compute the constants of eq. (35): Delta p_ich = (a Q + b) Q.
+
+    .. math:: a = C_t\,\rho,\quad b = C_l\,\mu
+
+    Parameters
+    ----------
+    nu : float or ndarray
+        Kinematic viscosity of the liquid, [m^2/s]
+    rho : float or ndarray
+        Density of the liquid, [kg/m^3]
+    coef : LossCoefficients
+        Coefficient set (C_t, C_l), [-]
+
+    Returns
+    -------
+    turbulent : ndarray
+        a, for Q in m^3/s, [Pa/(m^3/s)^2]
+    laminar : ndarray
+        b, for Q in m^3/s, [Pa/(m^3/s)]
+
+    """
     rho = np.asarray(rho, dtype=float)
     mu_mpas = rho * np.asarray(nu, dtype=float) * 1.0e3
-    flow = np.asarray(flow, dtype=float)
-    return ((coef.c_t / (LPM * LPM)) * rho * flow + (coef.c_l / LPM) * mu_mpas) * flow
+    return (coef.c_t / (LPM * LPM)) * rho, (coef.c_l / LPM) * mu_mpas
 
 
 def chamber_pressure_drop(dp: ArrayLike, dp_ich: ArrayLike) -> FloatArray:

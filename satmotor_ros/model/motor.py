@@ -25,9 +25,11 @@ from satmotor_ros.model._typing import ArrayLike, FloatArray
 from satmotor_ros.model.coefficients import (CoefficientSet, Liquid, MotorGeometry,
                                              ValidRange)
 from satmotor_ros.model.config import load_motor, MotorSpec
+from satmotor_ros.model.derived import derive
 from satmotor_ros.model.errors import InvalidInputError, ModelError
+from satmotor_ros.model.point import as_float, PointEvaluator
 from satmotor_ros.model.results import (COMPONENTS, INVALID, LossBreakdown, OperatingPoints,
-                                        PointStatus)
+                                        Point, PointStatus)
 from satmotor_ros.model.solve import solve_increasing
 from satmotor_ros.model.speed import absorbency, effective_speed
 from satmotor_ros.model.units import MPA, RPM
@@ -45,8 +47,8 @@ its own elements converge: 3-4x faster than solving a whole batch at once. A
 closed-form evaluation is a single pass, where chunking would only add a copy.
 """
 
-_RTOL = 1e-11
-"""Relative tolerance of the iterative maps, far below the model's own accuracy (~1 %)."""
+_RTOL = 1e-13
+"""Relative tolerance of the iterative maps: Newton polishes well below it, bisection to it."""
 
 At = tuple[int, tuple[int, ...]]
 """Where a chunk sits in the batch: flat offset and the batch's shape (for error messages)."""
@@ -142,24 +144,14 @@ class MotorModel:
         self.valid_range = valid_range
         self.liquid = liquid if liquid is not None else coefficient_set.liquid
         self.displacement_law = displacement_law
-        coef = self.coef = coefficient_set.coefficients
-        c_fc_ref = eq.compressibility_coefficient(coefficient_set.liquid.bulk_modulus,
-                                                  geometry, coef)
-        self.c_fc_beta = eq.compressibility_coefficient(self.liquid.bulk_modulus, geometry, coef)
-        rest = coef.c - c_fc_ref
-        self.c_dch = coef.deformation_share * rest
-        self.c_b = rest - self.c_dch
-        self.c = self.c_fc_beta + rest
-        h0 = float(eq.clearance_height(0.0, geometry, coef))
-        self._h_slope = float(eq.clearance_height(1.0, geometry, coef)) - h0  # dh/dp_i [m/Pa]
-        # eq. (33) as Delta Q_vl = k_p dp_i n + k_i sqrt(n), eq. (35) as dp_ich = a Q^2 + b Q:
-        # the constants read off the equation functions, for the solvers' slopes
-        self._k_p = float(eq.compressibility_loss(1.0, 1.0, self.c, geometry))
-        self._k_i = float(eq.inertia_loss(1.0, coef.c_id, geometry))
-        plus, minus = (float(self._channel_drop(q)) for q in (1.0, -1.0))
-        self._channel_a, self._channel_b = 0.5 * (plus + minus), 0.5 * (plus - minus)
-        # Q_Lfg ~ (h^3 dp)^e rises with dp only while h + 3 h' dp > 0, i.e. dp < h0 / (-4 h')
-        self.dp_limit = h0 / (-4.0 * self._h_slope) if self._h_slope < 0.0 else np.inf
+        self.coef = coefficient_set.coefficients
+        d = self.derived = derive(geometry, coefficient_set, valid_range, self.liquid)
+        self.c_fc_beta, self.c_dch, self.c_b, self.c = d.c_fc_beta, d.c_dch, d.c_b, d.c_lumped
+        self._h_slope = -d.compliance  # dh/dp_i [m/Pa]
+        self._k_p, self._k_i = d.k_p, d.k_i
+        self._channel_a, self._channel_b = d.ch_a, d.ch_b
+        self.dp_limit = d.dp_limit
+        self._point = PointEvaluator(d, displacement_law == 'eq39', _RTOL)
 
     @classmethod
     def from_spec(cls, spec: MotorSpec, coefficients: str = 'oil', liquid: Liquid | None = None,
@@ -234,9 +226,10 @@ class MotorModel:
             if self.displacement_law == 'eq39':
                 # Delta Q_vl = C_1 s exp(a / s) with s = sqrt(n [rpm]), a = C_2 ln(dp_i [MPa])
                 inv_s = 1.0 / np.sqrt(speed / RPM)
-                log_dp = np.log(dp_i / MPA)
+                above = dp_i > eq.EMPIRICAL_DP_FLOOR  # below it, eq. (39) is flat in dp_i
+                log_dp = np.log(np.where(above, dp_i, eq.EMPIRICAL_DP_FLOOR) / MPA)
                 d_speed = loss * (1.0 - self.coef.c2_39 * log_dp * inv_s) / (2.0 * speed)
-                return d_speed, loss * self.coef.c2_39 * inv_s / dp_i
+                return d_speed, np.where(above, loss * self.coef.c2_39 * inv_s / dp_i, 0.0)
             return (self._k_p * dp_i + 0.5 * self._k_i / np.sqrt(speed),
                     self._k_p * speed)
 
@@ -417,8 +410,7 @@ class MotorModel:
                     qt + self._displacement_loss_slopes(n, dp_i, loss)[0])
 
         lo, hi = np.where(moving, lo, 0.0), np.where(moving, hi, 0.0)
-        n, _ = solve_increasing(residual, lo, hi, hi, xtol=_RTOL * hi + 1e-15,
-                                ftol=_RTOL * flow)
+        n, _ = solve_increasing(residual, lo, hi, hi, xtol=_RTOL * hi + 1e-15)
         return np.where(moving, n, 0.0)
 
     def absorbency(self, speed: ArrayLike, dp: ArrayLike | None = None, *,
@@ -504,7 +496,7 @@ class MotorModel:
         upper = absorbency(speed, self._displacement_loss(speed, dp_cap) + q_lfg + q_c + q_ex,
                            self.geometry)
         flow, _ = solve_increasing(residual, qt * speed, upper, upper,
-                                   xtol=_RTOL * upper + 1e-18, ftol=_RTOL * upper)
+                                   xtol=_RTOL * upper + 1e-18)
         return flow
 
     @staticmethod
@@ -536,3 +528,132 @@ class MotorModel:
 
         """
         return self.absorbency(speed, dp_i=dp_i, p_ex=p_ex, errors=errors).losses
+
+    # -- single points ---------------------------------------------------------------------
+
+    def speed_point(self, flow: float, dp: float | None = None, *, dp_i: float | None = None,
+                    p_ex: float = 0.0) -> Point:
+        """
+        Compute the inverse map n(Q, dp) at one operating point, on Python floats.
+
+        Equal to :meth:`speed` with ``errors='mask'`` to 1e-12, at a few
+        microseconds a call. Bad values never raise: the point comes back NaN
+        with its :class:`PointStatus` flags.
+
+        Parameters
+        ----------
+        flow : float
+            Flow into the motor Q, [m^3/s]
+        dp : float, optional
+            Pressure drop between the ports, [Pa]
+        dp_i : float, optional
+            Pressure drop in the working chambers, instead of `dp`, [Pa]
+        p_ex : float
+            Pressure driving the external leakage, eq. (24), [Pa]
+
+        Returns
+        -------
+        Point
+            The operating point.
+
+        Raises
+        ------
+        ModelError
+            If not exactly one of `dp` and `dp_i` is given, or an argument is not a number.
+
+        """
+        if dp is None:
+            if dp_i is None:
+                self._which_dp(dp, dp_i)
+            port, value = False, dp_i
+        elif dp_i is None:
+            port, value = True, dp
+        else:
+            self._which_dp(dp, dp_i)
+        if type(flow) is not float:
+            flow = as_float('flow', flow)
+        if type(value) is not float:
+            value = as_float('dp' if port else 'dp_i', value)
+        if type(p_ex) is not float:
+            p_ex = as_float('p_ex', p_ex)
+        return self._point.speed(flow, value, port, p_ex)
+
+    def absorbency_point(self, speed: float, dp: float | None = None, *,
+                         dp_i: float | None = None, p_ex: float = 0.0,
+                         flow_guess: float | None = None) -> Point:
+        """
+        Compute the forward map Q(n, dp) at one operating point, on Python floats.
+
+        Equal to :meth:`absorbency` with ``errors='mask'`` to 1e-12. With a port
+        `dp`, eqs. (34)-(36) are solved together; `flow_guess` (for instance
+        the previous step's flow) starts that solve near its root.
+
+        Parameters
+        ----------
+        speed : float
+            Shaft speed n, [rad/s]
+        dp : float, optional
+            Pressure drop between the ports, [Pa]
+        dp_i : float, optional
+            Pressure drop in the working chambers, instead of `dp`, [Pa]
+        p_ex : float
+            Pressure driving the external leakage, eq. (24), [Pa]
+        flow_guess : float, optional
+            Starting estimate of Q for the coupled solve; ignored unless it is
+            finite and above q_t*n, [m^3/s]
+
+        Returns
+        -------
+        Point
+            The operating point.
+
+        Raises
+        ------
+        ModelError
+            If not exactly one of `dp` and `dp_i` is given, or an argument is not a number.
+
+        """
+        if dp is None:
+            if dp_i is None:
+                self._which_dp(dp, dp_i)
+            port, value = False, dp_i
+        elif dp_i is None:
+            port, value = True, dp
+        else:
+            self._which_dp(dp, dp_i)
+        if type(speed) is not float:
+            speed = as_float('speed', speed)
+        if type(value) is not float:
+            value = as_float('dp' if port else 'dp_i', value)
+        if type(p_ex) is not float:
+            p_ex = as_float('p_ex', p_ex)
+        if flow_guess is not None and type(flow_guess) is not float:
+            flow_guess = as_float('flow_guess', flow_guess)
+        return self._point.absorbency(speed, value, port, p_ex, flow_guess)
+
+    def breakdown_point(self, speed: float, dp_i: float, p_ex: float = 0.0) -> Point:
+        """
+        Compute the loss components at one speed and chamber pressure drop, eq. (31).
+
+        Parameters
+        ----------
+        speed : float
+            Shaft speed n, [rad/s]
+        dp_i : float
+            Pressure drop in the working chambers, [Pa]
+        p_ex : float
+            Pressure driving the external leakage, eq. (24), [Pa]
+
+        Returns
+        -------
+        Point
+            The operating point (its flow is the absorbency of eq. 36).
+
+        """
+        if type(speed) is not float:
+            speed = as_float('speed', speed)
+        if type(dp_i) is not float:
+            dp_i = as_float('dp_i', dp_i)
+        if type(p_ex) is not float:
+            p_ex = as_float('p_ex', p_ex)
+        return self._point.absorbency(speed, dp_i, False, p_ex, None)

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, fields
 import enum
+from typing import NamedTuple
 
 import numpy as np
 import numpy.typing as npt
@@ -79,6 +80,30 @@ class OperatingPoints:
     def invalid(self) -> npt.NDArray[np.bool_]:
         """Mask of the elements whose outputs are NaN."""
         return (self.status & int(INVALID)) != 0
+
+
+class Point(NamedTuple):
+    """
+    One operating point as Python floats, SI; same meaning as :class:`OperatingPoints`.
+
+    Returned by ``MotorModel.speed_point``, ``absorbency_point`` and
+    ``breakdown_point``. The loss fields are the :data:`COMPONENTS`, in order;
+    an invalid point has NaN in every float field.
+    """
+
+    flow: float  # Q [m^3/s]
+    speed: float  # n [rad/s]
+    dp: float  # port pressure drop [Pa]
+    dp_i: float  # chamber pressure drop [Pa]
+    flat_clearance: float  # Q_Lfg, eq. (1) [m^3/s]
+    commutation: float  # Q_C, eq. (5) [m^3/s]
+    compressibility: float  # Delta Q_fc, eq. (11) [m^3/s]
+    deformation: float  # Delta Q_dch, eq. (12) [m^3/s]
+    backlash: float  # Delta Q_b, eq. (13) [m^3/s]
+    inertia: float  # Delta Q_id, eq. (14) [m^3/s]
+    external: float  # Q_ex, eq. (24) [m^3/s]
+    total: float  # Q_vl, eq. (31) [m^3/s]
+    status: int  # PointStatus flags
 
 
 def describe_status(code: int) -> str:

@@ -69,3 +69,62 @@ def solve_increasing(func: Callable[[FloatArray], tuple[FloatArray, FloatArray]]
         # a Newton step this small leaves an error of its square: done without re-evaluating
         done |= inside & (np.abs(f) <= xtol * slope)
     return x, done
+
+
+def solve_increasing_scalar(func: Callable[[float], tuple[float, float]], lo: float, hi: float,
+                            x0: float, xtol: float, ftol: float = 0.0,
+                            maxiter: int = 60) -> tuple[float, bool]:
+    """
+    Find x in [lo, hi] with f(x) = 0 for an increasing f: one point, Python floats.
+
+    The same bracketed Newton method as :func:`solve_increasing`, step for
+    step, without numpy's per-call overhead.
+
+    Parameters
+    ----------
+    func : callable
+        Returns f(x) and df/dx, [f], [f/x]
+    lo, hi : float
+        Bracket with f(lo) <= 0 <= f(hi), [x]
+    x0 : float
+        Starting estimate inside the bracket, [x]
+    xtol : float
+        Done once the bracket, or the last Newton step, is narrower than this, [x]
+    ftol : float
+        ... or once the residual is this small in magnitude, [f]
+    maxiter : int
+        Iteration limit, [-]
+
+    Returns
+    -------
+    x : float
+        The root estimate, [x]
+    converged : bool
+        False if `maxiter` ran out first.
+
+    Examples
+    --------
+    >>> x, ok = solve_increasing_scalar(lambda x: (x * x - 2.0, 2.0 * x), 0.0, 2.0, 2.0, 1e-14)
+    >>> round(x, 12), ok
+    (1.414213562373, True)
+
+    """
+    a, b, x = lo, hi, x0
+    if b - a <= xtol:
+        return x, True
+    for _ in range(maxiter):
+        f, slope = func(x)
+        if f < 0.0:
+            a = x
+        elif f > 0.0:
+            b = x
+        if abs(f) <= ftol or b - a <= xtol or f != f:
+            return x, True
+        newton = x - f / slope if slope > 0.0 and slope != float('inf') else a - 1.0
+        if a < newton < b:
+            x = newton
+            if abs(f) <= xtol * slope:
+                return x, True
+        else:
+            x = 0.5 * (a + b)
+    return x, False

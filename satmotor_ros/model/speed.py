@@ -3,6 +3,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from satmotor_ros.model._typing import ArrayLike, FloatArray
@@ -73,18 +75,46 @@ def effective_speed(flow: ArrayLike, dp_i: ArrayLike, leakage: ArrayLike, c: flo
     form ``n = (2c / (sqrt(b^2 + 4ac) + b))^2``, which equals eq. (40).
 
     """
-    # n [rad/s] = RPM (2c / (sqrt(b^2 + 4ac) + b))^2 with c in cm^3/min. With x = 2 sqrt(RPM) c
-    # that is (x / (sqrt(b^2 + (2a / sqrt(RPM)) x) + b))^2: the constants fold into two scalars.
-    m2h = geometry.m2h
-    b = c_id * m2h
-    k = 2.0 / np.sqrt(RPM)
-    dp_i = np.asarray(dp_i, dtype=float)
-    two_a = k * geometry.displacement_cm3_per_rev + (k * c * m2h / MPA) * dp_i
-    x = np.maximum(np.asarray(flow, dtype=float) - leakage, 0.0) * (4.0 / (k * _CM3_PER_MIN))
+    a0, a1, scale, b = effective_speed_coefficients(c, c_id, geometry)
+    two_a = a0 + a1 * np.asarray(dp_i, dtype=float)
+    x = np.maximum(np.asarray(flow, dtype=float) - leakage, 0.0) * scale
     if b == 0.0:
         return x / two_a
     root = x / (np.sqrt(two_a * x + b * b) + b)
     return root * root
+
+
+def effective_speed_coefficients(c: float, c_id: float,
+                                 geometry: MotorGeometry) -> tuple[float, float, float, float]:
+    r"""
+    Compute the constants of eq. (40) in its folded, cancellation-free form.
+
+    .. math::
+        n = \left(\frac{x}{\sqrt{(a_0 + a_1 \Delta p_i)\,x + b^2} + b}\right)^2,\quad
+        x = s\,(Q - Q_{Lfg} - Q_C - Q_{ex})
+
+    Parameters
+    ----------
+    c : float
+        Lumped coefficient C of eq. (33), [1/(MPa*rev)]
+    c_id : float
+        Inertia coefficient C_id, [1/(rev*min)^0.5]
+    geometry : MotorGeometry
+        Motor geometry (q_t, m, H), [-]
+
+    Returns
+    -------
+    tuple of float
+        a_0 [cm^3/rev (rad/s)^-0.5], a_1 [a_0/Pa], s [(cm^3/min)/(m^3/s) (rad/s)^0.5] and
+        b = C_id m^2 H [cm^3/rev (rev/min)^0.5].
+
+    """
+    # n [rad/s] = RPM (2c / (sqrt(b^2 + 4ac) + b))^2 with c in cm^3/min. With x = 2 sqrt(RPM) c
+    # that is (x / (sqrt(b^2 + (2a / sqrt(RPM)) x) + b))^2: the constants fold into two scalars.
+    m2h = geometry.m2h
+    k = 2.0 / math.sqrt(RPM)
+    return (k * geometry.displacement_cm3_per_rev, k * c * m2h / MPA,
+            4.0 / (k * _CM3_PER_MIN), c_id * m2h)
 
 
 def speed_loss(flow: ArrayLike, speed: ArrayLike, geometry: MotorGeometry) -> FloatArray:

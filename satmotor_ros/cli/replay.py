@@ -1,0 +1,426 @@
+# SPDX-License-Identifier: Apache-2.0
+"""
+``satmotor replay``: the motor_model node's predictions over a recorded bag, fast.
+
+The bag's input topics are combined in log-time order by the node's own rule
+(:mod:`satmotor_ros.prediction`) and predicted in one vectorised model call; the result is
+written as CSV (hydraulic units in the header) and, with ``--out-bag``, as a new bag that
+holds the recorded and the predicted topics side by side.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+from pathlib import Path
+import time
+
+import numpy as np
+
+from satmotor_ros.bags import (BagError, describe_topics, encode_many, FLOAT64, JOINT_STATE,
+                               list_topics, missing_topics, OutTopic, parse_topic_map,
+                               read_series, Series, write_bag)
+from satmotor_ros.cli._common import add_model_options, build_model, CliError, fail
+from satmotor_ros.model import COMPONENTS, describe_status, ModelError
+from satmotor_ros.model.units import LPM, MPA, RPM
+from satmotor_ros.prediction import (combine_batch, driving_times, INPUTS, InputState, Level,
+                                     MODES, predict_batch, PredictionBatch, REQUIRED, Rule,
+                                     TOPICS)
+from satmotor_ros.prediction.rule import input_level
+
+FIELD_OF = {'flow': 'data', 'p_in': 'fluid_pressure', 'p_out': 'fluid_pressure',
+            'p_case': 'fluid_pressure', 'temperature': 'temperature',
+            'measured_speed': 'velocity'}
+"""The Series field each input is read from."""
+
+_INPUT_COLUMNS = (('flow', 'flow [l/min]', LPM), ('p_in', 'p_in [MPa]', MPA),
+                  ('p_out', 'p_out [MPa]', MPA), ('p_case', 'p_case [MPa]', MPA),
+                  ('temperature', 'temperature [degC]', 1.0),
+                  ('measured_speed', 'measured_speed [rpm]', RPM))
+_OUTPUT_COLUMNS = (('dp', 'dp [MPa]', MPA), ('dp_i', 'dp_i [MPa]', MPA),
+                   ('speed', 'speed [rpm]', RPM), ('speed', 'speed [rad/s]', 1.0),
+                   *((c, f'{c} [l/min]', LPM) for c in COMPONENTS),
+                   ('residual', 'residual [rpm]', RPM))
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    """
+    Register the subcommand.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The ``satmotor`` subparsers, [-]
+
+    """
+    parser = sub.add_parser(
+        'replay', help="run the motor_model node's prediction over a recorded bag",
+        description='Replay a rosbag2 bag (sqlite3 or MCAP) through the motor_model '
+                    "node's prediction, as fast as it can: the inputs are combined in "
+                    "log-time order by the node's rule. With a measured speed "
+                    '(joint_states) it prints residual statistics and plots predicted '
+                    'against measured speed.')
+    parser.add_argument('bag', help='bag directory, or a single .db3/.mcap file')
+    parser.add_argument('--out', default=None, metavar='FILE.csv',
+                        help='write one row per driving message (units in the header)')
+    parser.add_argument('--out-bag', default=None, metavar='DIR',
+                        help='write a new MCAP bag with the recorded and predicted topics')
+    parser.add_argument('--plot', default=None, metavar='FILE.png',
+                        help='plot of predicted and measured speed (default: beside --out, '
+                             'else <bag>_speed.png here; only with a measured speed)')
+    parser.add_argument('--no-plot', action='store_true', help='do not plot')
+    parser.add_argument('--topic-map', action='append', default=[], metavar='OLD:=NEW',
+                        help='match bag topic OLD as NEW (repeatable), e.g. '
+                             '/rig/p1:=inlet_pressure')
+    parser.add_argument('--timeout', type=float, default=0.5, metavar='S',
+                        help='input timeout of the rule, as the node parameter '
+                             'input_timeout (default 0.5 s)')
+    parser.add_argument('--mode', choices=MODES, default='on_flow',
+                        help='predict on every flow_command (default) or at --rate')
+    parser.add_argument('--rate', type=float, default=50.0, metavar='HZ',
+                        help='prediction rate with --mode rate (default 50 Hz)')
+    parser.add_argument('--joint', default='motor_shaft', metavar='NAME',
+                        help='joint of the measured speed in joint_states (default '
+                             'motor_shaft)')
+    add_model_options(parser)
+    parser.set_defaults(command=command)
+
+
+def command(bag: str, out: str | None, out_bag: str | None, plot: str | None, no_plot: bool,
+            topic_map: list[str], timeout: float, mode: str, rate: float, joint: str,
+            liquid: str, motor: str | None, law: str, viscosity: str | None,
+            density: str | None, bulk_modulus: str | None) -> int:
+    """
+    Replay a bag through the prediction and report.
+
+    Parameters
+    ----------
+    bag : str
+        Bag directory or storage file, [-]
+    out : str or None
+        CSV file to write, [-]
+    out_bag : str or None
+        Bag directory to write (MCAP), [-]
+    plot : str or None
+        PNG file for predicted against measured speed, [-]
+    no_plot : bool
+        Skip the plot, [-]
+    topic_map : list of str
+        ``OLD:=NEW`` renames, [-]
+    timeout : float
+        Input timeout of the rule, [s]
+    mode : str
+        ``'on_flow'`` or ``'rate'``, [-]
+    rate : float
+        Prediction rate in ``'rate'`` mode, [Hz]
+    joint : str
+        Joint of the measured speed, [-]
+    liquid, motor, law, viscosity, density, bulk_modulus : str or None
+        Model options, see :func:`satmotor_ros.cli._common.build_model`, [-]
+
+    Returns
+    -------
+    int
+        0 when predictions were made, 1 on an error (one line on stderr).
+
+    """
+    started = time.perf_counter()
+    try:
+        rule = Rule(timeout=timeout, mode=mode, rate=rate)
+    except ValueError as err:
+        return fail(CliError(f'--{str(err).split(" ", 1)[0]} {err}'))
+    try:
+        model = build_model(liquid, motor, law, viscosity, density, bulk_modulus)
+        renames = parse_topic_map(topic_map)
+        series = read_series(bag, [TOPICS[name] for name in INPUTS], renames, joint,
+                             keep_raw=out_bag is not None)
+        _require(bag, series, renames)
+        batch = _predict(model, rule, series)
+        if not batch.valid.any():
+            raise CliError(f'{bag}: none of {len(batch)} predictions could be made; the '
+                           f'first: {batch.message(0)}')
+        if out_bag is not None:
+            _write_bag(Path(out_bag), series, batch, joint)
+    except (BagError, CliError, ModelError) as err:
+        return fail(err)
+    except OSError as err:
+        return fail(CliError(f'{err.filename}: {err.strerror}'))
+    try:
+        if out is not None:
+            write_csv(Path(out), batch)
+        picture = _plot_path(bag, out, plot, no_plot, series)
+        if picture is not None:
+            plot_speed(picture, batch, f'{Path(bag).name}: {model.liquid.name}, '
+                                       f'{model.displacement_law}')
+    except OSError as err:
+        return fail(CliError(f'{err.filename}: {err.strerror}'))
+    print(summary(bag, batch, time.perf_counter() - started))
+    for path in (out, out_bag, picture):
+        if path is not None:
+            print(f'wrote {path}')
+    return 0
+
+
+def _require(bag: str, series: dict[str, Series], renames: dict[str, str]) -> None:
+    missing = missing_topics(series, [TOPICS[name] for name in REQUIRED])
+    if missing:
+        have = describe_topics(list_topics(bag))
+        hint = '' if renames else '; rename with --topic-map OLD:=NEW'
+        raise CliError(f'{bag}: no messages on {", ".join(missing)} (the bag has: {have})'
+                       f'{hint}')
+
+
+def inputs_of(series: dict[str, Series]) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """
+    Take the rule's inputs from the series that :func:`read_series` returned.
+
+    Parameters
+    ----------
+    series : dict
+        Topic name -> Series, [-]
+
+    Returns
+    -------
+    dict
+        Input name -> (log times [ns], values [SI]).
+
+    """
+    inputs = {}
+    for name in INPUTS:
+        found = series.get(TOPICS[name])
+        if found is not None and len(found):
+            inputs[name] = (found.t_ns, found.fields[FIELD_OF[name]])
+    return inputs
+
+
+def _predict(model, rule: Rule, series: dict[str, Series]) -> PredictionBatch:  # noqa: ANN001
+    inputs = inputs_of(series)
+    first = min(int(t[0]) for t, _ in inputs.values())
+    last = max(int(t[-1]) for t, _ in inputs.values())
+    stamps = driving_times(rule, inputs['flow'][0], first, last)
+    return predict_batch(model, combine_batch(rule, stamps, inputs), rule.timeout)
+
+
+def summary(bag: str, batch: PredictionBatch, seconds: float) -> str:
+    """
+    Describe a replay in a few lines: counts, the first problem, residual statistics.
+
+    Parameters
+    ----------
+    bag : str
+        The bag, [-]
+    batch : PredictionBatch
+        The predictions, [-]
+    seconds : float
+        Wall time of the replay, [s]
+
+    Returns
+    -------
+    str
+        The text.
+
+    """
+    n = len(batch)
+    valid = batch.valid
+    warn = int((batch.level == Level.WARN).sum())
+    lines = [f'{bag}: {n} driving messages, {int(valid.sum())} predictions ({warn} with a '
+             f'warning), {n - int(valid.sum())} rejected, in {seconds:.2f} s']
+    t0 = int(batch.snapshots.stamp_ns[0]) if n else 0
+    for level in (Level.ERROR, Level.WARN):
+        hits = np.flatnonzero(batch.level == level)
+        if len(hits):
+            i = int(hits[0])
+            lines.append(f'  first {level.name} at {(batch.snapshots.stamp_ns[i] - t0) / 1e9:.3f} '
+                         f's: {batch.message(i)}')
+    stats = residual_stats(batch)
+    if stats is None:
+        lines.append('  no measured speed (joint_states): no residual')
+    else:
+        lines.append(f'  residual measured - predicted speed over {stats["n"]} points: mean '
+                     f'{stats["mean"]:.3g} rpm, std {stats["std"]:.3g} rpm, RMS '
+                     f'{stats["rms"]:.3g} rpm, max |r| {stats["max_abs"]:.3g} rpm '
+                     f'({stats["rms_pct"]:.3g} % RMS of the mean measured speed)')
+    return '\n'.join(lines)
+
+
+def residual_stats(batch: PredictionBatch) -> dict[str, float] | None:
+    """
+    Summarise the residual of measured against predicted speed.
+
+    Parameters
+    ----------
+    batch : PredictionBatch
+        The predictions, [-]
+
+    Returns
+    -------
+    dict or None
+        ``n``, ``mean``, ``std``, ``rms``, ``max_abs`` [rpm] and ``rms_pct`` [%];
+        None when no prediction had a measured speed.
+
+    """
+    residual = batch.output('residual')
+    ok = np.isfinite(residual)
+    if not ok.any():
+        return None
+    r = residual[ok] / RPM
+    measured = batch.snapshots.values[INPUTS.index('measured_speed')][ok] / RPM
+    rms = float(np.sqrt(np.mean(r * r)))
+    scale = float(np.mean(np.abs(measured)))
+    return {'n': int(ok.sum()), 'mean': float(r.mean()), 'std': float(r.std()), 'rms': rms,
+            'max_abs': float(np.abs(r).max()),
+            'rms_pct': 100.0 * rms / scale if scale > 0 else float('nan')}
+
+
+def _state_notes(batch: PredictionBatch) -> list[str]:
+    """Name, per prediction, the inputs that are not usable (e.g. 'p_out:REVERSED')."""
+    states = batch.snapshots.states.astype(np.int64)
+    key = np.zeros(states.shape[1], dtype=np.int64)
+    for row in states:  # one small integer per combination of input states
+        key = key * 8 + row
+    codes, inverse = np.unique(key, return_inverse=True)
+    texts = []
+    for code in codes.tolist():
+        column = [(code >> (3 * (len(INPUTS) - 1 - i))) & 7 for i in range(len(INPUTS))]
+        texts.append(';'.join(f'{TOPICS[name]}:{InputState(s).name}'
+                              for name, s in zip(INPUTS, column) if input_level(name, s)))
+    return [texts[i] for i in inverse.reshape(-1).tolist()]
+
+
+def _status_names(batch: PredictionBatch) -> list[str]:
+    codes, inverse = np.unique(batch.status, return_inverse=True)
+    names = [describe_status(int(c)) for c in codes]
+    return [names[i] for i in inverse.reshape(-1).tolist()]
+
+
+def write_csv(path: Path, batch: PredictionBatch) -> None:
+    """
+    Write one row per driving message, hydraulic units in the header.
+
+    Columns: ``log_time [ns]``, ``time [s]`` (from the first), the inputs (optional ones
+    only when the bag has them), the outputs (``residual`` only with a measured speed),
+    ``level`` (OK, WARN, ERROR: ERROR rows are what the node would not publish, their
+    outputs empty), ``model_status`` and ``inputs`` (the unusable ones and why).
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The file, [-]
+    batch : PredictionBatch
+        The predictions, [-]
+
+    """
+    snaps = batch.snapshots
+    t_ns = snaps.stamp_ns
+    columns = [t_ns.tolist(), ((t_ns - t_ns[0]) / 1e9).tolist() if len(t_ns) else []]
+    header = ['log_time [ns]', 'time [s]']
+    for name, title, unit in _INPUT_COLUMNS:
+        values = snaps.values[INPUTS.index(name)]
+        if name in REQUIRED or not np.isnan(values).all():  # absent optional inputs: no column
+            columns.append(_blank_nan(values / unit))
+            header.append(title)
+    for name, title, unit in _OUTPUT_COLUMNS:
+        values = batch.output(name)
+        if name != 'residual' or not np.isnan(values).all():
+            columns.append(_blank_nan(values / unit))
+            header.append(title)
+    levels = [Level(k).name for k in range(3)]
+    columns += [[levels[k] for k in batch.level.tolist()], _status_names(batch),
+                _state_notes(batch)]
+    header += ['level', 'model_status', 'inputs']
+    with path.open('w', newline='', encoding='utf-8') as stream:
+        writer = csv.writer(stream)
+        writer.writerow(header)
+        writer.writerows(zip(*columns))
+
+
+def _blank_nan(values: np.ndarray) -> list:
+    listed = values.tolist()
+    if np.isnan(values).any():
+        listed = ['' if v != v else v for v in listed]
+    return listed
+
+
+def _write_bag(path: Path, series: dict[str, Series], batch: PredictionBatch,
+               joint: str) -> None:
+    """Write the recorded inputs and the predictions (what the node publishes) to a bag."""
+    flow_topic = series[TOPICS['flow']].topic
+    prefix = flow_topic[:-len('flow_command')] if flow_topic.endswith('flow_command') else '/'
+    prefix = prefix if prefix.startswith('/') else '/' + prefix
+    topics = [OutTopic(s.topic if s.topic.startswith('/') else '/' + s.topic, s.msgtype,
+                       s.t_ns, s.raw) for s in series.values() if len(s)]
+    valid = batch.valid
+    t_ns = batch.snapshots.stamp_ns[valid]
+    topics.append(OutTopic(prefix + 'predicted_joint_state', JOINT_STATE, t_ns, encode_many(
+        JOINT_STATE, {'velocity': batch.output('speed')[valid]}, t_ns, joint=joint)))
+    for c in COMPONENTS:
+        topics.append(OutTopic(f'{prefix}losses/{c}', FLOAT64, t_ns,
+                               encode_many(FLOAT64, {'data': batch.output(c)[valid]})))
+    residual = batch.output('residual')
+    has = valid & np.isfinite(residual)
+    if has.any():
+        topics.append(OutTopic(prefix + 'speed_residual', FLOAT64,
+                               batch.snapshots.stamp_ns[has],
+                               encode_many(FLOAT64, {'data': residual[has]})))
+    write_bag(path, topics)
+
+
+def _plot_path(bag: str, out: str | None, plot: str | None, no_plot: bool,
+               series: dict[str, Series]) -> Path | None:
+    measured = series.get(TOPICS['measured_speed'])
+    if no_plot or measured is None or not len(measured):
+        return None
+    if plot is not None:
+        return Path(plot)
+    if out is not None:
+        return Path(out).with_name(Path(out).stem + '_speed.png')
+    return Path(f'{Path(bag).resolve().name}_speed.png')
+
+
+def plot_speed(path: Path, batch: PredictionBatch, label: str, max_points: int = 20000) -> None:
+    """
+    Plot predicted and measured speed over time, and their residual.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The PNG to write, [-]
+    batch : PredictionBatch
+        The predictions, [-]
+    label : str
+        Title line, [-]
+    max_points : int
+        Most points drawn per curve (evenly thinned), [-]
+
+    """
+    import matplotlib
+    matplotlib.use('Agg')
+    from matplotlib import pyplot
+
+    t_ns = batch.snapshots.stamp_ns
+    step = max(1, len(t_ns) // max_points)
+    t = (t_ns[::step] - t_ns[0]) / 1e9
+    predicted = batch.output('speed')[::step] / RPM
+    measured = batch.snapshots.values[INPUTS.index('measured_speed')][::step] / RPM
+    residual = batch.output('residual')[::step] / RPM
+    fig, (top, bottom) = pyplot.subplots(2, 1, figsize=(8.0, 5.6), dpi=110, sharex=True,
+                                         gridspec_kw={'height_ratios': [2, 1]})
+    top.plot(t, measured, '-', lw=0.8, color='0.35', label='measured (joint_states)')
+    top.plot(t, predicted, '-', lw=0.8, color='tab:blue', label='predicted (motor model)')
+    top.set_ylabel('shaft speed [rpm]')
+    top.legend(fontsize=8)
+    top.grid(True, alpha=0.3)
+    top.set_title(f'Predicted against measured speed\n{label}', fontsize=10)
+    bottom.plot(t, residual, '-', lw=0.8, color='tab:red')
+    bottom.axhline(0.0, color='0.5', lw=0.6)
+    bottom.set_ylabel('measured - predicted [rpm]')
+    bottom.set_xlabel('time from the first driving message [s]')
+    bottom.grid(True, alpha=0.3)
+    stale = ~batch.valid[::step]
+    if stale.any():
+        top.plot(t[stale], np.zeros(int(stale.sum())), '|', color='tab:orange',
+                 label='no prediction (ERROR)')
+        top.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path)
+    pyplot.close(fig)

@@ -1,0 +1,170 @@
+# SPDX-License-Identifier: Apache-2.0
+"""
+Node parameters from a table: declared with descriptors, checked with a reason.
+
+A node lists its parameters as :class:`ParamSpec` rows. :func:`declare` declares them
+with a description that carries the unit and a range or a set of choices; a value from
+a parameter file that violates its descriptor does not kill the node: the default is
+used and the problem returned, for the node to report. :func:`check` rejects a set
+request with a reason that names the parameter and the value; an on-set callback
+returns its result, so that rclpy keeps the old value.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable, Mapping
+from dataclasses import dataclass
+import math
+from typing import Any
+
+from rcl_interfaces.msg import (FloatingPointRange, IntegerRange, ParameterDescriptor,
+                                SetParametersResult)
+from rclpy.exceptions import InvalidParameterTypeException, InvalidParameterValueException
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+
+
+@dataclass(frozen=True)
+class ParamSpec:
+    """One parameter: default, meaning with unit, and what values it accepts."""
+
+    name: str
+    default: Any  # float, int, str or bool; sets the type
+    description: str  # what it is, without the unit
+    unit: str = '-'  # SI unit, shown as '[unit]'
+    low: float | None = None  # inclusive range (numbers)
+    high: float | None = None
+    choices: tuple[str, ...] = ()  # allowed strings
+    read_only: bool = False  # fixed after start
+    check: Callable[[Any], str | None] | None = None  # extra test: a reason, or None
+
+    def descriptor(self) -> ParameterDescriptor:
+        """
+        Build the parameter's descriptor.
+
+        Returns
+        -------
+        ParameterDescriptor
+            Description with unit, range or choices, read-only flag.
+
+        """
+        text = f'{self.description} [{self.unit}]'
+        extra = f'one of: {", ".join(self.choices)}' if self.choices else ''
+        # dynamic typing: a value of the wrong type reaches reason(), which names it
+        desc = ParameterDescriptor(description=text, additional_constraints=extra,
+                                   read_only=self.read_only, dynamic_typing=True)
+        if isinstance(self.default, float) and self.low is not None:
+            desc.floating_point_range = [FloatingPointRange(
+                from_value=float(self.low), to_value=float(self.high), step=0.0)]
+        elif isinstance(self.default, int) and not isinstance(self.default, bool) \
+                and self.low is not None:
+            desc.integer_range = [IntegerRange(from_value=int(self.low),
+                                               to_value=int(self.high), step=1)]
+        return desc
+
+    def reason(self, value: Any) -> str | None:
+        """
+        Say why a value is not acceptable.
+
+        Parameters
+        ----------
+        value : Any
+            Proposed value, [unit of the parameter]
+
+        Returns
+        -------
+        str or None
+            The reason, naming the parameter and the value; None when it is acceptable.
+
+        """
+        kind = type(self.default)
+        if kind is float:
+            if not isinstance(value, (int, float)) or isinstance(value, bool):
+                return f'{self.name} = {value!r}: must be a number [{self.unit}]'
+        elif not isinstance(value, kind) or isinstance(value, bool) != (kind is bool):
+            return f'{self.name} = {value!r}: must be of type {kind.__name__}'
+        if kind in (float, int) and self.low is not None and not (
+                math.isfinite(value) and self.low <= value <= self.high):
+            return (f'{self.name} = {value!r} {self.unit}: must be within '
+                    f'[{self.low:g}, {self.high:g}]')
+        if self.choices and value not in self.choices:
+            return f'{self.name} = {value!r}: use one of {", ".join(self.choices)}'
+        return self.check(value) if self.check is not None else None
+
+
+def declare(node: Node, specs: Iterable[ParamSpec]) -> dict[str, str]:
+    """
+    Declare every parameter; an invalid override falls back to the default.
+
+    Parameters
+    ----------
+    node : rclpy.node.Node
+        The node, [-]
+    specs : iterable of ParamSpec
+        The table, [-]
+
+    Returns
+    -------
+    dict
+        Parameter name -> problem with its override (parameter file, command line), one
+        line each.
+
+    """
+    problems = {}
+    for spec in specs:
+        try:
+            node.declare_parameter(spec.name, spec.default, spec.descriptor())
+            reason = spec.reason(node.get_parameter(spec.name).value)
+        except (InvalidParameterValueException, InvalidParameterTypeException) as err:
+            reason = f'{spec.name}: {str(err).splitlines()[0]}'
+            node.declare_parameter(spec.name, spec.default, spec.descriptor(),
+                                   ignore_override=True)
+        if reason is not None:
+            problems[spec.name] = f'{reason}; using the default {spec.default!r}'
+            node.set_parameters([Parameter(spec.name, value=spec.default)])
+    return problems
+
+
+def check(specs: Mapping[str, ParamSpec], params: Iterable[Parameter]) -> SetParametersResult:
+    """
+    Check a set request against the table (for an on-set callback).
+
+    Parameters
+    ----------
+    specs : mapping
+        Name -> ParamSpec, [-]
+    params : iterable of rclpy.parameter.Parameter
+        The request, [-]
+
+    Returns
+    -------
+    SetParametersResult
+        Unsuccessful, with the first reason, if any value is not acceptable.
+
+    """
+    for param in params:
+        spec = specs.get(param.name)
+        reason = spec.reason(param.value) if spec is not None else None
+        if reason is not None:
+            return SetParametersResult(successful=False, reason=reason)
+    return SetParametersResult(successful=True)
+
+
+def values(node: Node, specs: Iterable[ParamSpec]) -> dict[str, Any]:
+    """
+    Read the current values of the table's parameters.
+
+    Parameters
+    ----------
+    node : rclpy.node.Node
+        The node, [-]
+    specs : iterable of ParamSpec
+        The table, [-]
+
+    Returns
+    -------
+    dict
+        Name -> value.
+
+    """
+    return {spec.name: node.get_parameter(spec.name).value for spec in specs}

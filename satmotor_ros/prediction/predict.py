@@ -1,0 +1,254 @@
+# SPDX-License-Identifier: Apache-2.0
+"""
+The prediction: inputs -> model call -> speed, losses, residual and status.
+
+:func:`predict_point` serves the live node (one snapshot per message, the model's
+single-point path ``speed_point``, a few microseconds) and :func:`predict_batch` serves bag
+replay (every driving time at once, the array path ``speed``). Both apply the same checks
+and levels to the same model, so a bag replayed gives the levels, statuses and messages
+the node published, and its numbers to 1e-12 (the two model paths agree to that).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numpy as np
+import numpy.typing as npt
+
+from satmotor_ros.model import COMPONENTS, describe_status, INVALID, MotorModel, PointStatus
+from satmotor_ros.prediction.rule import (describe_input, input_level, INPUTS, InputState,
+                                          Level, Snapshot, SnapshotBatch)
+
+OUTPUTS = ('dp', 'dp_i', 'p_ex', 'speed', *COMPONENTS, 'residual')
+"""Computed fields of a prediction (SI: Pa, rad/s, m^3/s), after the inputs."""
+
+_NOTED = PointStatus.STALLED | PointStatus.CHANNEL_LIMITED | PointStatus.EXTRAPOLATED
+_I_CASE = INPUTS.index('p_case')
+_I_SPEED = INPUTS.index('measured_speed')
+
+
+class Prediction(NamedTuple):
+    """One prediction: its inputs, the model's outputs and what is wrong, all SI."""
+
+    stamp_ns: int  # driving time [ns]
+    inputs: tuple[float, ...]  # values per INPUTS as used (NaN where missing) [SI]
+    outputs: tuple[float, ...]  # values per OUTPUTS; NaN where not computed [SI]
+    status: int  # PointStatus of the model; 0 when the model was not run
+    level: int  # a Level: OK, WARN (published, with a note) or ERROR (not published)
+    message: str  # 'OK' or the problems, each naming the field and the value
+
+    @property
+    def valid(self) -> bool:
+        """Whether the prediction may be published (its outputs are numbers)."""
+        return self.level < Level.ERROR
+
+    def output(self, name: str) -> float:
+        """
+        Return one output by name.
+
+        Parameters
+        ----------
+        name : str
+            One of :data:`OUTPUTS`, [-]
+
+        Returns
+        -------
+        float
+            Its value, [SI]
+
+        """
+        return self.outputs[OUTPUTS.index(name)]
+
+
+def _model_note(status: int, flow: float, dp: float) -> str:
+    return (f'model status {describe_status(status)} at flow_command.data = {flow!r} m^3/s, '
+            f'dp = {dp!r} Pa')
+
+
+def _messages(snap: Snapshot, timeout: float, status: int, dp: float) -> tuple[int, str]:
+    """Return the level and the message of a snapshot and its model status."""
+    level, notes = Level.OK, []
+    p_in = snap.values[INPUTS.index('p_in')]
+    for name, value, age, state in zip(INPUTS, snap.values, snap.ages, snap.states):
+        rated = input_level(name, state)
+        if rated:
+            level = max(level, rated)
+            notes.append(describe_input(name, state, value, age, timeout, p_in))
+    if level < Level.ERROR and status & int(_NOTED | INVALID):
+        level = max(level, Level.ERROR if status & INVALID else Level.WARN)
+        notes.append(_model_note(status, snap.values[0], dp))
+    return int(level), '; '.join(notes) if notes else 'OK'
+
+
+def _inputs_usable(states: tuple[int, ...]) -> bool:
+    return all(input_level(name, state) < Level.ERROR for name, state in zip(INPUTS, states))
+
+
+def predict_point(model: MotorModel, snap: Snapshot, timeout: float) -> Prediction:
+    """
+    Predict from one snapshot of the inputs (the live node's path).
+
+    Parameters
+    ----------
+    model : MotorModel
+        The motor model, [-]
+    snap : Snapshot
+        The inputs at the driving time, [-]
+    timeout : float
+        The input timeout, quoted in messages, [s]
+
+    Returns
+    -------
+    Prediction
+        Outputs and status; NaN outputs and level ERROR when no prediction may be made.
+
+    """
+    if not _inputs_usable(snap.states):
+        level, message = _messages(snap, timeout, 0, math.nan)
+        return Prediction(snap.stamp_ns, snap.values, (math.nan,) * len(OUTPUTS), 0, level,
+                          message)
+    flow, p_in, p_out = snap.values[0], snap.values[1], snap.values[2]
+    p_ex = snap.values[_I_CASE] if snap.states[_I_CASE] == InputState.FRESH else 0.0
+    dp = p_in - p_out
+    point = model.speed_point(flow, dp, p_ex=p_ex)
+    status = point.status
+    speed = point.speed
+    residual = (snap.values[_I_SPEED] - speed if snap.states[_I_SPEED] == InputState.FRESH
+                else math.nan)
+    level, message = _messages(snap, timeout, status, dp)
+    if level >= Level.ERROR:
+        return Prediction(snap.stamp_ns, snap.values, (math.nan,) * len(OUTPUTS), status,
+                          level, message)
+    outputs = (dp, point.dp_i, p_ex, speed, *(getattr(point, c) for c in COMPONENTS),
+               residual)
+    return Prediction(snap.stamp_ns, snap.values, outputs, status, level, message)
+
+
+class PredictionBatch(NamedTuple):
+    """Many predictions as arrays (see :class:`Prediction`)."""
+
+    snapshots: SnapshotBatch  # the inputs
+    outputs: npt.NDArray[np.float64]  # (len(OUTPUTS), n); NaN where level is ERROR [SI]
+    status: npt.NDArray[np.uint8]  # PointStatus per prediction (0 where not run)
+    level: npt.NDArray[np.uint8]  # Level per prediction
+    timeout: float  # the input timeout [s]
+
+    def __len__(self) -> int:
+        """Return the number of predictions."""
+        return len(self.level)
+
+    @property
+    def valid(self) -> npt.NDArray[np.bool_]:
+        """Mask of the predictions that would be published."""
+        return self.level < Level.ERROR
+
+    def output(self, name: str) -> npt.NDArray[np.float64]:
+        """
+        Return one output by name.
+
+        Parameters
+        ----------
+        name : str
+            One of :data:`OUTPUTS`, [-]
+
+        Returns
+        -------
+        ndarray
+            Its values, [SI]
+
+        """
+        return self.outputs[OUTPUTS.index(name)]
+
+    def snapshot(self, i: int) -> Snapshot:
+        """
+        Return the inputs of prediction `i` as the live node would hold them.
+
+        Parameters
+        ----------
+        i : int
+            Index of the prediction, [-]
+
+        Returns
+        -------
+        Snapshot
+            Its inputs.
+
+        """
+        s = self.snapshots
+        return Snapshot(int(s.stamp_ns[i]), tuple(float(v) for v in s.values[:, i]),
+                        tuple(float(a) for a in s.ages[:, i]),
+                        tuple(int(x) for x in s.states[:, i]))
+
+    def message(self, i: int) -> str:
+        """
+        Spell out prediction `i`'s problems, as :func:`predict_point` does.
+
+        Parameters
+        ----------
+        i : int
+            Index of the prediction, [-]
+
+        Returns
+        -------
+        str
+            ``'OK'`` or the problems.
+
+        """
+        dp = float(self.snapshots.values[1, i] - self.snapshots.values[2, i])
+        return _messages(self.snapshot(i), self.timeout, int(self.status[i]), dp)[1]
+
+
+def _level_table() -> npt.NDArray[np.uint8]:
+    table = np.zeros((len(INPUTS), max(InputState) + 1), dtype=np.uint8)
+    for i, name in enumerate(INPUTS):
+        for state in InputState:
+            table[i, state] = input_level(name, state)
+    return table
+
+
+_LEVELS = _level_table()
+
+
+def predict_batch(model: MotorModel, snaps: SnapshotBatch, timeout: float) -> PredictionBatch:
+    """
+    Predict from many snapshots at once (bag replay's path), as :func:`predict_point` would.
+
+    Parameters
+    ----------
+    model : MotorModel
+        The motor model, [-]
+    snaps : SnapshotBatch
+        The inputs at every driving time, [-]
+    timeout : float
+        The input timeout, quoted in messages, [s]
+
+    Returns
+    -------
+    PredictionBatch
+        Outputs, status and level per driving time.
+
+    """
+    values, states = snaps.values, snaps.states
+    n = values.shape[1]
+    level = np.zeros(n, dtype=np.uint8)
+    for i in range(len(INPUTS)):
+        np.maximum(level, _LEVELS[i][states[i]], out=level)
+    usable = level < Level.ERROR
+    flow = np.where(usable, values[0], 0.0)
+    dp = np.where(usable, values[1] - values[2], 0.0)
+    p_ex = np.where(usable & (states[_I_CASE] == InputState.FRESH), values[_I_CASE], 0.0)
+    op = model.speed(flow, dp, p_ex=p_ex, errors='mask')
+    status = np.where(usable, op.status, 0).astype(np.uint8)
+    model_level = np.where(status & int(INVALID), np.uint8(Level.ERROR),
+                           np.where(status & int(_NOTED), np.uint8(Level.WARN), np.uint8(0)))
+    np.maximum(level, model_level, out=level)
+    speed = op.speed
+    residual = np.where(states[_I_SPEED] == InputState.FRESH, values[_I_SPEED] - speed, np.nan)
+    columns = [dp, op.dp_i, p_ex, speed, *op.losses.as_dict().values(), residual]
+    outputs = np.empty((len(OUTPUTS), n))
+    for row, column in zip(outputs, columns):
+        row[:] = column
+    outputs[:, level >= Level.ERROR] = np.nan
+    return PredictionBatch(snaps, outputs, status, level, timeout)

@@ -1,0 +1,390 @@
+# SPDX-License-Identifier: Apache-2.0
+"""
+The combination rule: which inputs a prediction may use, and what is wrong with the others.
+
+Each input keeps its latest value and the time it arrived. A prediction is made at a
+driving time (every ``flow_command`` by default, or the ticks of a fixed rate) from the
+latest value of each input, provided it arrived no longer than the input timeout before
+the driving time and its value is valid. The live node (:class:`Combiner`, one message
+at a time) and bag replay (:func:`combine_batch`, whole arrays at once) apply the same
+rule; the tests check that they agree element by element.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+import enum
+import math
+from typing import NamedTuple
+
+import numpy as np
+import numpy.typing as npt
+
+INPUTS = ('flow', 'p_in', 'p_out', 'p_case', 'temperature', 'measured_speed')
+"""The inputs of a prediction, in the order of every per-input tuple and array."""
+
+TOPICS = {
+    'flow': 'flow_command', 'p_in': 'inlet_pressure', 'p_out': 'outlet_pressure',
+    'p_case': 'case_pressure', 'temperature': 'fluid_temperature',
+    'measured_speed': 'joint_states',
+}
+"""The topic (relative name, DESIGN.md) that carries each input."""
+
+UNITS = {'flow': 'm^3/s', 'p_in': 'Pa', 'p_out': 'Pa', 'p_case': 'Pa', 'temperature': 'degC',
+         'measured_speed': 'rad/s'}
+"""The SI unit of each input, as on its topic."""
+
+FIELDS = {'flow': 'flow_command.data', 'p_in': 'inlet_pressure.fluid_pressure',
+          'p_out': 'outlet_pressure.fluid_pressure', 'p_case': 'case_pressure.fluid_pressure',
+          'temperature': 'fluid_temperature.temperature',
+          'measured_speed': 'joint_states.velocity'}
+"""The message field each input is read from, as named in diagnostics."""
+
+REQUIRED = ('flow', 'p_in', 'p_out')
+"""Inputs without which no prediction is made."""
+
+NON_NEGATIVE = ('flow', 'p_in', 'p_out', 'p_case')
+"""Inputs whose negative values are invalid (flow into the motor, absolute pressures)."""
+
+MODES = ('on_flow', 'rate')
+"""Publish modes: on every flow_command, or at a fixed rate."""
+
+
+class Level(enum.IntEnum):
+    """Severity of a prediction's problems, as ``diagnostic_msgs/DiagnosticStatus`` levels."""
+
+    OK = 0
+    WARN = 1
+    ERROR = 2
+
+
+class InputState(enum.IntEnum):
+    """Why an input can or cannot be used at a driving time."""
+
+    FRESH = 0  # arrived within the timeout, value valid
+    MISSING = 1  # never arrived
+    STALE = 2  # older than the timeout
+    NOT_FINITE = 3  # NaN or inf
+    NEGATIVE = 4  # negative flow or absolute pressure
+    REVERSED = 5  # outlet pressure above inlet pressure
+
+
+@dataclass(frozen=True)
+class Rule:
+    """
+    When predictions are made and which inputs they may use.
+
+    Parameters
+    ----------
+    timeout : float
+        Oldest age of an input that a prediction may use, [s]
+    mode : {'on_flow', 'rate'}
+        Predict on every flow_command, or at a fixed rate, [-]
+    rate : float
+        Prediction rate in ``'rate'`` mode, [Hz]
+
+    """
+
+    timeout: float = 0.5  # [s]
+    mode: str = 'on_flow'  # 'on_flow' or 'rate'
+    rate: float = 50.0  # [Hz]
+
+    def __post_init__(self) -> None:
+        """Reject values the rule cannot run with, naming the field."""
+        if not (math.isfinite(self.timeout) and self.timeout > 0.0):
+            raise ValueError(f'timeout = {self.timeout!r} s: must be a finite value > 0')
+        if self.mode not in MODES:
+            raise ValueError(f'mode = {self.mode!r}: use one of {", ".join(MODES)}')
+        if not (math.isfinite(self.rate) and 0.0 < self.rate <= 10000.0):
+            raise ValueError(f'rate = {self.rate!r} Hz: must be in (0, 10000]')
+
+    @property
+    def timeout_ns(self) -> int:
+        """Return the timeout in integer nanoseconds, [ns]."""
+        return int(round(self.timeout * 1e9))
+
+    @property
+    def period_ns(self) -> int:
+        """Return the prediction period in ``'rate'`` mode, [ns]."""
+        return int(round(1e9 / self.rate))
+
+
+def check_value(name: str, value: float) -> InputState:
+    """
+    Check one input value (scalar form of :func:`check_values`).
+
+    Parameters
+    ----------
+    name : str
+        Input name, one of :data:`INPUTS`, [-]
+    value : float
+        Its value, [unit of the input]
+
+    Returns
+    -------
+    InputState
+        FRESH, NOT_FINITE or NEGATIVE.
+
+    """
+    if not math.isfinite(value):
+        return InputState.NOT_FINITE
+    if value < 0.0 and name in NON_NEGATIVE:
+        return InputState.NEGATIVE
+    return InputState.FRESH
+
+
+def check_values(name: str, values: npt.NDArray[np.float64]) -> npt.NDArray[np.uint8]:
+    """
+    Check input values element by element (array form of :func:`check_value`).
+
+    Parameters
+    ----------
+    name : str
+        Input name, one of :data:`INPUTS`, [-]
+    values : ndarray
+        Its values, [unit of the input]
+
+    Returns
+    -------
+    ndarray of uint8
+        An :class:`InputState` per element.
+
+    """
+    states = np.where(np.isfinite(values), np.uint8(InputState.FRESH),
+                      np.uint8(InputState.NOT_FINITE)).astype(np.uint8)
+    if name in NON_NEGATIVE:
+        states[(values < 0.0) & (states == InputState.FRESH)] = InputState.NEGATIVE
+    return states
+
+
+class Snapshot(NamedTuple):
+    """The inputs of one prediction: the latest value, age and state of each."""
+
+    stamp_ns: int  # driving time [ns]
+    values: tuple[float, ...]  # per input of INPUTS; NaN when missing [unit of the input]
+    ages: tuple[float, ...]  # per input: driving time minus arrival; NaN when missing [s]
+    states: tuple[int, ...]  # per input: an InputState
+
+
+def _pressure_order(states: list[int], values: tuple[float, ...] | list[float]) -> None:
+    i_in, i_out = INPUTS.index('p_in'), INPUTS.index('p_out')
+    if states[i_in] == InputState.FRESH and states[i_out] == InputState.FRESH \
+            and values[i_out] > values[i_in]:
+        states[i_out] = InputState.REVERSED
+
+
+class Combiner:
+    """
+    The rule applied live: keep each input's latest value, snapshot at a driving time.
+
+    Parameters
+    ----------
+    rule : Rule
+        Timeout and mode, [-]
+
+    """
+
+    def __init__(self, rule: Rule) -> None:
+        """Start with no input received."""
+        self.rule = rule
+        self._values = [math.nan] * len(INPUTS)
+        self._times: list[int | None] = [None] * len(INPUTS)
+
+    def update(self, name: str, value: float, t_ns: int) -> None:
+        """
+        Record the latest value of an input.
+
+        Parameters
+        ----------
+        name : str
+            Input name, one of :data:`INPUTS`, [-]
+        value : float
+            The value, [unit of the input]
+        t_ns : int
+            Arrival time on the node's clock, [ns]
+
+        """
+        i = INPUTS.index(name)
+        self._values[i] = float(value)
+        self._times[i] = int(t_ns)
+
+    def snapshot(self, t_ns: int) -> Snapshot:
+        """
+        Take the inputs a prediction at time `t_ns` may use.
+
+        Parameters
+        ----------
+        t_ns : int
+            Driving time on the node's clock, [ns]
+
+        Returns
+        -------
+        Snapshot
+            Values, ages and states of every input.
+
+        """
+        timeout_ns = self.rule.timeout_ns
+        states, ages = [], []
+        for name, value, t in zip(INPUTS, self._values, self._times):
+            if t is None:
+                states.append(InputState.MISSING)
+                ages.append(math.nan)
+                continue
+            age = t_ns - t
+            ages.append(age * 1e-9)
+            states.append(InputState.STALE if age > timeout_ns else check_value(name, value))
+        _pressure_order(states, self._values)
+        return Snapshot(int(t_ns), tuple(self._values), tuple(ages), tuple(states))
+
+
+class SnapshotBatch(NamedTuple):
+    """The inputs of many predictions, as arrays (see :class:`Snapshot`)."""
+
+    stamp_ns: npt.NDArray[np.int64]  # driving times [ns]
+    values: npt.NDArray[np.float64]  # (len(INPUTS), n) [unit of the input]
+    ages: npt.NDArray[np.float64]  # (len(INPUTS), n) [s]
+    states: npt.NDArray[np.uint8]  # (len(INPUTS), n) InputState
+
+
+def driving_times(rule: Rule, flow_t_ns: npt.NDArray[np.int64], first_ns: int,
+                  last_ns: int) -> npt.NDArray[np.int64]:
+    """
+    Return the times at which predictions are made over a recording.
+
+    Parameters
+    ----------
+    rule : Rule
+        The rule, [-]
+    flow_t_ns : ndarray of int64
+        Arrival times of flow_command, [ns]
+    first_ns, last_ns : int
+        Times of the first and last message of the recording, [ns]
+
+    Returns
+    -------
+    ndarray of int64
+        Every flow_command's time (``'on_flow'``), or ticks of the rate from the first
+        message on (``'rate'``), [ns]
+
+    """
+    if rule.mode == 'on_flow':
+        return np.asarray(flow_t_ns, dtype=np.int64).copy()
+    if last_ns < first_ns:
+        return np.zeros(0, dtype=np.int64)
+    return np.arange(first_ns, last_ns + 1, rule.period_ns, dtype=np.int64)
+
+
+def combine_batch(rule: Rule, stamps_ns: npt.NDArray[np.int64],
+                  inputs: dict[str, tuple[npt.NDArray[np.int64], npt.NDArray[np.float64]]],
+                  ) -> SnapshotBatch:
+    """
+    Apply the rule to whole recorded series at once (what the live node does per message).
+
+    An input recorded at the same nanosecond as a driving time counts as received before it.
+
+    Parameters
+    ----------
+    rule : Rule
+        Timeout, [-]
+    stamps_ns : ndarray of int64
+        Driving times, ascending, [ns]
+    inputs : dict
+        Input name -> (arrival times ascending [ns], values [unit of the input]); absent
+        inputs never arrived, [-]
+
+    Returns
+    -------
+    SnapshotBatch
+        Values, ages and states per input and driving time.
+
+    """
+    n = len(stamps_ns)
+    values = np.full((len(INPUTS), n), np.nan)
+    ages = np.full((len(INPUTS), n), np.nan)
+    states = np.full((len(INPUTS), n), InputState.MISSING, dtype=np.uint8)
+    for i, name in enumerate(INPUTS):
+        if name not in inputs or len(inputs[name][0]) == 0:
+            continue
+        t, v = inputs[name]
+        idx = np.searchsorted(t, stamps_ns, side='right') - 1
+        seen = idx >= 0
+        at = np.where(seen, idx, 0)
+        age_ns = stamps_ns - t[at]
+        values[i] = np.where(seen, v[at], np.nan)
+        ages[i] = np.where(seen, age_ns * 1e-9, np.nan)
+        state = check_values(name, values[i])
+        state[age_ns > rule.timeout_ns] = InputState.STALE
+        state[~seen] = InputState.MISSING
+        states[i] = state
+    i_in, i_out = INPUTS.index('p_in'), INPUTS.index('p_out')
+    reversed_ = (states[i_in] == InputState.FRESH) & (states[i_out] == InputState.FRESH) \
+        & (values[i_out] > values[i_in])
+    states[i_out][reversed_] = InputState.REVERSED
+    return SnapshotBatch(np.asarray(stamps_ns, dtype=np.int64), values, ages, states)
+
+
+def input_level(name: str, state: int) -> Level:
+    """
+    Rate an input's state: what it means for the prediction.
+
+    Parameters
+    ----------
+    name : str
+        Input name, [-]
+    state : int
+        Its :class:`InputState`, [-]
+
+    Returns
+    -------
+    Level
+        ERROR when no prediction may be made, WARN when it is made without this input.
+
+    """
+    if state == InputState.FRESH:
+        return Level.OK
+    if name in REQUIRED:
+        return Level.ERROR
+    if state == InputState.MISSING:
+        return Level.OK  # optional input not published: not a problem
+    return Level.ERROR if name == 'p_case' else Level.WARN
+
+
+def describe_input(name: str, state: int, value: float, age: float, timeout: float,
+                   p_in: float = math.nan) -> str:
+    """
+    Spell out what is wrong with an input, naming the field and the value.
+
+    Parameters
+    ----------
+    name : str
+        Input name, [-]
+    state : int
+        Its :class:`InputState`, [-]
+    value : float
+        Its latest value, [unit of the input]
+    age : float
+        Its age at the driving time, [s]
+    timeout : float
+        The input timeout, [s]
+    p_in : float
+        The inlet pressure, quoted when the outlet pressure is above it, [Pa]
+
+    Returns
+    -------
+    str
+        One line, e.g. ``'inlet_pressure.fluid_pressure = nan Pa: not finite'``.
+
+    """
+    field, unit = FIELDS[name], UNITS[name]
+    if state == InputState.MISSING:
+        return f'{TOPICS[name]}: no message received'
+    if state == InputState.STALE:
+        return f'{TOPICS[name]}: last message {age:.3g} s old (input_timeout {timeout:g} s)'
+    if state == InputState.NOT_FINITE:
+        return f'{field} = {value!r} {unit}: not finite'
+    if state == InputState.NEGATIVE:
+        return f'{field} = {value!r} {unit}: negative'
+    if state == InputState.REVERSED:
+        return (f'{field} = {value!r} {unit} is above {FIELDS["p_in"]} = {p_in!r} Pa: '
+                f'the pressure drop would be negative')
+    return f'{field} = {value!r} {unit}: ok'

@@ -1,0 +1,240 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Bags written and read back: the fast decoder against rosbags, matching, errors."""
+
+from pathlib import Path
+import shutil
+
+import numpy as np
+import pytest
+from rosbags.highlevel import AnyReader
+from rosbags.rosbag2 import CompressionFormat, CompressionMode, StoragePlugin, Writer
+from rosbags.typesys import get_typestore, Stores
+from satmotor_ros.bags import (BagError, decode, encode_many, encode_message, FLOAT64,
+                               FLUID_PRESSURE, JOINT_STATE, list_topics, match_topics,
+                               missing_topics, OutTopic, parse_topic_map, read_series,
+                               TEMPERATURE, write_bag)
+import yaml
+
+TYPESTORE = get_typestore(Stores.ROS2_KILTED)
+N = 200
+
+
+def _inputs(rng, prefix='/'):
+    """Return OutTopics of the four input topics with random values and frame ids."""
+    t0 = 1_700_000_000_000_000_000
+    t = t0 + np.cumsum(rng.integers(1, 20_000_000, size=(4, N)), axis=1)
+    flow = rng.uniform(0, 6e-4, N)
+    p_in = rng.uniform(1e6, 3e7, N)
+    p_out = rng.uniform(1e5, 1e6, N)
+    speed = rng.uniform(0, 150, N)
+    return {
+        'flow': flow, 'p_in': p_in, 'p_out': p_out, 'speed': speed, 't': t,
+        'topics': [
+            OutTopic(prefix + 'flow_command', FLOAT64, t[0],
+                     encode_many(FLOAT64, {'data': flow})),
+            OutTopic(prefix + 'inlet_pressure', FLUID_PRESSURE, t[1], encode_many(
+                FLUID_PRESSURE, {'fluid_pressure': p_in, 'variance': np.full(N, 4.0)},
+                t[1] - 5, frame_id='inlet')),
+            OutTopic(prefix + 'outlet_pressure', FLUID_PRESSURE, t[2], encode_many(
+                FLUID_PRESSURE, {'fluid_pressure': p_out}, t[2] - 5)),
+            OutTopic(prefix + 'joint_states', JOINT_STATE, t[3], encode_many(
+                JOINT_STATE, {'position': speed * 2, 'velocity': speed}, t[3],
+                joint='motor_shaft')),
+        ]}
+
+
+@pytest.mark.parametrize('storage', ['mcap', 'sqlite3'])
+def test_written_bag_reads_back_exactly_and_as_rosbags_reads_it(tmp_path, storage):
+    """Test values, log times and stamps survive a round trip, and rosbags agrees."""
+    data = _inputs(np.random.default_rng(1))
+    bag = tmp_path / 'bag'
+    assert write_bag(bag, data['topics'], storage=storage) == 4 * N
+    series = read_series(bag, ['flow_command', 'inlet_pressure', 'outlet_pressure',
+                               'joint_states'])
+    np.testing.assert_array_equal(series['flow_command'].fields['data'], data['flow'])
+    np.testing.assert_array_equal(series['flow_command'].t_ns, data['t'][0])
+    assert series['flow_command'].stamp_ns is None
+    np.testing.assert_array_equal(series['inlet_pressure'].fields['fluid_pressure'],
+                                  data['p_in'])
+    np.testing.assert_array_equal(series['inlet_pressure'].fields['variance'], 4.0)
+    np.testing.assert_array_equal(series['inlet_pressure'].stamp_ns, data['t'][1] - 5)
+    np.testing.assert_array_equal(series['outlet_pressure'].fields['fluid_pressure'],
+                                  data['p_out'])
+    np.testing.assert_array_equal(series['joint_states'].fields['velocity'], data['speed'])
+    np.testing.assert_array_equal(series['joint_states'].fields['position'], 2 * data['speed'])
+    assert np.isnan(series['joint_states'].fields['effort']).all()
+    with AnyReader([bag], default_typestore=TYPESTORE) as reader:
+        seen = {}
+        for conn, t, raw in reader.messages():
+            seen.setdefault(conn.topic, []).append((t, reader.deserialize(raw, conn.msgtype)))
+    assert [m.fluid_pressure for _, m in seen['/inlet_pressure']] == data['p_in'].tolist()
+    assert [m.header.frame_id for _, m in seen['/inlet_pressure']] == ['inlet'] * N
+    assert [m.velocity[0] for _, m in seen['/joint_states']] == data['speed'].tolist()
+    assert [t for t, _ in seen['/flow_command']] == data['t'][0].tolist()
+
+
+def test_decoder_equals_rosbags_on_mixed_layouts_and_endianness():
+    """Test frame ids, joint orders and big-endian messages mixed in one topic."""
+    js, hdr, tm = (TYPESTORE.types[n] for n in (
+        JOINT_STATE, 'std_msgs/msg/Header', 'builtin_interfaces/msg/Time'))
+    rng = np.random.default_rng(2)
+    msgs = []
+    for i in range(60):
+        names = [['motor_shaft'], ['a', 'motor_shaft'], ['motor_shaft', 'b'], ['zz']][i % 4]
+        k = len(names)
+        msg = js(header=hdr(stamp=tm(sec=i, nanosec=7 * i), frame_id=['', 'x', 'y'][i % 3]),
+                 name=names, position=rng.normal(size=k), velocity=rng.normal(size=k),
+                 effort=rng.normal(size=k) if i % 5 else np.zeros(0))
+        msgs.append((msg, bytes(TYPESTORE.serialize_cdr(msg, JOINT_STATE,
+                                                        little_endian=bool(i % 7)))))
+    decoded = decode(JOINT_STATE, [raw for _, raw in msgs], 'motor_shaft')
+    expected = [m for m, _ in msgs if 'motor_shaft' in m.name]
+    assert decoded.keep.sum() == len(expected) == 45
+    for name in ('position', 'velocity', 'effort'):
+        want = [getattr(m, name)[m.name.index('motor_shaft')]
+                if len(getattr(m, name)) else np.nan for m in expected]
+        np.testing.assert_array_equal(decoded.fields[name], want)
+    np.testing.assert_array_equal(decoded.stamp_ns, [m.header.stamp.sec * 10**9
+                                                     + m.header.stamp.nanosec
+                                                     for m in expected])
+
+
+def test_encoder_is_byte_identical_to_rosbags():
+    fp = TYPESTORE.types[FLUID_PRESSURE]
+    hdr = TYPESTORE.types['std_msgs/msg/Header']
+    tm = TYPESTORE.types['builtin_interfaces/msg/Time']
+    msg = fp(header=hdr(stamp=tm(sec=3, nanosec=9), frame_id='abc'), fluid_pressure=2.5e7,
+             variance=0.5)
+    assert encode_message(FLUID_PRESSURE, {'fluid_pressure': 2.5e7, 'variance': 0.5},
+                          3_000_000_009, 'abc') == bytes(TYPESTORE.serialize_cdr(msg,
+                                                                                 FLUID_PRESSURE))
+    temp = TYPESTORE.types[TEMPERATURE](
+        header=hdr(stamp=tm(sec=1, nanosec=0), frame_id=''), temperature=-4.0, variance=0.0)
+    assert encode_many(TEMPERATURE, {'temperature': [-4.0]}, [10**9])[0] == \
+        bytes(TYPESTORE.serialize_cdr(temp, TEMPERATURE))
+
+
+def test_decoder_rejects_garbage_with_one_line():
+    with pytest.raises(BagError, match='truncated'):
+        decode(FLUID_PRESSURE, [b'\x00\x01\x00\x00\x01\x00'])
+    with pytest.raises(BagError, match='not a CDR message'):
+        decode(FLOAT64, [b'\xff\xff\x00\x00' + bytes(8)])
+    with pytest.raises(BagError, match='no fast decoder'):
+        decode('std_msgs/msg/String', [b''])
+
+
+def test_names_match_with_or_without_namespace_and_can_be_renamed():
+    bag = ['/flow_command', '/m1/inlet_pressure', '/m2/inlet_pressure', 'outlet_pressure']
+    assert match_topics(bag, ['flow_command', 'outlet_pressure']) == {
+        'flow_command': '/flow_command', 'outlet_pressure': 'outlet_pressure'}
+    with pytest.raises(BagError, match='inlet_pressure matches several topics '
+                                       r'\(/m1/inlet_pressure, /m2/inlet_pressure\)'):
+        match_topics(bag, ['inlet_pressure'])
+    assert match_topics(bag, ['/m2/inlet_pressure']) == {
+        '/m2/inlet_pressure': '/m2/inlet_pressure'}
+    renamed = parse_topic_map(['/m1/inlet_pressure:=inlet_pressure'])
+    assert match_topics(bag, ['inlet_pressure'], renamed) == {
+        'inlet_pressure': '/m1/inlet_pressure'}
+    with pytest.raises(BagError, match='/nope is not in the bag'):
+        match_topics(bag, ['x'], {'/nope': 'x'})
+    with pytest.raises(BagError, match="--topic-map 'a=b': use OLD:=NEW"):
+        parse_topic_map(['a=b'])
+
+
+def test_namespaced_bag_reads_and_reports_missing_topics(tmp_path):
+    data = _inputs(np.random.default_rng(3), prefix='/motor1/')
+    write_bag(tmp_path / 'bag', data['topics'][:2])
+    series = read_series(tmp_path / 'bag', ['flow_command', 'inlet_pressure',
+                                            'outlet_pressure'])
+    assert series['inlet_pressure'].topic == '/motor1/inlet_pressure'
+    assert missing_topics(series, ['flow_command', 'outlet_pressure', 'case_pressure']) == [
+        'outlet_pressure', 'case_pressure']
+
+
+def test_wrong_type_on_a_design_topic_is_named(tmp_path):
+    write_bag(tmp_path / 'bag', [OutTopic('/inlet_pressure', FLOAT64, np.array([1]),
+                                          encode_many(FLOAT64, {'data': [1.0]}))])
+    with pytest.raises(BagError, match='inlet_pressure .* is std_msgs/msg/Float64; expected '
+                                       'sensor_msgs/msg/FluidPressure'):
+        read_series(tmp_path / 'bag', ['inlet_pressure'])
+
+
+def _rosbags_bag(path, mode=None, storage=StoragePlugin.SQLITE3):
+    """Write a small bag with rosbags' own writer, optionally zstd-compressed."""
+    writer = Writer(path, version=8, storage_plugin=storage)
+    if mode is not None:
+        writer.set_compression(mode, CompressionFormat.ZSTD)
+    with writer:
+        conn = writer.add_connection('/flow_command', FLOAT64, typestore=TYPESTORE)
+        for i in range(10):
+            writer.write(conn, 100 + i, encode_message(FLOAT64, {'data': float(i)}))
+
+
+@pytest.mark.parametrize('mode', [None, CompressionMode.FILE, CompressionMode.MESSAGE])
+def test_compressed_bags_read(tmp_path, mode):
+    _rosbags_bag(tmp_path / 'bag', mode)
+    series = read_series(tmp_path / 'bag', ['flow_command'])
+    assert series['flow_command'].fields['data'].tolist() == list(map(float, range(10)))
+
+
+def test_bag_without_metadata_reads_from_its_storage_files(tmp_path):
+    _rosbags_bag(tmp_path / 'bag')
+    (tmp_path / 'bag' / 'metadata.yaml').unlink()
+    assert len(read_series(tmp_path / 'bag', ['flow_command'])['flow_command']) == 10
+    db3 = next((tmp_path / 'bag').glob('*.db3'))
+    assert len(read_series(db3, ['flow_command'])['flow_command']) == 10
+
+
+def _edit_metadata(bag: Path, edit):
+    meta = bag / 'metadata.yaml'
+    doc = yaml.safe_load(meta.read_text())
+    edit(doc['rosbag2_bagfile_information'])
+    meta.write_text(yaml.safe_dump(doc))
+
+
+@pytest.mark.parametrize(('edit', 'text'), [
+    (lambda d: d['topics_with_message_count'][0].update(message_count=11),
+     'metadata.yaml and storage disagree: /flow_command has 11 messages in metadata.yaml '
+     'and 10 in'),
+    (lambda d: d['topics_with_message_count'][0]['topic_metadata'].update(
+        type='std_msgs/msg/Float32'),
+     '/flow_command is std_msgs/msg/Float32 in metadata.yaml and std_msgs/msg/Float64 in'),
+    (lambda d: d.update(relative_file_paths=['gone.db3']), "lists 'gone.db3', which is not"),
+    (lambda d: d.update(storage_identifier='mcap'),
+     "storage_identifier is 'mcap' but .* is sqlite3"),
+    (lambda d: d.update(storage_identifier='rosbag_v1'), "'rosbag_v1' is not supported"),
+    (lambda d: d.pop('relative_file_paths'), "missing or malformed 'relative_file_paths'"),
+])
+def test_metadata_that_disagrees_with_storage_is_one_clear_error(tmp_path, edit, text):
+    _rosbags_bag(tmp_path / 'bag')
+    _edit_metadata(tmp_path / 'bag', edit)
+    with pytest.raises(BagError, match=text) as err:
+        read_series(tmp_path / 'bag', ['flow_command'])
+    assert '\n' not in str(err.value)
+
+
+def test_truncated_mcap_and_missing_bag_are_errors(tmp_path):
+    write_bag(tmp_path / 'bag', _inputs(np.random.default_rng(4))['topics'])
+    mcap = next((tmp_path / 'bag').glob('*.mcap'))
+    cut = tmp_path / 'cut'
+    cut.mkdir()
+    (cut / 'x.mcap').write_bytes(mcap.read_bytes()[:3000])
+    with pytest.raises(BagError, match='x.mcap: truncated'):
+        list_topics(cut)
+    with pytest.raises(BagError, match='no such bag'):
+        list_topics(tmp_path / 'nothing')
+    with pytest.raises(BagError, match='already exists'):
+        write_bag(tmp_path / 'bag', [])
+    shutil.rmtree(tmp_path / 'bag')
+
+
+@pytest.mark.parametrize('storage', [StoragePlugin.SQLITE3, StoragePlugin.MCAP])
+def test_messages_stored_out_of_order_come_back_in_log_time_order(tmp_path, storage):
+    with Writer(tmp_path / 'bag', version=9, storage_plugin=storage) as writer:
+        conn = writer.add_connection('/inlet_pressure', FLUID_PRESSURE, typestore=TYPESTORE)
+        for t in (30, 10, 20, 10):
+            writer.write(conn, t, encode_message(FLUID_PRESSURE, {'fluid_pressure': t * 1.0},
+                                                 frame_id='a' * (t // 10)))
+    series = read_series(tmp_path / 'bag', ['inlet_pressure'])['inlet_pressure']
+    assert series.t_ns.tolist() == [10, 10, 20, 30]
+    assert series.fields['fluid_pressure'].tolist() == [10.0, 10.0, 20.0, 30.0]

@@ -1,0 +1,213 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The combination rule and the prediction, shared by the node and replay (no ROS)."""
+
+import dataclasses
+import math
+
+from hypothesis import given, settings
+from hypothesis import strategies as st
+import numpy as np
+import pytest
+
+from satmotor_ros.model import CoefficientSet, MotorModel, PointStatus
+from satmotor_ros.model.units import LPM, MPA
+from satmotor_ros.prediction import (check_value, check_values, combine_batch, Combiner,
+                                     driving_times, INPUTS, Level, predict_batch,
+                                     predict_point, Rule)
+
+OIL = MotorModel.default('oil')
+RULE = Rule(timeout=0.5)
+MS = 1_000_000  # one millisecond [ns]
+
+
+def _combiner(**inputs):
+    """Return a Combiner holding `inputs` (name -> (value, t_ns))."""
+    combiner = Combiner(RULE)
+    for name, (value, t_ns) in inputs.items():
+        combiner.update(name, value, t_ns)
+    return combiner
+
+
+def _good(**overrides):
+    inputs = {'p_in': (20 * MPA, 0), 'p_out': (0.2 * MPA, 0), 'flow': (20 * LPM, 10 * MS)}
+    inputs.update(overrides)
+    return _combiner(**inputs)
+
+
+def test_prediction_equals_the_library_for_the_same_inputs():
+    pred = predict_point(OIL, _good().snapshot(10 * MS), RULE.timeout)
+    op = OIL.speed(20 * LPM, 19.8 * MPA)
+    assert pred.level == Level.OK and pred.message == 'OK' and pred.valid
+    assert pred.output('speed') == pytest.approx(float(op.speed), rel=1e-14)
+    assert pred.output('dp') == 19.8 * MPA
+    for name, value in op.losses.as_dict().items():
+        assert pred.output(name) == pytest.approx(float(value), rel=1e-14, abs=0.0)
+    assert math.isnan(pred.output('residual'))
+    assert pred.stamp_ns == 10 * MS
+
+
+@pytest.mark.parametrize(('name', 'value', 'text'), [
+    ('p_in', math.nan, 'inlet_pressure.fluid_pressure = nan Pa: not finite'),
+    ('flow', math.inf, 'flow_command.data = inf m^3/s: not finite'),
+    ('p_out', -3.0, 'outlet_pressure.fluid_pressure = -3.0 Pa: negative'),
+    ('flow', -1e-4, 'flow_command.data = -0.0001 m^3/s: negative'),
+    ('p_out', 25 * MPA, 'outlet_pressure.fluid_pressure = 25000000.0 Pa is above '
+                        'inlet_pressure.fluid_pressure = 20000000.0 Pa'),
+    ('p_case', math.nan, 'case_pressure.fluid_pressure = nan Pa: not finite'),
+])
+def test_bad_input_gives_no_prediction_and_names_field_and_value(name, value, text):
+    pred = predict_point(OIL, _good(**{name: (value, 5 * MS)}).snapshot(10 * MS), RULE.timeout)
+    assert pred.level == Level.ERROR and not pred.valid
+    assert text in pred.message
+    assert all(math.isnan(v) for v in pred.outputs)
+
+
+def test_missing_and_stale_inputs_give_no_prediction():
+    combiner = _combiner(flow=(20 * LPM, 0), p_in=(20 * MPA, 0))
+    pred = predict_point(OIL, combiner.snapshot(0), RULE.timeout)
+    assert pred.level == Level.ERROR and 'outlet_pressure: no message received' in pred.message
+    combiner.update('p_out', 1 * MPA, 0)
+    combiner.update('flow', 20 * LPM, 600 * MS)
+    pred = predict_point(OIL, combiner.snapshot(600 * MS), RULE.timeout)
+    assert pred.level == Level.ERROR
+    assert pred.message == ('inlet_pressure: last message 0.6 s old (input_timeout 0.5 s); '
+                            'outlet_pressure: last message 0.6 s old (input_timeout 0.5 s)')
+    combiner.update('p_in', 20 * MPA, 601 * MS)
+    combiner.update('p_out', 1 * MPA, 601 * MS)
+    assert predict_point(OIL, combiner.snapshot(601 * MS), RULE.timeout).level == Level.OK
+
+
+def test_input_exactly_at_the_timeout_is_still_used():
+    pred = predict_point(OIL, _good(flow=(20 * LPM, 500 * MS)).snapshot(500 * MS), RULE.timeout)
+    assert pred.level == Level.OK  # the pressures are exactly 0.5 s old
+    pred = predict_point(OIL, _good(flow=(20 * LPM, 500 * MS)).snapshot(500 * MS + 1),
+                         RULE.timeout)
+    assert pred.level == Level.ERROR and 'inlet_pressure: last message' in pred.message
+
+
+def test_zero_flow_is_a_stalled_motor_published_with_a_warning():
+    pred = predict_point(OIL, _good(flow=(0.0, 10 * MS)).snapshot(10 * MS), RULE.timeout)
+    assert pred.level == Level.WARN and pred.valid
+    assert pred.output('speed') == 0.0 and pred.status & PointStatus.STALLED
+    assert 'STALLED' in pred.message and 'flow_command.data = 0.0' in pred.message
+
+
+def test_pressure_beyond_the_model_limit_is_an_error_with_the_model_status():
+    pred = predict_point(OIL, _good(p_in=(60 * MPA, 0)).snapshot(10 * MS), RULE.timeout)
+    assert pred.level == Level.ERROR and pred.status & PointStatus.BEYOND_LIMIT
+    assert 'BEYOND_LIMIT' in pred.message and 'dp = 59800000.0 Pa' in pred.message
+    assert math.isnan(pred.output('speed'))
+
+
+def test_extrapolated_point_is_published_with_a_warning():
+    pred = predict_point(OIL, _good(p_in=(40 * MPA, 0)).snapshot(10 * MS), RULE.timeout)
+    assert pred.level == Level.WARN and pred.status & PointStatus.EXTRAPOLATED
+    assert pred.output('speed') > 0.0
+
+
+def test_case_pressure_drives_external_leakage_and_blocks_when_stale():
+    spec_set = OIL.coefficient_set
+    leaky = MotorModel(OIL.geometry, CoefficientSet(
+        spec_set.name, spec_set.liquid,
+        dataclasses.replace(spec_set.coefficients, external_leakage=1e-12)), OIL.valid_range)
+    pred = predict_point(leaky, _good(p_case=(0.5 * MPA, 5 * MS)).snapshot(10 * MS),
+                         RULE.timeout)
+    assert pred.output('p_ex') == 0.5 * MPA
+    assert pred.output('external') == pytest.approx(1e-12 * 0.5 * MPA, rel=1e-12)
+    ref = leaky.speed(20 * LPM, 19.8 * MPA, p_ex=0.5 * MPA)
+    assert pred.output('speed') == pytest.approx(float(ref.speed), rel=1e-14)
+    without = predict_point(leaky, _good().snapshot(10 * MS), RULE.timeout)
+    assert without.output('p_ex') == 0.0 and without.output('speed') > pred.output('speed')
+    stale = predict_point(leaky, _good(p_case=(0.5 * MPA, 0)).snapshot(900 * MS),
+                          RULE.timeout)
+    assert stale.level == Level.ERROR and 'case_pressure: last message' in stale.message
+
+
+def test_measured_speed_gives_the_residual_and_its_absence_only_a_warning():
+    pred = predict_point(OIL, _good(measured_speed=(50.0, 8 * MS)).snapshot(10 * MS),
+                         RULE.timeout)
+    assert pred.output('residual') == 50.0 - pred.output('speed')
+    stale = predict_point(OIL, _good(measured_speed=(50.0, 0), flow=(20 * LPM, 700 * MS),
+                                     p_in=(20 * MPA, 700 * MS), p_out=(0.2 * MPA, 700 * MS))
+                          .snapshot(700 * MS), RULE.timeout)
+    assert stale.level == Level.WARN and stale.valid and math.isnan(stale.output('residual'))
+    assert 'joint_states: last message 0.7 s old' in stale.message
+    odd_temp = predict_point(OIL, _good(temperature=(math.nan, 1)).snapshot(10 * MS),
+                             RULE.timeout)
+    assert odd_temp.level == Level.WARN and 'fluid_temperature.temperature = nan' \
+        in odd_temp.message
+
+
+@pytest.mark.parametrize(('kwargs', 'text'), [
+    ({'timeout': 0.0}, 'timeout = 0.0 s'), ({'timeout': math.nan}, 'timeout = nan'),
+    ({'mode': 'sometimes'}, "mode = 'sometimes'"), ({'rate': -1.0}, 'rate = -1.0 Hz'),
+])
+def test_rule_rejects_bad_settings_naming_them(kwargs, text):
+    with pytest.raises(ValueError, match=text):
+        Rule(**kwargs)
+
+
+def test_driving_times_follow_the_mode():
+    flow_t = np.array([5, 17, 30], dtype=np.int64)
+    on_flow = driving_times(Rule(), flow_t, 0, 40)
+    assert on_flow.tolist() == [5, 17, 30] and on_flow is not flow_t
+    ticks = driving_times(Rule(mode='rate', rate=100.0), flow_t, 0, 40 * MS)
+    assert ticks.tolist() == [0, 10 * MS, 20 * MS, 30 * MS, 40 * MS]
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.floats(allow_nan=True, allow_infinity=True), st.sampled_from(INPUTS))
+def test_scalar_and_array_value_checks_agree(value, name):
+    assert check_values(name, np.array([value]))[0] == check_value(name, value)
+
+
+def _random_events(rng, n):
+    """
+    Return time-ordered (name, value, t_ns) events with bad values, gaps and repeats.
+
+    Times strictly increase: the order of messages logged in the same nanosecond is the
+    rule's one documented ambiguity (replay counts them as before the driving message).
+    """
+    names = ['flow', 'p_in', 'p_out', 'p_case', 'temperature', 'measured_speed']
+    weights = np.array([4, 3, 3, 1, 1, 2], dtype=float)
+    t, events = 0, []
+    for _ in range(n):
+        t += int(rng.choice([1000, 1 * MS, 20 * MS, 300 * MS, 800 * MS], p=[.1, .5, .3, .07, .03]))
+        name = names[rng.choice(len(names), p=weights / weights.sum())]
+        scale = {'flow': 40 * LPM, 'p_in': 30 * MPA, 'p_out': 3 * MPA, 'p_case': 1 * MPA,
+                 'temperature': 60.0, 'measured_speed': 150.0}[name]
+        value = float(rng.choice([rng.uniform(0, 1), 0.0, -0.1, math.nan, math.inf, 2.0],
+                                 p=[.8, .04, .04, .04, .04, .04])) * scale
+        events.append((name, value, t))
+    return events
+
+
+@pytest.mark.parametrize('seed', range(6))
+def test_live_rule_and_batch_rule_give_identical_predictions(seed):
+    """The node's per-message path and replay's array path agree (model paths to 1e-12)."""
+    rng = np.random.default_rng(seed)
+    events = _random_events(rng, 400)
+    combiner, live, snaps = Combiner(RULE), [], []
+    for name, value, t in events:
+        combiner.update(name, value, t)
+        if name == 'flow':
+            snaps.append(combiner.snapshot(t))
+            live.append(predict_point(OIL, snaps[-1], RULE.timeout))
+    series = {}
+    for name in INPUTS:
+        mine = [(t, v) for n, v, t in events if n == name]
+        series[name] = (np.array([t for t, _ in mine], dtype=np.int64),
+                        np.array([v for _, v in mine]))
+    stamps = driving_times(RULE, series['flow'][0], events[0][2], events[-1][2])
+    batch = predict_batch(OIL, combine_batch(RULE, stamps, series), RULE.timeout)
+    assert len(batch) == len(live) > 50
+    assert {p.level for p in live} == {0, 1, 2}
+    for i, pred in enumerate(live):
+        assert batch.snapshot(i).states == snaps[i].states
+        np.testing.assert_array_equal(batch.snapshot(i).ages, snaps[i].ages)
+        assert int(batch.level[i]) == pred.level, (i, pred.message, batch.message(i))
+        assert int(batch.status[i]) == pred.status
+        assert batch.message(i) == pred.message
+        np.testing.assert_allclose(batch.outputs[:, i], np.array(pred.outputs), rtol=1e-12,
+                                   atol=1e-300)
+        np.testing.assert_array_equal(batch.snapshots.values[:, i], np.array(pred.inputs))
