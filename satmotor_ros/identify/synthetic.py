@@ -364,6 +364,48 @@ def generate_series(plan: Plan, injection: Injection, seed: int = 0, samples: in
     return replace(table, time_series=True)
 
 
+def write_bag_of(path: str | Path, table: BenchTable, storage: str = 'mcap',
+                 absolute: bool = True) -> None:
+    """
+    Record a generated time series as a rosbag2 bag of the DESIGN.md topics.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        Bag directory to create, [-]
+    table : BenchTable
+        A generated time series (with time, temperature, p_case), [-]
+    storage : {'mcap', 'sqlite3'}
+        Storage plugin, [-]
+    absolute : bool
+        Publish absolute pressures (+ 101325 Pa), as FluidPressure defines them, [-]
+
+    """
+    from satmotor_ros.bags import (encode_many, FLOAT64, FLUID_PRESSURE, JOINT_STATE,
+                                   OutTopic, TEMPERATURE, write_bag)
+    t_ns = 1_700_000_000_000_000_000 + np.round(table.channels['time'] * 1e9).astype(np.int64)
+    atm = 101325.0 if absolute else 0.0
+
+    def pressure(name: str, p: FloatArray) -> OutTopic:
+        return OutTopic(f'/{name}', FLUID_PRESSURE, t_ns + 1000,
+                        encode_many(FLUID_PRESSURE, {'fluid_pressure': p + atm}, t_ns))
+
+    topics = [OutTopic('/flow_measured', FLOAT64, t_ns + 2000,
+                       encode_many(FLOAT64, {'data': table.flow})),
+              pressure('inlet_pressure', table.p_in), pressure('outlet_pressure', table.p_out),
+              pressure('case_pressure', table.channels['p_case']),
+              OutTopic('/fluid_temperature', TEMPERATURE, t_ns + 3000, encode_many(
+                  TEMPERATURE, {'temperature': table.channels['temperature']}, t_ns)),
+              OutTopic('/joint_states', JOINT_STATE, t_ns, encode_many(
+                  JOINT_STATE, {'position': np.cumsum(table.speed) * 0.01,
+                                'velocity': table.speed}, t_ns, joint='motor_shaft'))]
+    for name, values in table.channels.items():
+        if name not in ('time', 'revolutions', 'temperature', 'p_case'):
+            topics.append(OutTopic(f'/{name}', FLOAT64, t_ns + 4000,
+                                   encode_many(FLOAT64, {'data': values})))
+    write_bag(path, topics, storage)
+
+
 def to_columns(table: BenchTable) -> dict[str, tuple[str, FloatArray]]:
     """
     Express a generated table in hydraulic units for a bench CSV.
@@ -417,14 +459,19 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument('--points', type=int, default=100)
     parser.add_argument('--series', type=int, default=0, metavar='SAMPLES',
                         help='write a 100 Hz time series of this many samples instead')
-    parser.add_argument('--out', required=True, help='CSV file to write')
+    parser.add_argument('--bag', choices=('mcap', 'sqlite3'), default=None,
+                        help='write the time series as a rosbag2 bag (directory --out)')
+    parser.add_argument('--out', required=True, help='CSV file (or bag directory) to write')
     args = parser.parse_args(argv)
     plan = Plan(liquid=args.liquid, n_points=args.points)
     injection = Injection.realistic(args.effect, args.scale, args.liquid)
     table = (generate_series(plan, injection, args.seed, samples=args.series) if args.series
              else generate(plan, injection, args.seed))
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    write_csv(args.out, to_columns(table))
+    if args.bag:
+        write_bag_of(args.out, table, args.bag)
+    else:
+        write_csv(args.out, to_columns(table))
     print(f'wrote {args.out}: {len(table)} rows, {args.liquid}, {args.effect} '
           f'(magnitude {injection.magnitude:.4g}, regressor {injection.regressor or "-"})')
     return 0
