@@ -74,3 +74,29 @@ def test_foreign_bag_gives_one_clear_line(tmp_path, bag, capsys):
                  str(tmp_path / 'o')])
     err = capsys.readouterr().err
     assert code == 1 and err.count('\n') == 1
+
+
+def _residual_rms(path):
+    import csv
+    with open(path, newline='') as f:
+        rows = list(csv.DictReader(f))
+    r = np.array([float(row['residual [rpm]']) for row in rows if row['residual [rpm]']])
+    return float(np.sqrt(np.mean(r ** 2)))
+
+
+def test_end_to_end_bag_calibrate_then_replay_with_the_new_yaml_shrinks_speed_residual(
+        tmp_path, capsys):
+    """A leaking motor's bag -> calibrate -> coefficients.yaml into the node's prediction."""
+    series = generate_series(Plan(liquid='water'),
+                             Injection.realistic('external_leakage', 1.0, 'water'), seed=3,
+                             samples=8000, rate=50.0)
+    bag = tmp_path / 'bag'
+    write_bag_of(bag, series, 'mcap', flow_topic='flow_command')
+    assert main(['calibrate', str(bag), '--liquid', 'water', '--out', str(tmp_path / 'cal')]) == 0
+    common = ['replay', str(bag), '--liquid', 'water', '--no-plot']
+    assert main([*common, '--out', str(tmp_path / 'before.csv')]) == 0
+    assert main([*common, '--motor', str(tmp_path / 'cal' / 'coefficients.yaml'),
+                 '--out', str(tmp_path / 'after.csv')]) == 0
+    capsys.readouterr()
+    before, after = _residual_rms(tmp_path / 'before.csv'), _residual_rms(tmp_path / 'after.csv')
+    assert after < 0.6 * before

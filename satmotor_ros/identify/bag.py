@@ -133,11 +133,9 @@ def read_bag(path: str | Path, joint: str | None = 'motor_shaft',
         if topic in series and len(series[topic]):
             unit = 'degC' if column == 'temperature' else 'N*m' if column == 'torque' else 'Pa'
             columns[column] = (unit, _on(series[topic], field, t, t0))
-    absolute = float(np.nanmin(columns['p_out'][1])) >= 0.9 * ATMOSPHERE
-    if absolute:
-        for column in ('p_in', 'p_out', 'p_case'):
-            if column in columns:
-                columns[column] = ('Pa', columns[column][1] - ATMOSPHERE)
+    for column in ('p_in', 'p_out', 'p_case'):  # FluidPressure is absolute
+        if column in columns:
+            columns[column] = ('Pa', columns[column][1] - ATMOSPHERE)
     for name, base in extra.items():
         s = extra_series.get(name)
         if s is not None and len(s) and base not in columns:
@@ -145,6 +143,6 @@ def read_bag(path: str | Path, joint: str | None = 'motor_shaft',
             columns[base] = ('', _on(s, field, t, t0))
     table = table_from_columns(columns, str(path), time_series=True)
     notes = (f'rosbag2: flow from {flow_topic}, speed from joint_states, {len(t)} samples on '
-             'its times' + ('; pressures made gauge (- 101325 Pa)' if absolute else ''),)
+             'its times; pressures made gauge (- 101325 Pa)',)
     return BenchTable(table.speed, table.flow, table.p_in, table.p_out, table.channels,
                       table.units, table.source, True, notes + table.notes)

@@ -365,7 +365,7 @@ def generate_series(plan: Plan, injection: Injection, seed: int = 0, samples: in
 
 
 def write_bag_of(path: str | Path, table: BenchTable, storage: str = 'mcap',
-                 absolute: bool = True) -> None:
+                 flow_topic: str = 'flow_measured') -> None:
     """
     Record a generated time series as a rosbag2 bag of the DESIGN.md topics.
 
@@ -377,20 +377,20 @@ def write_bag_of(path: str | Path, table: BenchTable, storage: str = 'mcap',
         A generated time series (with time, temperature, p_case), [-]
     storage : {'mcap', 'sqlite3'}
         Storage plugin, [-]
-    absolute : bool
-        Publish absolute pressures (+ 101325 Pa), as FluidPressure defines them, [-]
+    flow_topic : str
+        Topic of the flow: ``flow_measured`` or ``flow_command``, [-]
 
     """
     from satmotor_ros.bags import (encode_many, FLOAT64, FLUID_PRESSURE, JOINT_STATE,
                                    OutTopic, TEMPERATURE, write_bag)
     t_ns = 1_700_000_000_000_000_000 + np.round(table.channels['time'] * 1e9).astype(np.int64)
-    atm = 101325.0 if absolute else 0.0
+    atm = 101325.0  # FluidPressure is absolute
 
     def pressure(name: str, p: FloatArray) -> OutTopic:
         return OutTopic(f'/{name}', FLUID_PRESSURE, t_ns + 1000,
                         encode_many(FLUID_PRESSURE, {'fluid_pressure': p + atm}, t_ns))
 
-    topics = [OutTopic('/flow_measured', FLOAT64, t_ns + 2000,
+    topics = [OutTopic(f'/{flow_topic}', FLOAT64, t_ns + 2000,
                        encode_many(FLOAT64, {'data': table.flow})),
               pressure('inlet_pressure', table.p_in), pressure('outlet_pressure', table.p_out),
               pressure('case_pressure', table.channels['p_case']),
