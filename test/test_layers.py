@@ -12,8 +12,8 @@ from satmotor_ros.model import losses, speed
 
 
 @pytest.mark.parametrize('module', ['satmotor_ros.model', 'satmotor_ros.plant',
-                                    'satmotor_ros.cli', 'satmotor_ros.prediction',
-                                    'satmotor_ros.bags'])
+                                    'satmotor_ros.identify', 'satmotor_ros.prediction',
+                                    'satmotor_ros.bags', 'satmotor_ros.cli'])
 def test_layer_imports_without_rclpy(module):
     code = f'import sys, {module}; assert "rclpy" not in sys.modules, "rclpy imported"'
     subprocess.run([sys.executable, '-c', code], check=True)

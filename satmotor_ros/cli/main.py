@@ -8,7 +8,7 @@ from collections.abc import Sequence
 import sys
 
 from satmotor_ros import __version__
-from satmotor_ros.cli import characteristics, demo, operating_point, replay
+from satmotor_ros.cli import calibrate, characteristics, demo, operating_point, replay
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -27,7 +27,7 @@ def build_parser() -> argparse.ArgumentParser:
                     '(Śliwiński 2017 model).')
     parser.add_argument('--version', action='version', version=f'%(prog)s {__version__}')
     sub = parser.add_subparsers(dest='subcommand', required=True, metavar='COMMAND')
-    for module in (demo, operating_point, characteristics, replay):
+    for module in (demo, operating_point, characteristics, replay, calibrate):
         module.add_parser(sub)
     return parser
 

@@ -1,0 +1,196 @@
+# SPDX-License-Identifier: Apache-2.0
+"""
+Calibration files: ``calibration.json`` and ``coefficients.yaml``.
+
+``coefficients.yaml`` has the layout of ``config/sm075_25.yaml`` (it loads with
+:func:`satmotor_ros.model.load_motor`) and holds one coefficient set, named
+after the liquid, with the fitted coefficients and, when an effect was
+found, an ``effects:`` block that describes it as data::
+
+    effects:
+      <effect id>:
+        regressor: <channel or expression>
+        coefficient: <value>        # SI, in `unit`
+        unit: <unit>
+        ci95: [<low>, <high>]
+        ...                         # what the effect needs to be evaluated
+
+Plain numbers are SI (temperature in degC).
+"""
+
+from __future__ import annotations
+
+from dataclasses import fields, replace
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from satmotor_ros.identify.pipeline import Calibration
+from satmotor_ros.model import LossCoefficients
+import yaml
+
+EVALUATION = {
+    'external_leakage': 'Q_ex = k_ex * p (eq. 24) with p the gauge pressure named by regressor; '
+                        'k_ex is also coefficients.external_leakage',
+    'viscosity_temperature': 'nu(T) from the law (walther: log10(log10(nu_cSt + 0.7)) = '
+                             'log10(log10(nu_ref_cSt + 0.7)) - B (log10 T_K - log10 T_ref_K); '
+                             'vogel: nu = nu_ref 10^(B (1/(T_K - C) - 1/(T_ref_K - C)))) '
+                             'replaces the liquid viscosity in eqs. (1), (5) and (35)',
+    'clearance_wear': 'h_R and h_S grow by w (x - reference), x = time [s] or cumulative '
+                      'revolutions [rev], in eqs. (1), (2) and (5)',
+    'flow_sensor_offset': 'the flowmeter reads Q + b; the motor absorbs Q',
+    'flow_sensor_gain': 'the flowmeter reads (1 + g) Q; the motor absorbs Q',
+    'speed_sensor_gain': 'the speed sensor reads (1 + g) n; the shaft turns at n',
+    'channel': 'extra loss k (x - reference) added to Q_vl (eq. 31), x the channel',
+    'term': 'extra loss k f(n [rad/s], dp [Pa]) added to Q_vl (eq. 31), dp the chamber drop '
+            'dp_i of eq. (34)',
+}
+"""What the model must do with each kind of effect block (also written into the YAML)."""
+
+
+def write_json(cal: Calibration, path: str | Path) -> dict[str, Any]:
+    """
+    Write ``calibration.json`` (DESIGN.md, "Calibration output").
+
+    Parameters
+    ----------
+    cal : Calibration
+        The result, [-]
+    path : str or pathlib.Path
+        File to write, [-]
+
+    Returns
+    -------
+    dict
+        The object written.
+
+    """
+    summary = cal.summary()
+    Path(path).write_text(json.dumps(summary, indent=2) + '\n', encoding='utf-8')
+    return summary
+
+
+def fitted_coefficients(cal: Calibration) -> LossCoefficients:
+    """
+    Apply the fitted factors (and an external leakage) to the packaged coefficients.
+
+    Parameters
+    ----------
+    cal : Calibration
+        The result, [-]
+
+    Returns
+    -------
+    LossCoefficients
+        a1 and c1 times s_L, c times s_C, c_id times s_id, and
+        external_leakage = k_ex when that effect was chosen.
+
+    """
+    coef = cal.model.coef
+    s_l, s_c, s_id = (float(v) for v in cal.final.values[:3])
+    changes = {'a1': coef.a1 * s_l, 'c1': coef.c1 * s_l, 'c': coef.c * s_c,
+               'c_id': coef.c_id * s_id}
+    chosen = cal.chosen
+    if chosen is not None and chosen.effect == 'external_leakage':
+        changes['external_leakage'] = float(cal.final.values[3])
+    return replace(coef, **changes)
+
+
+def effect_block(cal: Calibration) -> dict[str, Any]:
+    """
+    Describe the chosen effect as data for the ``effects:`` block.
+
+    Parameters
+    ----------
+    cal : Calibration
+        The result, [-]
+
+    Returns
+    -------
+    dict
+        ``{effect id: {...}}``; empty when no effect was found.
+
+    """
+    chosen = cal.chosen
+    if chosen is None:
+        return {}
+    value = float(cal.final.values[3])
+    entry: dict[str, Any] = {
+        'regressor': chosen.regressor, 'coefficient': value, 'unit': chosen.unit,
+        'ci95': [float(v) for v in cal.final.ci95[3]], 'source': chosen.source,
+    }
+    kind = chosen.effect.split(':')[0]
+    if chosen.effect == 'viscosity_temperature':
+        law = cal.law
+        entry.update(law=law.law, reference_temperature=float(law.reference_temperature),
+                     reference_viscosity=float(law.reference_viscosity))
+        if law.law == 'vogel':
+            entry['vogel_c'] = 140.0
+    elif chosen.effect == 'clearance_wear':
+        entry['reference'] = float(np.min(cal.table.channels[chosen.regressor]))
+    elif kind == 'channel':
+        entry['reference'] = float(np.mean(cal.table.channels[chosen.regressor]))
+    entry['evaluation'] = EVALUATION[kind]
+    return {chosen.effect: entry}
+
+
+def coefficients_document(cal: Calibration) -> dict[str, Any]:
+    """
+    Build the ``coefficients.yaml`` document.
+
+    Parameters
+    ----------
+    cal : Calibration
+        The result, [-]
+
+    Returns
+    -------
+    dict
+        A motor document with one coefficient set (plain SI numbers).
+
+    """
+    spec = cal.spec
+    coef = fitted_coefficients(cal)
+    liquid = cal.model.liquid
+    entry: dict[str, Any] = {
+        'liquid': {'name': liquid.name,
+                   'kinematic_viscosity': liquid.kinematic_viscosity,
+                   'density': liquid.density, 'bulk_modulus': liquid.bulk_modulus},
+        'coefficients': {f.name: float(getattr(coef, f.name)) for f in fields(coef)},
+    }
+    effects = effect_block(cal)
+    if effects:
+        entry['effects'] = effects
+    g = spec.geometry
+    return {
+        'motor': f'{spec.name} (calibrated)',
+        'geometry': {f.name: float(getattr(g, f.name)) for f in fields(g)},
+        'valid_range': {f.name: float(getattr(spec.valid_range, f.name))
+                        for f in fields(spec.valid_range)},
+        'coefficient_sets': {cal.liquid: entry},
+    }
+
+
+def write_yaml(cal: Calibration, path: str | Path) -> None:
+    """
+    Write ``coefficients.yaml``.
+
+    Parameters
+    ----------
+    cal : Calibration
+        The result, [-]
+    path : str or pathlib.Path
+        File to write, [-]
+
+    """
+    s_l, s_c, s_id = cal.final.values[:3]
+    head = (f'# {cal.spec.name} calibrated on {cal.table.source} ({len(cal.parts)} points), '
+            f'liquid {cal.liquid}.\n'
+            f'# Fitted factors on the packaged values: leakage (a1, c1) x{s_l:.4g}, '
+            f'c x{s_c:.4g}, c_id x{s_id:.4g}.\n'
+            "# Plain numbers are SI (temperature degC); loss coefficients in the paper's "
+            'fitting units.\n')
+    body = yaml.safe_dump(coefficients_document(cal), sort_keys=False, allow_unicode=True,
+                          width=99)
+    Path(path).write_text(head + body, encoding='utf-8')

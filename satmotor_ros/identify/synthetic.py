@@ -1,0 +1,482 @@
+# SPDX-License-Identifier: Apache-2.0
+"""
+Synthetic bench data from the model, with one effect injected and seeded noise.
+
+The truth is always :class:`~satmotor_ros.model.MotorModel` itself: the
+flow is its forward map Q(n, dp) (eqs. 34-36, channel drop coupled), with
+a modified coefficient set, liquid or geometry for the physical effects
+(a model per temperature or per wear state), and the sensor effects applied
+to what the sensors report. The viscosity law used here is deliberately not
+the one the candidate library fits (an exponential law for oil, a table for
+water), so a test also checks that the library generalises.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from pathlib import Path
+import re
+
+import numpy as np
+
+from satmotor_ros.identify.candidates import TERMS
+from satmotor_ros.identify.table import BenchTable
+from satmotor_ros.model import load_motor, MotorModel
+from satmotor_ros.model._typing import FloatArray
+from satmotor_ros.model.units import LPM, MPA, RPM
+
+WATER_TABLE = ((10.0, 1.3059e-3), (20.0, 1.0016e-3), (30.0, 0.7972e-3), (40.0, 0.6527e-3),
+               (50.0, 0.5465e-3), (60.0, 0.4660e-3), (70.0, 0.4035e-3))
+"""Dynamic viscosity of water [degC], [Pa*s] (IAPWS 2008 at 0.1 MPa)."""
+
+OIL_LAMBDA = 0.042
+"""Exponential viscosity-temperature coefficient of an ISO VG 46 oil near 40 degC, [1/K]."""
+
+EFFECTS = ('none', 'external_leakage', 'viscosity_temperature', 'clearance_wear',
+           'flow_sensor_offset', 'flow_sensor_gain', 'speed_sensor_gain', 'channel:aux',
+           'term:dp^2*n')
+"""The effects :func:`generate` can inject (any ``channel:<name>`` or ``term:<expr>`` too)."""
+
+REALISTIC = {
+    'none': ((0.0, 0.0), ''),
+    'external_leakage': ((0.4 * LPM / MPA, 0.4 * LPM / MPA), 'p_case'),  # k_ex [m^3/(s*Pa)]
+    'viscosity_temperature': ((30.0, 30.0), 'temperature'),  # temperature span [K]
+    # clearance growth over the test [m]: about doubles the oil's small leakage by the end
+    'clearance_wear': ((1.5e-6, 0.8e-6), 'time'),
+    'flow_sensor_offset': ((0.25 * LPM, 0.25 * LPM), '1'),  # b [m^3/s], 0.4 % of 60 l/min
+    'flow_sensor_gain': ((0.01, 0.01), 'flow'),  # g [-]
+    'speed_sensor_gain': ((0.01, 0.01), 'speed'),  # g [-]
+    'channel:aux': ((0.2 * LPM, 0.2 * LPM), 'aux'),  # peak-to-peak loss change [m^3/s]
+    'term:dp^2*n': ((0.5 * LPM, 0.5 * LPM), 'dp^2*n'),  # largest extra loss [m^3/s]
+}
+"""
+Realistic magnitudes (oil, water) and the regressor per effect, in the units of :class:`Injection`.
+
+About 5-20 times the noise of Q_vl that the default :class:`Plan` gives
+(0.027 l/min); the sweep also runs half of them, near the detection limit.
+"""
+
+
+@dataclass(frozen=True)
+class Injection:
+    """
+    One effect to inject.
+
+    `magnitude` means: k_ex [m^3/(s*Pa)] for external_leakage; the
+    temperature span [K] for viscosity_temperature; the clearance growth
+    over the test [m] for clearance_wear; b [m^3/s] for flow_sensor_offset;
+    g [-] for the gains; the peak-to-peak loss change [m^3/s] for
+    ``channel:<name>``; the largest extra loss [m^3/s] for ``term:<expr>``.
+    """
+
+    effect: str = 'none'  # an id of the DESIGN.md vocabulary
+    magnitude: float = 0.0  # see the class docstring
+    regressor: str = ''  # p_case|p_out (external_leakage), time|revolutions (wear)
+
+    @classmethod
+    def realistic(cls, effect: str, scale: float = 1.0, liquid: str = 'oil') -> Injection:
+        """
+        Build an injection at `scale` times the realistic magnitude.
+
+        Parameters
+        ----------
+        effect : str
+            A key of :data:`REALISTIC`, [-]
+        scale : float
+            Factor on the realistic magnitude, [-]
+        liquid : str
+            ``'oil'`` or ``'water'``, [-]
+
+        Returns
+        -------
+        Injection
+            The injection.
+
+        """
+        (oil, water), regressor = REALISTIC[effect]
+        return cls(effect, (water if 'water' in liquid else oil) * scale, regressor)
+
+
+@dataclass(frozen=True)
+class Plan:
+    """Operating range, duration and sensor noise of a synthetic bench test."""
+
+    liquid: str = 'oil'  # coefficient set
+    n_points: int = 100  # operating points
+    speed_rpm: tuple[float, float] = (100.0, 1500.0)  # [rpm]
+    dp_mpa: tuple[float, float] = (2.0, 25.0)  # port drop [MPa]
+    p_out_mpa: tuple[float, float] = (0.3, 3.0)  # [MPa]
+    p_case_mpa: tuple[float, float] = (0.05, 0.6)  # [MPa]
+    temperature_c: tuple[float, float] = (38.0, 48.0)  # when viscosity is not injected [degC]
+    duration_s: float = 3600.0  # test duration [s]
+    noise_flow_lpm: float = 0.02  # flowmeter noise, absolute [l/min]
+    noise_flow_rel: float = 0.0005  # flowmeter noise, share of reading [-]
+    noise_speed_rpm: float = 0.3  # [rpm]
+    noise_pressure_mpa: float = 0.01  # [MPa]
+    noise_temperature_c: float = 0.1  # [degC]
+    extra_channels: tuple[str, ...] = ('aux',)  # channels with no effect unless injected
+
+    def noise_lpm(self, flow: FloatArray, model: MotorModel) -> FloatArray:
+        """
+        Compute the standard deviation of the measured Q_vl that the sensor noise causes.
+
+        Parameters
+        ----------
+        flow : ndarray
+            Flow, [m^3/s]
+        model : MotorModel
+            The model (for q_t), [-]
+
+        Returns
+        -------
+        ndarray
+            Noise of Q - q_t n, [l/min]
+
+        """
+        q = np.hypot(self.noise_flow_lpm, self.noise_flow_rel * flow / LPM)
+        n = model.geometry.displacement * self.noise_speed_rpm * RPM / LPM
+        return np.hypot(q, n)
+
+
+def _law_viscosity(liquid: str, nu_ref: float, temperature: FloatArray,
+                   t_ref: float) -> FloatArray:
+    if 'water' in liquid:
+        t, mu = np.array(WATER_TABLE).T
+        rel = np.exp(np.interp(temperature, t, np.log(mu)) - np.interp(t_ref, t, np.log(mu)))
+        return nu_ref * rel
+    return nu_ref * np.exp(-OIL_LAMBDA * (temperature - t_ref))
+
+
+def _absorbency(model: MotorModel, speed: FloatArray, dp: FloatArray,
+                p_ex: FloatArray | float = 0.0) -> tuple[FloatArray, FloatArray]:
+    op = model.absorbency(speed, dp=dp, p_ex=p_ex)
+    return op.flow, op.dp_i
+
+
+def _grouped(models: list[MotorModel], group: np.ndarray, speed: FloatArray, dp: FloatArray,
+             p_ex: FloatArray | float) -> tuple[FloatArray, FloatArray]:
+    flow, dp_i = np.empty_like(speed), np.empty_like(speed)
+    p_ex = np.broadcast_to(p_ex, speed.shape)
+    for g, model in enumerate(models):
+        at = group == g
+        if at.any():
+            flow[at], dp_i[at] = _absorbency(model, speed[at], dp[at], p_ex[at])
+    return flow, dp_i
+
+
+def true_flow(base: MotorModel, injection: Injection, speed: FloatArray, dp: FloatArray,
+              channels: dict[str, FloatArray]) -> FloatArray:
+    """
+    Compute the flow the motor really absorbs, with a physical effect injected.
+
+    Parameters
+    ----------
+    base : MotorModel
+        The packaged model, [-]
+    injection : Injection
+        The effect, [-]
+    speed : ndarray
+        True speed, [rad/s]
+    dp : ndarray
+        True port drop, [Pa]
+    channels : dict of str to ndarray
+        Channels (time [s], revolutions [rev], temperature [degC], p_case,
+        p_out [Pa], extra), [-]
+
+    Returns
+    -------
+    ndarray
+        Flow, [m^3/s]
+
+    """
+    effect, k = injection.effect, injection.magnitude
+    spec = base.coefficient_set
+    if effect == 'external_leakage':
+        coef = replace(spec.coefficients, external_leakage=k)
+        model = MotorModel(base.geometry, replace(spec, coefficients=coef), base.valid_range)
+        return _absorbency(model, speed, dp, channels[injection.regressor or 'p_case'])[0]
+    if effect == 'viscosity_temperature':
+        temperature = channels['temperature']
+        bins = np.round(temperature * 4.0) / 4.0
+        levels, group = np.unique(bins, return_inverse=True)
+        t_ref = float(np.mean(temperature))
+        nus = _law_viscosity(spec.name, spec.liquid.kinematic_viscosity, levels, t_ref)
+        models = [MotorModel(base.geometry, spec, base.valid_range,
+                             replace(spec.liquid, kinematic_viscosity=float(nu)))
+                  for nu in nus]
+        return _grouped(models, group, speed, dp, 0.0)[0]
+    if effect == 'clearance_wear':
+        x = channels[injection.regressor or 'time']
+        frac = (x - x.min()) / max(np.ptp(x), 1e-300)
+        steps = np.round(frac * 200).astype(int)
+        levels, group = np.unique(steps, return_inverse=True)
+        g = base.geometry
+        models = [MotorModel(replace(g, clearance_rotor=g.clearance_rotor + k * s / 200,
+                                     clearance_satellites=g.clearance_satellites + k * s / 200),
+                             spec, base.valid_range) for s in levels]
+        return _grouped(models, group, speed, dp, 0.0)[0]
+    flow, dp_i = _absorbency(base, speed, dp)
+    if effect.startswith('term:'):
+        x = TERMS[effect[5:]][0](speed, dp_i)
+        return flow + k * x / np.max(np.abs(x))
+    if effect.startswith('channel:'):
+        x = channels[effect[8:]]
+        return flow + k * (x - x.mean()) / max(np.ptp(x), 1e-300)
+    return flow
+
+
+def _operating_points(plan: Plan, rng: np.random.Generator,
+                      n: int) -> tuple[FloatArray, FloatArray]:
+    speed = rng.uniform(*plan.speed_rpm, n) * RPM
+    dp = rng.uniform(*plan.dp_mpa, n) * MPA
+    return speed, dp
+
+
+def _temperature(plan: Plan, injection: Injection, rng: np.random.Generator,
+                 time: FloatArray) -> FloatArray:
+    if injection.effect == 'viscosity_temperature':
+        mid = 0.5 * sum(plan.temperature_c)
+        lo, hi = mid - 0.5 * injection.magnitude, mid + 0.5 * injection.magnitude
+    else:
+        lo, hi = plan.temperature_c
+    # warm-up and cool-down cycles, so that temperature is no proxy for time
+    phase = rng.uniform(0, 2 * np.pi)
+    cycles = 0.5 * (1 + np.sin(2 * np.pi * 2.5 * time / max(time[-1], 1e-9) + phase))
+    return lo + (hi - lo) * (0.7 * cycles + 0.3 * rng.uniform(0, 1, time.size))
+
+
+def _channels(plan: Plan, injection: Injection, rng: np.random.Generator, time: FloatArray,
+              draw: int, index: np.ndarray) -> dict[str, FloatArray]:
+    """Draw p_case, p_out and the extra channels `draw` times, spread by `index`."""
+    channels = {'time': time, 'temperature': _temperature(plan, injection, rng, time),
+                'p_case': rng.uniform(*plan.p_case_mpa, draw)[index] * MPA,
+                'p_out': rng.uniform(*plan.p_out_mpa, draw)[index] * MPA}
+    names = list(plan.extra_channels)
+    match = re.fullmatch(r'channel:(\w+)', injection.effect)
+    if match and match.group(1) not in names:
+        names.append(match.group(1))
+    for name in names:
+        channels[name] = rng.uniform(0.0, 1.0, draw)[index]
+    return channels
+
+
+def _measure(plan: Plan, injection: Injection, rng: np.random.Generator, flow: FloatArray,
+             speed: FloatArray, dp: FloatArray,
+             channels: dict[str, FloatArray], noise: float) -> BenchTable:
+    n = flow.size
+    gain_q = 1.0 + (injection.magnitude if injection.effect == 'flow_sensor_gain' else 0.0)
+    gain_n = 1.0 + (injection.magnitude if injection.effect == 'speed_sensor_gain' else 0.0)
+    offset = injection.magnitude if injection.effect == 'flow_sensor_offset' else 0.0
+    sd_q = np.hypot(plan.noise_flow_lpm * LPM, plan.noise_flow_rel * flow) * noise
+    flow_m = gain_q * flow + offset + rng.normal(0.0, 1.0, n) * sd_q
+    speed_m = gain_n * speed + rng.normal(0.0, plan.noise_speed_rpm * RPM * noise, n)
+    sd_p = plan.noise_pressure_mpa * MPA * noise
+    p_out = channels.pop('p_out') + rng.normal(0.0, sd_p, n)
+    p_in = p_out + dp + rng.normal(0.0, sd_p, n)
+    channels['temperature'] = channels['temperature'] + rng.normal(
+        0.0, plan.noise_temperature_c * noise, n)
+    channels['p_case'] = channels['p_case'] + rng.normal(0.0, sd_p, n)
+    units = {'speed': 'rad/s', 'flow': 'm^3/s', 'p_in': 'Pa', 'p_out': 'Pa', 'time': 's',
+             'revolutions': 'rev', 'temperature': 'degC', 'p_case': 'Pa'}
+    return BenchTable(speed_m, flow_m, p_in, p_out, channels, units, '<synthetic>')
+
+
+def generate(plan: Plan, injection: Injection, seed: int = 0) -> BenchTable:
+    """
+    Generate a bench table of steady operating points.
+
+    Parameters
+    ----------
+    plan : Plan
+        Range, duration and noise, [-]
+    injection : Injection
+        The effect to inject, [-]
+    seed : int
+        Seed of the operating points and the noise, [-]
+
+    Returns
+    -------
+    BenchTable
+        Measured points (SI) with time, revolutions, temperature, p_case and
+        the plan's extra channels.
+
+    """
+    rng = np.random.default_rng(seed)
+    n = plan.n_points
+    speed, dp = _operating_points(plan, rng, n)
+    time = np.sort(rng.uniform(0.0, plan.duration_s, n))
+    channels = _channels(plan, injection, rng, time, n, np.arange(n))
+    channels['revolutions'] = np.cumsum(np.diff(time, prepend=0.0) * speed) / (2 * np.pi)
+    base = MotorModel.from_spec(load_motor(), plan.liquid)
+    flow = true_flow(base, injection, speed, dp, {**channels})
+    return _measure(plan, injection, rng, flow, speed, dp, channels, 1.0)
+
+
+def generate_series(plan: Plan, injection: Injection, seed: int = 0, samples: int = 20000,
+                    rate: float = 100.0, hold_s: float = 8.0, tau_s: float = 0.3,
+                    noise: float = 3.0) -> BenchTable:
+    """
+    Generate a time series of set-point steps with first-order transients.
+
+    Parameters
+    ----------
+    plan : Plan
+        Range and noise (multiplied by `noise` per sample), [-]
+    injection : Injection
+        The effect to inject, [-]
+    seed : int
+        Seed, [-]
+    samples : int
+        Number of samples, [-]
+    rate : float
+        Sample rate, [Hz]
+    hold_s : float
+        Time each set-point is held, [s]
+    tau_s : float
+        Time constant of speed and pressure between set-points, [s]
+    noise : float
+        Factor on the plan's noise for raw samples, [-]
+
+    Returns
+    -------
+    BenchTable
+        Raw samples, ``time_series`` True.
+
+    """
+    rng = np.random.default_rng(seed)
+    time = np.arange(samples) / rate
+    steps = int(np.ceil(time[-1] / hold_s)) + 1
+    sp_speed, sp_dp = _operating_points(plan, rng, steps)
+    k = np.minimum((time / hold_s).astype(int), steps - 1)
+    alpha = 1.0 - np.exp(-1.0 / (rate * tau_s))
+    speed, dp = np.empty(samples), np.empty(samples)
+    s, d = sp_speed[0], sp_dp[0]
+    target_s, target_d = sp_speed[k], sp_dp[k]
+    for i in range(samples):  # first-order lag (a loop; 1e5 samples take ~0.1 s)
+        s += alpha * (target_s[i] - s)
+        d += alpha * (target_d[i] - d)
+        speed[i], dp[i] = s, d
+    channels = _channels(plan, injection, rng, time, steps, k)
+    channels['revolutions'] = np.cumsum(speed / rate) / (2 * np.pi)
+    base = MotorModel.from_spec(load_motor(), plan.liquid)
+    flow = true_flow(base, injection, speed, dp, {**channels})
+    table = _measure(plan, injection, rng, flow, speed, dp, channels, noise)
+    return replace(table, time_series=True)
+
+
+def write_bag_of(path: str | Path, table: BenchTable, storage: str = 'mcap',
+                 flow_topic: str = 'flow_measured') -> None:
+    """
+    Record a generated time series as a rosbag2 bag of the DESIGN.md topics.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        Bag directory to create, [-]
+    table : BenchTable
+        A generated time series (with time, temperature, p_case), [-]
+    storage : {'mcap', 'sqlite3'}
+        Storage plugin, [-]
+    flow_topic : str
+        Topic of the flow: ``flow_measured`` or ``flow_command``, [-]
+
+    """
+    from satmotor_ros.bags import (encode_many, FLOAT64, FLUID_PRESSURE, JOINT_STATE,
+                                   OutTopic, TEMPERATURE, write_bag)
+    t_ns = 1_700_000_000_000_000_000 + np.round(table.channels['time'] * 1e9).astype(np.int64)
+    atm = 101325.0  # FluidPressure is absolute
+
+    def pressure(name: str, p: FloatArray) -> OutTopic:
+        return OutTopic(f'/{name}', FLUID_PRESSURE, t_ns + 1000,
+                        encode_many(FLUID_PRESSURE, {'fluid_pressure': p + atm}, t_ns))
+
+    topics = [OutTopic(f'/{flow_topic}', FLOAT64, t_ns + 2000,
+                       encode_many(FLOAT64, {'data': table.flow})),
+              pressure('inlet_pressure', table.p_in), pressure('outlet_pressure', table.p_out),
+              pressure('case_pressure', table.channels['p_case']),
+              OutTopic('/fluid_temperature', TEMPERATURE, t_ns + 3000, encode_many(
+                  TEMPERATURE, {'temperature': table.channels['temperature']}, t_ns)),
+              OutTopic('/joint_states', JOINT_STATE, t_ns, encode_many(
+                  JOINT_STATE, {'position': np.cumsum(table.speed) * 0.01,
+                                'velocity': table.speed}, t_ns, joint='motor_shaft'))]
+    for name, values in table.channels.items():
+        if name not in ('time', 'revolutions', 'temperature', 'p_case'):
+            topics.append(OutTopic(f'/{name}', FLOAT64, t_ns + 4000,
+                                   encode_many(FLOAT64, {'data': values})))
+    write_bag(path, topics, storage)
+
+
+def to_columns(table: BenchTable) -> dict[str, tuple[str, FloatArray]]:
+    """
+    Express a generated table in hydraulic units for a bench CSV.
+
+    Parameters
+    ----------
+    table : BenchTable
+        A generated table, [-]
+
+    Returns
+    -------
+    dict of str to (str, ndarray)
+        Column name -> (unit, values in that unit).
+
+    """
+    columns = {'time': ('s', table.channels['time']), 'speed': ('rpm', table.speed / RPM),
+               'flow': ('l/min', table.flow / LPM), 'p_in': ('MPa', table.p_in / MPA),
+               'p_out': ('MPa', table.p_out / MPA),
+               'temperature': ('degC', table.channels['temperature']),
+               'p_case': ('MPa', table.channels['p_case'] / MPA)}
+    for name, values in table.channels.items():
+        if name not in columns and name != 'revolutions':
+            columns[name] = ('-', values)
+    return columns
+
+
+def main(argv: list[str] | None = None) -> int:
+    """
+    Write a synthetic bench CSV: ``python -m satmotor_ros.identify.synthetic``.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        Command-line arguments, [-]
+
+    Returns
+    -------
+    int
+        0.
+
+    """
+    import argparse
+    from satmotor_ros.identify.table import write_csv
+    parser = argparse.ArgumentParser(description='Write a synthetic bench table (CSV) from '
+                                                 'the model with one effect injected.')
+    parser.add_argument('--liquid', default='oil')
+    parser.add_argument('--effect', default='none', help=f'one of {", ".join(REALISTIC)}')
+    parser.add_argument('--scale', type=float, default=1.0,
+                        help='factor on the realistic magnitude')
+    parser.add_argument('--seed', type=int, default=0)
+    parser.add_argument('--points', type=int, default=100)
+    parser.add_argument('--series', type=int, default=0, metavar='SAMPLES',
+                        help='write a 100 Hz time series of this many samples instead')
+    parser.add_argument('--bag', choices=('mcap', 'sqlite3'), default=None,
+                        help='write the time series as a rosbag2 bag (directory --out)')
+    parser.add_argument('--out', required=True, help='CSV file (or bag directory) to write')
+    args = parser.parse_args(argv)
+    plan = Plan(liquid=args.liquid, n_points=args.points)
+    injection = Injection.realistic(args.effect, args.scale, args.liquid)
+    table = (generate_series(plan, injection, args.seed, samples=args.series) if args.series
+             else generate(plan, injection, args.seed))
+    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+    if args.bag:
+        write_bag_of(args.out, table, args.bag)
+    else:
+        write_csv(args.out, to_columns(table))
+    print(f'wrote {args.out}: {len(table)} rows, {args.liquid}, {args.effect} '
+          f'(magnitude {injection.magnitude:.4g}, regressor {injection.regressor or "-"})')
+    return 0
+
+
+if __name__ == '__main__':
+    import sys
+    sys.exit(main())

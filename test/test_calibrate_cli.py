@@ -1,0 +1,121 @@
+# SPDX-License-Identifier: Apache-2.0
+"""``satmotor calibrate``: exact JSON fields, a loadable YAML, real plots, one-line errors."""
+
+import json
+
+import numpy as np
+import pytest
+
+from satmotor_ros.cli import main
+from satmotor_ros.identify import write_csv
+from satmotor_ros.identify.synthetic import generate, Injection, Plan
+from satmotor_ros.model import load_motor, MotorModel
+from satmotor_ros.model.units import LPM, MPA, RPM
+
+FIELDS = ['liquid', 'n_points', 'effect', 'regressor', 'coefficient', 'ci95', 'unit',
+          'error_before', 'error_after', 'candidates']
+
+
+def _csv(path, table, extra=()):
+    columns = {'time': ('s', table.channels['time']), 'speed': ('rpm', table.speed / RPM),
+               'flow': ('l/min', table.flow / LPM), 'p_in': ('MPa', table.p_in / MPA),
+               'p_out': ('bar', table.p_out / 1e5),
+               'temperature': ('degC', table.channels['temperature']),
+               'p_case': ('kPa', table.channels['p_case'] / 1e3),
+               'aux': ('V', table.channels['aux'])}
+    for name in extra:
+        columns[name] = ('-', np.linspace(0.0, 1.0, len(table)))
+    write_csv(path, columns)
+    return path
+
+
+def _run(capsys, *argv):
+    code = main([str(a) for a in argv])
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+@pytest.fixture(scope='module')
+def leak_run(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp('leak')
+    table = generate(Plan(liquid='water'), Injection.realistic('external_leakage', 1, 'water'),
+                     seed=7)
+    data = _csv(tmp / 'bench.csv', table)
+    code = main(['calibrate', str(data), '--liquid', 'water', '--out', str(tmp / 'out')])
+    return code, tmp / 'out', table
+
+
+def test_calibrate_writes_json_with_exactly_the_design_fields(leak_run):
+    code, out, _ = leak_run
+    assert code == 0
+    result = json.loads((out / 'calibration.json').read_text())
+    assert list(result) == FIELDS
+    assert result['effect'] == 'external_leakage'
+    assert result['regressor'] == 'p_case'
+    assert result['ci95'][0] <= 0.4 * LPM / MPA <= result['ci95'][1]
+    assert set(result['error_before']) == {'rmse_lpm', 'mean_abs_pct', 'max_abs_lpm'}
+    assert result['error_after']['rmse_lpm'] * 2 < result['error_before']['rmse_lpm']
+    assert all(set(c) == {'effect', 'regressor', 'cv_rmse_lpm'} for c in result['candidates'])
+    cv = [c['cv_rmse_lpm'] for c in result['candidates']]
+    assert cv == sorted(cv)
+
+
+def test_calibrated_yaml_loads_and_its_model_explains_the_data(leak_run):
+    _, out, table = leak_run
+    spec = load_motor(out / 'coefficients.yaml')
+    model = MotorModel.from_spec(spec, 'water')
+    assert model.coef.external_leakage > 0
+    block = (out / 'coefficients.yaml').read_text()
+    assert 'effects:' in block and 'regressor: p_case' in block
+    packaged = MotorModel.default('water')
+    p_case = table.channels['p_case']
+    fitted = model.absorbency(table.speed, dp=table.dp, p_ex=p_case).flow
+    before = packaged.absorbency(table.speed, dp=table.dp).flow
+    rms = lambda x: float(np.sqrt(np.mean(x ** 2))) / LPM  # noqa: E731
+    assert rms(table.flow - fitted) < 0.04
+    assert rms(table.flow - before) > 2 * rms(table.flow - fitted)
+
+
+def test_calibrate_report_has_real_plots(leak_run):
+    _, out, _ = leak_run
+    report = (out / 'report.md').read_text()
+    for name in ('residuals.png', 'characteristics.png', 'ranking.png'):
+        assert f'({name})' in report
+        data = (out / name).read_bytes()
+        assert data[:8] == b'\x89PNG\r\n\x1a\n' and len(data) > 10000
+    assert 'external_leakage(p_case)' in report
+
+
+def test_calibrate_clean_data_exits_zero_with_effect_none(tmp_path, capsys):
+    table = generate(Plan(liquid='oil'), Injection(), seed=3)
+    data = _csv(tmp_path / 'clean.csv', table, extra=('strain',))
+    code, out, _ = _run(capsys, 'calibrate', data, '--liquid', 'oil', '--out', tmp_path / 'o')
+    assert code == 0
+    assert out.startswith('effect: none')
+    result = json.loads((tmp_path / 'o' / 'calibration.json').read_text())
+    assert result['effect'] == 'none' and result['coefficient'] is None
+    assert any(c['effect'] == 'channel:strain' for c in result['candidates'])
+    assert 'effects:' not in (tmp_path / 'o' / 'coefficients.yaml').read_text()
+
+
+@pytest.mark.parametrize(('text', 'match'), [
+    ('speed [rpm],flow [l/min],p_in [MPa]\n1,2,3\n', "missing required column 'p_out'"),
+    ('speed [rpm],flow [gal/h],p_in [MPa],p_out [MPa]\n1,2,3,4\n', "unknown flow unit 'gal/h'"),
+    ('speed [rpm],flow [l/min],p_in [MPa],p_out [MPa]\n' + '600,20,10,1\n' * 20,
+     'one speed only'),
+    ('speed [rpm],flow [l/min],p_in [MPa],p_out [MPa]\n600,20,10,1\n700,22,12,1\n',
+     'too few points'),
+])
+def test_calibrate_unusable_data_is_one_line_and_exit_1(tmp_path, capsys, text, match):
+    data = tmp_path / 'bad.csv'
+    data.write_text(text)
+    code, out, err = _run(capsys, 'calibrate', data, '--liquid', 'oil', '--out', tmp_path / 'o')
+    assert code == 1
+    assert match in err
+    assert err.count('\n') == 1 and err.startswith('satmotor: error: ')
+
+
+def test_calibrate_unknown_liquid_is_one_line(tmp_path, capsys):
+    data = _csv(tmp_path / 'b.csv', generate(Plan(), Injection(), seed=0))
+    code, _, err = _run(capsys, 'calibrate', data, '--liquid', 'glycol', '--out', tmp_path)
+    assert code == 1 and "--liquid 'glycol'" in err
