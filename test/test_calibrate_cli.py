@@ -69,7 +69,8 @@ def test_calibrated_yaml_loads_and_its_model_explains_the_data(leak_run):
     assert 'effects:' in block and 'regressor: p_case' in block
     packaged = MotorModel.default('water')
     p_case = table.channels['p_case']
-    fitted = model.absorbency(table.speed, dp=table.dp, p_ex=p_case).flow
+    assert model.channels == ('p_case',)
+    fitted = model.absorbency(table.speed, dp=table.dp, channels={'p_case': p_case}).flow
     before = packaged.absorbency(table.speed, dp=table.dp).flow
     rms = lambda x: float(np.sqrt(np.mean(x ** 2))) / LPM  # noqa: E731
     assert rms(table.flow - fitted) < 0.04

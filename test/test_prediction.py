@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from satmotor_ros.model import CoefficientSet, MotorModel, PointStatus
-from satmotor_ros.model.units import LPM, MPA
+from satmotor_ros.model.units import ATMOSPHERE, LPM, MPA
 from satmotor_ros.prediction import (check_value, check_values, combine_batch, Combiner,
                                      driving_times, INPUTS, Level, predict_batch,
                                      predict_point, Rule)
@@ -110,7 +110,8 @@ def test_case_pressure_drives_external_leakage_and_blocks_when_stale():
     leaky = MotorModel(OIL.geometry, CoefficientSet(
         spec_set.name, spec_set.liquid,
         dataclasses.replace(spec_set.coefficients, external_leakage=1e-12)), OIL.valid_range)
-    pred = predict_point(leaky, _good(p_case=(0.5 * MPA, 5 * MS)).snapshot(10 * MS),
+    case = 0.5 * MPA + ATMOSPHERE  # FluidPressure is absolute; eq. (24) takes gauge
+    pred = predict_point(leaky, _good(p_case=(case, 5 * MS)).snapshot(10 * MS),
                          RULE.timeout)
     assert pred.output('p_ex') == 0.5 * MPA
     assert pred.output('external') == pytest.approx(1e-12 * 0.5 * MPA, rel=1e-12)
@@ -118,7 +119,7 @@ def test_case_pressure_drives_external_leakage_and_blocks_when_stale():
     assert pred.output('speed') == pytest.approx(float(ref.speed), rel=1e-14)
     without = predict_point(leaky, _good().snapshot(10 * MS), RULE.timeout)
     assert without.output('p_ex') == 0.0 and without.output('speed') > pred.output('speed')
-    stale = predict_point(leaky, _good(p_case=(0.5 * MPA, 0)).snapshot(900 * MS),
+    stale = predict_point(leaky, _good(p_case=(case, 0)).snapshot(900 * MS),
                           RULE.timeout)
     assert stale.level == Level.ERROR and 'case_pressure: last message' in stale.message
 

@@ -25,9 +25,8 @@ from satmotor_ros.bags import (BagError, describe_topics, FIELDS, list_topics, r
 from satmotor_ros.identify.errors import DataError
 from satmotor_ros.identify.table import BenchTable, table_from_columns
 from satmotor_ros.model._typing import FloatArray
+from satmotor_ros.model.units import ATMOSPHERE
 
-ATMOSPHERE = 101325.0
-"""Standard atmosphere, [Pa]: FluidPressure is absolute, bench tables are gauge."""
 
 COLUMNS = {'inlet_pressure': ('p_in', 'fluid_pressure'),
            'outlet_pressure': ('p_out', 'fluid_pressure'),

@@ -22,28 +22,11 @@ import numpy as np
 from satmotor_ros.identify.parts import LossParts, Modifier
 from satmotor_ros.identify.viscosity import ViscosityLaw
 from satmotor_ros.model._typing import FloatArray
+from satmotor_ros.model.effects import TERMS
 from satmotor_ros.model.units import LPM
 
 NAMED_CHANNELS = ('time', 'revolutions', 'temperature', 'p_case')
 """Channels a named physical effect covers; every other channel gets ``channel:<name>``."""
-
-TERMS: Mapping[str, tuple[Callable[[FloatArray, FloatArray], FloatArray], str]] = {
-    'n^2': (lambda n, dp: n ** 2, 'm^3/s/(rad/s)^2'),
-    'n^1.5': (lambda n, dp: n ** 1.5, 'm^3/s/(rad/s)^1.5'),
-    'dp^2': (lambda n, dp: dp ** 2, 'm^3/s/Pa^2'),
-    'dp^0.5': (lambda n, dp: dp ** 0.5, 'm^3/s/Pa^0.5'),
-    'dp^2*n': (lambda n, dp: dp ** 2 * n, 'm^3/s/(Pa^2*rad/s)'),
-    'dp*n^2': (lambda n, dp: dp * n ** 2, 'm^3/s/(Pa*(rad/s)^2)'),
-    'dp*n^0.5': (lambda n, dp: dp * n ** 0.5, 'm^3/s/(Pa*(rad/s)^0.5)'),
-    'dp^0.5*n': (lambda n, dp: dp ** 0.5 * n, 'm^3/s/(Pa^0.5*rad/s)'),
-}
-"""
-Functions of speed n [rad/s] and chamber drop dp = dp_i [Pa] that eqs. (31)-(33) lack.
-
-Left out on purpose, as the model or a named effect already has them: 1
-(flowmeter offset), n (sensor gains), n^0.5 (C_id, eq. 14), dp*n (C, eq. 33)
-and dp (the leakage of eqs. 1 and 5 is close to linear in dp).
-"""
 
 MIN_SPREAD = 1.0e-3
 """A regressor must vary by this share of its largest magnitude to be offered, [-]."""

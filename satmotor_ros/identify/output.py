@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 from satmotor_ros.identify.pipeline import Calibration
 from satmotor_ros.model import LossCoefficients
+from satmotor_ros.model.viscosity import WATER_VOGEL
 import yaml
 
 EVALUATION = {
@@ -126,7 +127,7 @@ def effect_block(cal: Calibration) -> dict[str, Any]:
         entry.update(law=law.law, reference_temperature=float(law.reference_temperature),
                      reference_viscosity=float(law.reference_viscosity))
         if law.law == 'vogel':
-            entry['vogel_c'] = 140.0
+            entry['vogel_c'] = WATER_VOGEL[2]
     elif chosen.effect == 'clearance_wear':
         entry['reference'] = float(np.min(cal.table.channels[chosen.regressor]))
     elif kind == 'channel':
@@ -159,6 +160,9 @@ def coefficients_document(cal: Calibration) -> dict[str, Any]:
                    'density': liquid.density, 'bulk_modulus': liquid.bulk_modulus},
         'coefficients': {f.name: float(getattr(coef, f.name)) for f in fields(coef)},
     }
+    span = _viscosity_span(cal)
+    if span is not None:
+        entry['viscosity_range'] = span
     effects = effect_block(cal)
     if effects:
         entry['effects'] = effects
@@ -170,6 +174,20 @@ def coefficients_document(cal: Calibration) -> dict[str, Any]:
                         for f in fields(spec.valid_range)},
         'coefficient_sets': {cal.liquid: entry},
     }
+
+
+def _viscosity_span(cal: Calibration) -> list[float] | None:
+    """Return the viscosity span the fit covers: the law over the data's temperatures."""
+    packaged = cal.model.coefficient_set.viscosity_range
+    chosen = cal.chosen
+    if chosen is None or chosen.effect != 'viscosity_temperature':
+        return None if packaged is None else [float(v) for v in packaged]
+    temperature = cal.table.channels['temperature']
+    law = cal.law
+    nu = law.viscosity(np.array([np.min(temperature), np.max(temperature)]),
+                       float(cal.final.values[3]))
+    low, high = sorted(float(v) for v in nu)
+    return [min(low, law.reference_viscosity), max(high, law.reference_viscosity)]
 
 
 def write_yaml(cal: Calibration, path: str | Path) -> None:

@@ -14,6 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass, fields
 import math
 
+from satmotor_ros.model.effects import Effect
 from satmotor_ros.model.errors import ConfigError
 from satmotor_ros.model.units import CM3_PER_REV
 
@@ -167,6 +168,7 @@ class CoefficientSet:
     liquid: Liquid
     coefficients: LossCoefficients
     viscosity_range: tuple[float, float] | None = None  # (nu_min, nu_max) [m^2/s]
+    effects: tuple[Effect, ...] = ()  # effects a calibration added, see .effects
 
     def __post_init__(self) -> None:
         """Reject an empty or non-physical viscosity range."""

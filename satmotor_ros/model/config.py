@@ -14,11 +14,13 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass
 from importlib import resources
+import math
 from pathlib import Path
 from typing import Any
 
 from satmotor_ros.model.coefficients import (CoefficientSet, field_names, FieldError, Liquid,
                                              LossCoefficients, MotorGeometry, ValidRange)
+from satmotor_ros.model.effects import Effect, effect_from_mapping
 from satmotor_ros.model.errors import ConfigError, UnitError
 from satmotor_ros.model.losses import compressibility_coefficient
 from satmotor_ros.model.units import parse_quantity
@@ -182,10 +184,10 @@ def coefficient_set_from_mapping(doc: Any, name: str, geometry: MotorGeometry) -
     """
     where = f'coefficient_sets.{name}'
     doc = _mapping(doc, where, {'liquid', 'coefficients'})
-    unknown = sorted(set(doc) - {'liquid', 'coefficients', 'viscosity_range'})
+    unknown = sorted(set(doc) - {'liquid', 'coefficients', 'viscosity_range', 'effects'})
     if unknown:
         msg = (f'{where} has unknown key(s): {", ".join(map(str, unknown))} '
-               '(known: liquid, coefficients, viscosity_range)')
+               '(known: liquid, coefficients, viscosity_range, effects)')
         raise ConfigError(msg)
     liquid = liquid_from_mapping(doc['liquid'], f'{where}.liquid', default_name=name)
     span = _viscosity_range(doc.get('viscosity_range'), f'{where}.viscosity_range')
@@ -197,8 +199,28 @@ def coefficient_set_from_mapping(doc: Any, name: str, geometry: MotorGeometry) -
                f'{coef.compressed_volume_fraction!r} gives C_fc*beta_l = {c_fc:.4g} > '
                f'c = {coef.c!r}: the compressibility share cannot exceed the lumped C')
         raise ConfigError(msg)
+    effects = _effects(doc.get('effects'), f'{where}.effects', coef)
     return _construct(CoefficientSet, where, name=name, liquid=liquid, coefficients=coef,
-                      viscosity_range=span)
+                      viscosity_range=span, effects=effects)
+
+
+def _effects(doc: Any, where: str, coef: LossCoefficients) -> tuple[Effect, ...]:
+    if not doc:
+        return ()
+    effects = tuple(effect_from_mapping(name, block, where)
+                    for name, block in _mapping(doc, where, None).items())
+    kinds = [e.kind for e in effects]
+    twice = sorted({k for k in kinds if kinds.count(k) > 1 and k not in ('channel', 'term')})
+    if twice:
+        msg = f'{where} has more than one {", ".join(twice)} effect'
+        raise ConfigError(msg)
+    for effect in effects:
+        k, k_ex = effect.coefficient, coef.external_leakage
+        if effect.kind == 'external_leakage' and not math.isclose(k, k_ex, rel_tol=1e-9):
+            msg = (f'{where}.external_leakage.coefficient = {k!r} differs from '
+                   f'coefficients.external_leakage = {k_ex!r}: eq. (24) takes one k_ex')
+            raise ConfigError(msg)
+    return effects
 
 
 def _viscosity_range(doc: Any, where: str) -> tuple[float, float] | None:

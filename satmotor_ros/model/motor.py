@@ -16,14 +16,17 @@ with ``errors='raise'`` (the default) the first bad element raises
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from typing import Literal
 
 from satmotor_ros.model._typing import ArrayLike
 from satmotor_ros.model.coefficients import (CoefficientSet, Liquid, MotorGeometry,
                                              ValidRange)
 from satmotor_ros.model.composition import Equations
+from satmotor_ros.model.conditioned import ConditionedModel, map_points
 from satmotor_ros.model.config import load_motor, MotorSpec
 from satmotor_ros.model.derived import derive
+from satmotor_ros.model.effects import true_flow, true_speed
 from satmotor_ros.model.errors import ModelError
 from satmotor_ros.model.forward import absorbency_map
 from satmotor_ros.model.inverse import speed_map
@@ -81,6 +84,9 @@ class MotorModel:
         self.displacement_law = displacement_law
         self._equations = Equations(geometry, self.coef, self.liquid, self.derived, self.law)
         self._point = PointEvaluator(self.derived, not self.law.closed_form)
+        self.effects = coefficient_set.effects
+        self._conditioned = ConditionedModel(self) if self.effects else None
+        self.channels = self._conditioned.channels if self._conditioned else ()
 
     @property
     def c_fc_beta(self) -> float:
@@ -167,7 +173,8 @@ class MotorModel:
 
     def speed(self, flow: ArrayLike, dp: ArrayLike | None = None, *,
               dp_i: ArrayLike | None = None, p_ex: ArrayLike = 0.0, errors: Errors = 'raise',
-              method: Literal['auto', 'iterative'] = 'auto') -> OperatingPoints:
+              method: Literal['auto', 'iterative'] = 'auto',
+              channels: Mapping[str, ArrayLike] | None = None) -> OperatingPoints:
         """
         Compute the effective speed and losses from flow and pressure (inverse map).
 
@@ -188,6 +195,9 @@ class MotorModel:
             Raise on the first invalid element, or return it as NaN, [-]
         method : {'auto', 'iterative'}
             Force the numerical solver even where eq. (40) applies, [-]
+        channels : mapping of str to float or ndarray, optional
+            Measured channels the coefficient set's effects need (see
+            :attr:`channels`; gauge Pa, degC, s, rev), [-]
 
         Returns
         -------
@@ -199,12 +209,17 @@ class MotorModel:
         if method not in ('auto', 'iterative'):
             msg = f"method = {method!r}: use 'auto' or 'iterative'"
             raise ModelError(msg)
+        if self._conditioned is not None:
+            return map_points(
+                lambda q, d, p, c: self.speed_point(q, **{dp_name: d}, p_ex=p, channels=c),
+                ('flow', flow), (dp_name, dp_value), p_ex, channels, self.geometry, errors)
         closed_form = self.law.closed_form and method == 'auto'
         return speed_map(self._equations, flow, dp_name, dp_value, p_ex, errors, closed_form)
 
     def absorbency(self, speed: ArrayLike, dp: ArrayLike | None = None, *,
                    dp_i: ArrayLike | None = None, p_ex: ArrayLike = 0.0,
-                   errors: Errors = 'raise') -> OperatingPoints:
+                   errors: Errors = 'raise',
+                   channels: Mapping[str, ArrayLike] | None = None) -> OperatingPoints:
         """
         Compute the flow the motor absorbs at a speed and pressure (forward map).
 
@@ -224,6 +239,8 @@ class MotorModel:
             Pressure driving the external leakage, eq. (24), [Pa]
         errors : {'raise', 'mask'}
             Raise on the first invalid element, or return it as NaN, [-]
+        channels : mapping of str to float or ndarray, optional
+            Measured channels the coefficient set's effects need, [-]
 
         Returns
         -------
@@ -232,6 +249,10 @@ class MotorModel:
 
         """
         dp_name, dp_value = self._which_dp(dp, dp_i)
+        if self._conditioned is not None:
+            return map_points(
+                lambda n, d, p, c: self.absorbency_point(n, **{dp_name: d}, p_ex=p, channels=c),
+                ('speed', speed), (dp_name, dp_value), p_ex, channels, self.geometry, errors)
         return absorbency_map(self._equations, speed, dp_name, dp_value, p_ex, errors)
 
     @staticmethod
@@ -241,7 +262,8 @@ class MotorModel:
         return ('dp', dp) if dp is not None else ('dp_i', dp_i)
 
     def breakdown(self, speed: ArrayLike, dp_i: ArrayLike, p_ex: ArrayLike = 0.0,
-                  errors: Errors = 'raise') -> LossBreakdown:
+                  errors: Errors = 'raise',
+                  channels: Mapping[str, ArrayLike] | None = None) -> LossBreakdown:
         """
         Compute the loss components at given speed and chamber pressure drop, eq. (31).
 
@@ -255,19 +277,23 @@ class MotorModel:
             Pressure driving the external leakage, eq. (24), [Pa]
         errors : {'raise', 'mask'}
             Raise on the first invalid element, or return it as NaN, [-]
+        channels : mapping of str to float or ndarray, optional
+            Measured channels the coefficient set's effects need, [-]
 
         Returns
         -------
         LossBreakdown
-            Every component of eq. (31) and their total, [m^3/s]
+            Every component of eq. (31) and their total (with any extra loss of
+            an effect), [m^3/s]
 
         """
-        return self.absorbency(speed, dp_i=dp_i, p_ex=p_ex, errors=errors).losses
+        return self.absorbency(speed, dp_i=dp_i, p_ex=p_ex, errors=errors,
+                               channels=channels).losses
 
     # -- single points ---------------------------------------------------------------------
 
     def speed_point(self, flow: float, dp: float | None = None, *, dp_i: float | None = None,
-                    p_ex: float = 0.0) -> Point:
+                    p_ex: float = 0.0, channels: Mapping[str, float] | None = None) -> Point:
         """
         Compute the inverse map n(Q, dp) at one operating point, on Python floats.
 
@@ -285,6 +311,8 @@ class MotorModel:
             Pressure drop in the working chambers, instead of `dp`, [Pa]
         p_ex : float
             Pressure driving the external leakage, eq. (24), [Pa]
+        channels : mapping of str to float, optional
+            Measured channels the coefficient set's effects need, [-]
 
         Returns
         -------
@@ -294,7 +322,8 @@ class MotorModel:
         Raises
         ------
         ModelError
-            If not exactly one of `dp` and `dp_i` is given, or an argument is not a number.
+            If not exactly one of `dp` and `dp_i` is given, an argument is not a
+            number, or an effect's channel is missing.
 
         """
         if dp is None:
@@ -311,11 +340,14 @@ class MotorModel:
             value = as_float('dp' if port else 'dp_i', value)
         if type(p_ex) is not float:
             p_ex = as_float('p_ex', p_ex)
+        if self._conditioned is not None:
+            return self._conditioned.speed_point(flow, value, port, p_ex, channels)
         return self._point.speed(flow, value, port, p_ex)
 
     def absorbency_point(self, speed: float, dp: float | None = None, *,
                          dp_i: float | None = None, p_ex: float = 0.0,
-                         flow_guess: float | None = None) -> Point:
+                         flow_guess: float | None = None,
+                         channels: Mapping[str, float] | None = None) -> Point:
         """
         Compute the forward map Q(n, dp) at one operating point, on Python floats.
 
@@ -336,6 +368,8 @@ class MotorModel:
         flow_guess : float, optional
             Starting estimate of Q for the coupled solve; ignored unless it is
             finite and above q_t*n, [m^3/s]
+        channels : mapping of str to float, optional
+            Measured channels the coefficient set's effects need, [-]
 
         Returns
         -------
@@ -364,9 +398,13 @@ class MotorModel:
             p_ex = as_float('p_ex', p_ex)
         if flow_guess is not None and type(flow_guess) is not float:
             flow_guess = as_float('flow_guess', flow_guess)
+        if self._conditioned is not None:
+            return self._conditioned.absorbency_point(speed, value, port, p_ex, flow_guess,
+                                                      channels)
         return self._point.absorbency(speed, value, port, p_ex, flow_guess)
 
-    def breakdown_point(self, speed: float, dp_i: float, p_ex: float = 0.0) -> Point:
+    def breakdown_point(self, speed: float, dp_i: float, p_ex: float = 0.0,
+                        channels: Mapping[str, float] | None = None) -> Point:
         """
         Compute the loss components at one speed and chamber pressure drop, eq. (31).
 
@@ -378,6 +416,8 @@ class MotorModel:
             Pressure drop in the working chambers, [Pa]
         p_ex : float
             Pressure driving the external leakage, eq. (24), [Pa]
+        channels : mapping of str to float, optional
+            Measured channels the coefficient set's effects need, [-]
 
         Returns
         -------
@@ -391,4 +431,42 @@ class MotorModel:
             dp_i = as_float('dp_i', dp_i)
         if type(p_ex) is not float:
             p_ex = as_float('p_ex', p_ex)
+        if self._conditioned is not None:
+            return self._conditioned.absorbency_point(speed, dp_i, False, p_ex, None, channels)
         return self._point.absorbency(speed, dp_i, False, p_ex, None)
+
+    # -- instruments -----------------------------------------------------------------------
+
+    def true_flow(self, reading: ArrayLike) -> ArrayLike:
+        """
+        Return the flow through the motor from a flowmeter reading (sensor effects).
+
+        Parameters
+        ----------
+        reading : float or ndarray
+            What the flowmeter reads, [m^3/s]
+
+        Returns
+        -------
+        float or ndarray
+            The flow; the reading itself when the set has no flowmeter effect, [m^3/s]
+
+        """
+        return true_flow(self.effects, reading)
+
+    def true_speed(self, reading: ArrayLike) -> ArrayLike:
+        """
+        Return the shaft speed from a speed-sensor reading (sensor effects).
+
+        Parameters
+        ----------
+        reading : float or ndarray
+            What the speed sensor reads, [rad/s]
+
+        Returns
+        -------
+        float or ndarray
+            The speed; the reading itself without a speed-sensor effect, [rad/s]
+
+        """
+        return true_speed(self.effects, reading)

@@ -33,6 +33,9 @@ CM3_PER_MIN = 1.0e-6 / 60.0
 CM3_PER_REV = 1.0e-6 / (2.0 * math.pi)
 """One cm^3/rev in m^3/rad (eq. 33's and eq. 39's Delta q in the paper's unit)."""
 
+ATMOSPHERE = 101325.0
+"""Standard atmosphere in Pa: absolute (sensor_msgs/FluidPressure) minus this is gauge."""
+
 # kind -> unit -> (scale, offset): si = value * scale + offset
 _UNITS: dict[str, dict[str, tuple[float, float]]] = {
     'flow': {

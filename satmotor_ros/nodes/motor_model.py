@@ -150,6 +150,7 @@ class MotorModelNode(Node):
         self._joint = values['joint_name']
         self._worst: Prediction | None = None  # the worst prediction since the last report
         self._published = self._rejected = self._no_joint = 0
+        self._origin_ns: int | None = None  # first prediction: the effects' time channel [ns]
         self._last_level = -1
         depth = values['qos_depth']
         sensor = QoSProfile(depth=depth, reliability=qos_profile_sensor_data.reliability,
@@ -222,8 +223,9 @@ class MotorModelNode(Node):
         if self._model is None:
             return f'none ({self._model_error})'
         m = self._model
+        effects = ', '.join(e.name for e in m.effects) or 'none'
         return (f'{m.name}, {m.coefficient_set.name} set, {m.liquid.name}, '
-                f'{m.displacement_law}')
+                f'{m.displacement_law}, effects: {effects}')
 
     # -- inputs -----------------------------------------------------------------------------
 
@@ -264,7 +266,9 @@ class MotorModelNode(Node):
             pred = Prediction(t_ns, snap.values, (), 0, Level.ERROR,
                               f'no model: {self._model_error}')
         else:
-            pred = predict_point(self._model, snap, self._rule.timeout)
+            if self._origin_ns is None:
+                self._origin_ns = t_ns
+            pred = predict_point(self._model, snap, self._rule.timeout, self._origin_ns)
         if self._worst is None or pred.level >= self._worst.level:
             self._worst = pred
         if pred.level != self._last_level:
@@ -326,7 +330,7 @@ class MotorModelNode(Node):
         if self._model is None:
             return Prediction(now, snap.values, (), 0, Level.ERROR,
                               f'no model: {self._model_error}')
-        pred = predict_point(self._model, snap, self._rule.timeout)
+        pred = predict_point(self._model, snap, self._rule.timeout, self._origin_ns)
         if pred.valid:  # inputs fresh, but no flow_command drove a prediction
             return pred._replace(level=Level.WARN, message='no prediction within '
                                  f'input_timeout {self._rule.timeout:g} s')

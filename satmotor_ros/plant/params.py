@@ -13,11 +13,8 @@ from dataclasses import dataclass, field, fields
 import math
 from typing import ClassVar
 
-from satmotor_ros.model.units import LPM, MPA
+from satmotor_ros.model.units import ATMOSPHERE, LPM, MPA
 from satmotor_ros.plant.errors import PlantError
-
-ATMOSPHERE = 101325.0
-"""Standard atmospheric pressure, the default tank pressure, [Pa]."""
 
 
 def check_bounds(record: object) -> None:

@@ -18,15 +18,50 @@ import numpy as np
 import numpy.typing as npt
 
 from satmotor_ros.model import COMPONENTS, describe_status, INVALID, MotorModel, PointStatus
-from satmotor_ros.prediction.rule import (describe_input, input_level, INPUTS, InputState,
-                                          Level, Snapshot, SnapshotBatch)
+from satmotor_ros.model._typing import FloatArray
+from satmotor_ros.model.units import ATMOSPHERE
+from satmotor_ros.prediction.rule import (describe_input, FIELDS, input_level, INPUTS,
+                                          InputState, Level, Snapshot, SnapshotBatch)
 
 OUTPUTS = ('dp', 'dp_i', 'p_ex', 'speed', *COMPONENTS, 'residual')
 """Computed fields of a prediction (SI: Pa, rad/s, m^3/s), after the inputs."""
 
 _NOTED = PointStatus.STALLED | PointStatus.CHANNEL_LIMITED | PointStatus.EXTRAPOLATED
+_I_OUT = INPUTS.index('p_out')
 _I_CASE = INPUTS.index('p_case')
 _I_SPEED = INPUTS.index('measured_speed')
+_GAUGED = {'p_case': _I_CASE, 'p_out': _I_OUT}
+_MEASURED = {**_GAUGED, 'temperature': INPUTS.index('temperature')}
+CHANNELS = ('p_case', 'p_out', 'temperature', 'time')
+"""
+Channels a calibrated effect may read (``MotorModel.channels``): case and outlet pressure
+made gauge (absolute - ATMOSPHERE, floored at 0) [Pa], temperature [degC], and time since
+the first prediction [s], as ``satmotor calibrate`` counts it from the start of a bag.
+"""
+
+
+def _gauge(p: float) -> float:
+    return p - ATMOSPHERE if p > ATMOSPHERE else 0.0
+
+
+def _channels(model: MotorModel, snap: Snapshot,
+              origin_ns: int) -> tuple[dict[str, float] | None, str]:
+    """Return the channels the model's effects need, or None and why they are missing."""
+    channels: dict[str, float] = {}
+    for name in model.channels:
+        if name == 'time':
+            channels[name] = (snap.stamp_ns - origin_ns) * 1e-9
+            continue
+        i = _MEASURED.get(name)
+        if i is None:
+            return None, (f'the calibrated effect needs the channel {name!r}, which '
+                          f'motor_model does not measure (it has: {", ".join(CHANNELS)})')
+        if snap.states[i] != InputState.FRESH:
+            return None, (f'the calibrated effect needs {FIELDS[INPUTS[i]]}: '
+                          f'{InputState(snap.states[i]).name.lower()}')
+        value = snap.values[i]
+        channels[name] = _gauge(value) if name in _GAUGED else value
+    return channels, ''
 
 
 class Prediction(NamedTuple):
@@ -100,7 +135,8 @@ def _input_level(states: tuple[int, ...]) -> int:
     return max(row[state] for row, state in zip(_LEVEL_ROWS, states))
 
 
-def predict_point(model: MotorModel, snap: Snapshot, timeout: float) -> Prediction:
+def predict_point(model: MotorModel, snap: Snapshot, timeout: float,
+                  origin_ns: int | None = None) -> Prediction:
     """
     Predict from one snapshot of the inputs (the live node's path).
 
@@ -112,6 +148,9 @@ def predict_point(model: MotorModel, snap: Snapshot, timeout: float) -> Predicti
         The inputs at the driving time, [-]
     timeout : float
         The input timeout, quoted in messages, [s]
+    origin_ns : int, optional
+        Time of the first prediction, from which the ``time`` channel counts; the
+        snapshot's own time when omitted, [ns]
 
     Returns
     -------
@@ -120,18 +159,23 @@ def predict_point(model: MotorModel, snap: Snapshot, timeout: float) -> Predicti
 
     """
     inputs_level = _input_level(snap.states)
-    if inputs_level >= Level.ERROR:
+    channels, why = None, ''
+    if inputs_level < Level.ERROR and model.channels:
+        channels, why = _channels(model, snap, snap.stamp_ns if origin_ns is None else origin_ns)
+    if inputs_level >= Level.ERROR or why:
         level, message = _messages(snap, timeout, 0, math.nan)
+        if why:
+            level, message = Level.ERROR, why if message == 'OK' else f'{message}; {why}'
         return Prediction(snap.stamp_ns, snap.values, (math.nan,) * len(OUTPUTS), 0, level,
                           message)
     flow, p_in, p_out = snap.values[0], snap.values[1], snap.values[2]
-    p_ex = snap.values[_I_CASE] if snap.states[_I_CASE] == InputState.FRESH else 0.0
+    p_ex = _gauge(snap.values[_I_CASE]) if snap.states[_I_CASE] == InputState.FRESH else 0.0
     dp = p_in - p_out
-    point = model.speed_point(flow, dp, p_ex=p_ex)
+    point = model.speed_point(flow, dp, p_ex=p_ex, channels=channels)
     status = point.status
     speed = point.speed
-    residual = (snap.values[_I_SPEED] - speed if snap.states[_I_SPEED] == InputState.FRESH
-                else math.nan)
+    residual = (model.true_speed(snap.values[_I_SPEED]) - speed
+                if snap.states[_I_SPEED] == InputState.FRESH else math.nan)
     if inputs_level == Level.OK and not status & _NOTED_OR_INVALID:
         level, message = Level.OK, 'OK'  # the usual case, without building any text
     else:
@@ -218,7 +262,8 @@ class PredictionBatch(NamedTuple):
         return _messages(self.snapshot(i), self.timeout, int(self.status[i]), dp)[1]
 
 
-def predict_batch(model: MotorModel, snaps: SnapshotBatch, timeout: float) -> PredictionBatch:
+def predict_batch(model: MotorModel, snaps: SnapshotBatch, timeout: float,
+                  origin_ns: int | None = None) -> PredictionBatch:
     """
     Predict from many snapshots at once (bag replay's path), as :func:`predict_point` would.
 
@@ -230,6 +275,9 @@ def predict_batch(model: MotorModel, snaps: SnapshotBatch, timeout: float) -> Pr
         The inputs at every driving time, [-]
     timeout : float
         The input timeout, quoted in messages, [s]
+    origin_ns : int, optional
+        Time from which the ``time`` channel counts; the first driving time when
+        omitted, [ns]
 
     Returns
     -------
@@ -242,20 +290,50 @@ def predict_batch(model: MotorModel, snaps: SnapshotBatch, timeout: float) -> Pr
     level = np.zeros(n, dtype=np.uint8)
     for i in range(len(INPUTS)):
         np.maximum(level, _LEVELS[i][states[i]], out=level)
+    channels = None
+    if model.channels:
+        level, channels = _batch_channels(model, snaps, level, origin_ns)
     usable = level < Level.ERROR
     flow = np.where(usable, values[0], 0.0)
     dp = np.where(usable, values[1] - values[2], 0.0)
-    p_ex = np.where(usable & (states[_I_CASE] == InputState.FRESH), values[_I_CASE], 0.0)
-    op = model.speed(flow, dp, p_ex=p_ex, errors='mask')
+    p_ex = np.where(usable & (states[_I_CASE] == InputState.FRESH),
+                    np.maximum(values[_I_CASE] - ATMOSPHERE, 0.0), 0.0)
+    op = model.speed(flow, dp, p_ex=p_ex, errors='mask', channels=channels)
     status = np.where(usable, op.status, 0).astype(np.uint8)
     model_level = np.where(status & int(INVALID), np.uint8(Level.ERROR),
                            np.where(status & int(_NOTED), np.uint8(Level.WARN), np.uint8(0)))
     np.maximum(level, model_level, out=level)
     speed = op.speed
-    residual = np.where(states[_I_SPEED] == InputState.FRESH, values[_I_SPEED] - speed, np.nan)
+    residual = np.where(states[_I_SPEED] == InputState.FRESH,
+                        model.true_speed(values[_I_SPEED]) - speed, np.nan)
     columns = [dp, op.dp_i, p_ex, speed, *op.losses.as_dict().values(), residual]
     outputs = np.empty((len(OUTPUTS), n))
     for row, column in zip(outputs, columns):
         row[:] = column
     outputs[:, level >= Level.ERROR] = np.nan
     return PredictionBatch(snaps, outputs, status, level, timeout)
+
+
+def _batch_channels(model: MotorModel, snaps: SnapshotBatch, level: npt.NDArray[np.uint8],
+                    origin_ns: int | None) -> tuple[npt.NDArray[np.uint8], dict[str, FloatArray]]:
+    """Return the levels with missing channels made ERROR, and the channels (0 there)."""
+    channels: dict[str, FloatArray] = {}
+    level = level.copy()
+    stamps = snaps.stamp_ns
+    for name in model.channels:
+        if name == 'time':
+            origin = int(stamps[0]) if origin_ns is None and len(stamps) else origin_ns or 0
+            channels[name] = (stamps - origin) * 1e-9
+            continue
+        i = _MEASURED.get(name)
+        if i is None:
+            level[:] = Level.ERROR
+            channels[name] = np.zeros(len(level))
+            continue
+        fresh = snaps.states[i] == InputState.FRESH
+        level[~fresh] = Level.ERROR
+        value = snaps.values[i]
+        if name in _GAUGED:
+            value = np.maximum(value - ATMOSPHERE, 0.0)
+        channels[name] = np.where(fresh & (level < Level.ERROR), value, 0.0)
+    return level, channels

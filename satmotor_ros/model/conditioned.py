@@ -1,0 +1,474 @@
+# SPDX-License-Identifier: Apache-2.0
+"""
+A coefficient set's effects (:mod:`.effects`) evaluated at measured channels.
+
+Effects that change the motor build a variant of it: a viscosity from the
+liquid temperature, clearances grown by wear (cached by value, so a steady
+channel costs one build). Effects that add a loss to Q_vl (``channel:`` and
+``term:``) are solved with eq. (36) by a bracketed root search on Python
+floats whose residual is checked like every other solve of the model. Every
+array map with effects is the single-point path applied element by element,
+so the two agree exactly.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import replace
+import math
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from satmotor_ros.model.coefficients import MotorGeometry
+from satmotor_ros.model.effects import Effect, SENSOR_KINDS, TERMS
+from satmotor_ros.model.errors import ConfigError, InvalidInputError, ModelError
+from satmotor_ros.model.results import (COMPONENTS, describe_status, INVALID, LossBreakdown,
+                                        OperatingPoints, Point, PointStatus)
+from satmotor_ros.model.screening import CHECK, FLOW_ATOL
+from satmotor_ros.model.viscosity import vogel_viscosity, walther_viscosity
+
+if TYPE_CHECKING:
+    from satmotor_ros.model.motor import MotorModel
+
+Channels = Mapping[str, float]
+_CACHE = 4096  # variants kept before the cache is cleared
+_ITERATIONS = 200
+_EXPANSIONS = 60
+_INVALID_FLAGS = int(INVALID)
+_STALLED = int(PointStatus.STALLED)
+_CHANNEL_LIMITED = int(PointStatus.CHANNEL_LIMITED)
+
+
+def _invalid(status: int) -> Point:
+    return Point(*(math.nan,) * 12, status)
+
+
+def effect_viscosity(effect: Effect, temperature: float) -> float:
+    """
+    Return the viscosity of a ``viscosity_temperature`` effect at a temperature.
+
+    Parameters
+    ----------
+    effect : Effect
+        The effect (law, reference temperature and viscosity, slope), [-]
+    temperature : float
+        Liquid temperature, [degC]
+
+    Returns
+    -------
+    float
+        Kinematic viscosity, [m^2/s]
+
+    """
+    if effect.law == 'vogel':
+        return float(vogel_viscosity(temperature, effect.reference_temperature,
+                                     effect.reference_viscosity, effect.coefficient,
+                                     effect.vogel_c))
+    return float(walther_viscosity(temperature, effect.reference_temperature,
+                                   effect.reference_viscosity, effect.coefficient))
+
+
+def wear_growth(effect: Effect, x: float) -> float:
+    """
+    Return the growth of both axial clearances of a ``clearance_wear`` effect.
+
+    Parameters
+    ----------
+    effect : Effect
+        The effect, [-]
+    x : float
+        Time [s] or cumulative revolutions [rev], as the effect's regressor, [s or rev]
+
+    Returns
+    -------
+    float
+        k (x - reference), never below 0, [m]
+
+    """
+    return max(effect.coefficient * (x - effect.reference), 0.0)
+
+
+def _bracketed_root(f: Callable[[float], float], lo: float, f_lo: float, hi: float,
+                    f_hi: float) -> tuple[float, bool]:
+    """Find a root of f in [lo, hi] with f(lo) < 0 < f(hi) (Illinois false position)."""
+    side = 0
+    for _ in range(_ITERATIONS):
+        x = hi - f_hi * (hi - lo) / (f_hi - f_lo)
+        if not lo < x < hi:
+            x = 0.5 * (lo + hi)
+        fx = f(x)
+        if fx != fx:
+            return x, False
+        if fx == 0.0 or hi - lo <= 4e-16 * abs(x):
+            return x, True
+        if fx < 0.0:
+            lo, f_lo = x, fx
+            if side == -1:
+                f_hi *= 0.5
+            side = -1
+        else:
+            hi, f_hi = x, fx
+            if side == 1:
+                f_lo *= 0.5
+            side = 1
+    return x, False
+
+
+class ConditionedModel:
+    """
+    The effects of a model's coefficient set, evaluated point by point.
+
+    Parameters
+    ----------
+    model : MotorModel
+        A model whose coefficient set has effects, [-]
+
+    """
+
+    def __init__(self, model: MotorModel) -> None:
+        """Sort the effects by what they do and build the motor without them."""
+        effects = model.coefficient_set.effects
+        motor = [e for e in effects if e.kind not in SENSOR_KINDS]
+        self.channels = tuple(sorted({e.channel for e in motor if e.channel}))
+        found = {e.kind: e for e in motor}
+        self._leakage = found.get('external_leakage')
+        self._viscosity = found.get('viscosity_temperature')
+        self._wear = found.get('clearance_wear')
+        self._constant = [e for e in motor if e.kind == 'channel']
+        self._terms = [(e.coefficient, TERMS[e.regressor][0]) for e in motor if e.kind == 'term']
+        self._model = model
+        self._bare = type(model)(model.geometry, replace(model.coefficient_set, effects=()),
+                                 model.valid_range, model.liquid, model.displacement_law,
+                                 model.name)
+        self._variants: dict[tuple[float, float], MotorModel] = {}
+
+    # -- conditions ------------------------------------------------------------------------
+
+    def _channel(self, channels: Channels | None, effect: Effect) -> float:
+        name = effect.regressor
+        if channels is None or name not in channels:
+            given = ', '.join(channels) if channels else 'none'
+            msg = (f'effect {effect.name} needs the channel {name!r} '
+                   f'(channels given: {given})')
+            raise ModelError(msg)
+        return float(channels[name])
+
+    def _variant(self, viscosity: float, growth: float) -> MotorModel:
+        key = (viscosity, growth)
+        model = self._variants.get(key)
+        if model is None:
+            bare = self._bare
+            g: MotorGeometry = bare.geometry
+            if growth:
+                g = replace(g, clearance_rotor=g.clearance_rotor + growth,
+                            clearance_satellites=g.clearance_satellites + growth)
+            liquid = bare.liquid
+            if viscosity != liquid.kinematic_viscosity:
+                liquid = replace(liquid, kinematic_viscosity=viscosity)
+            if len(self._variants) >= _CACHE:
+                self._variants.clear()
+            model = type(bare)(g, bare.coefficient_set, bare.valid_range, liquid,
+                               bare.displacement_law, bare.name)
+            self._variants[key] = model
+        return model
+
+    def conditions(self, channels: Channels | None,
+                   p_ex: float) -> tuple[MotorModel | None, float, float, int]:
+        """
+        Return the motor at the channels' values, p_ex, the constant extra loss and a status.
+
+        Parameters
+        ----------
+        channels : mapping of str to float or None
+            Measured channels by name (SI; temperature in degC), [-]
+        p_ex : float
+            Pressure driving the external leakage when no effect names one, [Pa]
+
+        Returns
+        -------
+        tuple
+            The motor (None when the channels make it invalid), p_ex [Pa], the
+            sum of the ``channel:`` losses [m^3/s] and the PointStatus flags.
+
+        Raises
+        ------
+        ModelError
+            When a channel an effect needs is not given.
+
+        """
+        values = {e.name: self._channel(channels, e)
+                  for e in (self._leakage, self._viscosity, self._wear, *self._constant) if e}
+        if any(not math.isfinite(v) for v in values.values()):
+            return None, p_ex, 0.0, int(PointStatus.NOT_FINITE)
+        if self._leakage is not None:
+            p_ex = values[self._leakage.name]
+        viscosity = self._bare.liquid.kinematic_viscosity
+        if self._viscosity is not None:
+            viscosity = effect_viscosity(self._viscosity, values[self._viscosity.name])
+        growth = 0.0 if self._wear is None else wear_growth(self._wear, values[self._wear.name])
+        try:
+            model = self._variant(viscosity, growth)
+        except (ConfigError, OverflowError, ValueError):
+            return None, p_ex, 0.0, int(PointStatus.BEYOND_LIMIT)
+        constant = math.fsum(e.coefficient * (values[e.name] - e.reference)
+                             for e in self._constant)
+        return model, p_ex, constant, 0
+
+    def _extra(self, speed: float, dp_i: float, constant: float) -> float:
+        return constant + sum(k * f(speed, dp_i) for k, f in self._terms)
+
+    def _with_extra(self, point: Point, flow: float | None, dp: float | None, extra: float,
+                    status: int) -> Point:
+        """Return `point` with `extra` in Q_vl (and in Q when `flow` is None)."""
+        if point.status & _INVALID_FLAGS:
+            return point
+        values = point._asdict()
+        values['total'] = point.total + extra
+        values['flow'] = point.flow + extra if flow is None else flow
+        if dp is not None:
+            values['dp'] = dp
+        values['status'] = (point.status & ~_STALLED) | status
+        return Point(**values)
+
+    # -- maps ------------------------------------------------------------------------------
+
+    def speed_point(self, flow: float, dp: float, port: bool, p_ex: float,
+                    channels: Channels | None) -> Point:
+        """
+        Compute the inverse map n(Q, dp) at one point with the effects.
+
+        Parameters
+        ----------
+        flow : float
+            Flow into the motor Q, [m^3/s]
+        dp : float
+            Port drop if `port`, else chamber drop, [Pa]
+        port : bool
+            Whether `dp` is between the ports, [-]
+        p_ex : float
+            Pressure driving the external leakage when no effect names one, [Pa]
+        channels : mapping of str to float or None
+            Measured channels by name, [-]
+
+        Returns
+        -------
+        Point
+            The operating point; Q_vl holds the effects' extra loss.
+
+        """
+        model, p_ex, constant, status = self.conditions(channels, p_ex)
+        if model is None:
+            return _invalid(status)
+        if not self._terms and constant == 0.0:
+            return model.speed_point(flow, dp if port else None,
+                                     dp_i=None if port else dp, p_ex=p_ex)
+        first = model.speed_point(flow, dp if port else None, dp_i=None if port else dp,
+                                  p_ex=p_ex)
+        if first.status & _INVALID_FLAGS:
+            return first
+        dp_i, limited = first.dp_i, first.status & _CHANNEL_LIMITED
+        evaluator = model._point  # noqa: SLF001 -- the same equations, on floats
+
+        def excess(n: float) -> float:
+            at = evaluator.absorbency(n, dp_i, False, p_ex, None)
+            return at.flow + self._extra(n, dp_i, constant) - flow
+
+        lo = evaluator.speed_floor(dp_i) if evaluator.empirical else 0.0
+        f_lo = excess(lo)
+        if f_lo != f_lo:
+            return _invalid(int(PointStatus.NO_ROOT))
+        if f_lo >= 0.0:
+            if lo > 0.0:  # eq. (39) below its speed floor has no answer, as in point.py
+                return _invalid(int(PointStatus.NO_ROOT))
+            speed, status = 0.0, _STALLED
+        else:
+            hi = max(2.0 * flow / model.geometry.displacement, 2.0 * lo, 1.0)
+            f_hi = excess(hi)
+            for _ in range(_EXPANSIONS):
+                if not f_hi < 0.0:
+                    break
+                lo, f_lo, hi = hi, f_hi, 4.0 * hi
+                f_hi = excess(hi)
+            if not f_hi >= 0.0:
+                return _invalid(int(PointStatus.NO_ROOT))
+            speed, done = _bracketed_root(excess, lo, f_lo, hi, f_hi)
+            if not (done and abs(excess(speed)) <= CHECK * flow + FLOW_ATOL):
+                return _invalid(int(PointStatus.NOT_CONVERGED))
+            status = 0
+        point = evaluator.absorbency(speed, dp_i, False, p_ex, None)
+        return self._with_extra(point, flow, dp if port else None,
+                                self._extra(speed, dp_i, constant), status | limited)
+
+    def absorbency_point(self, speed: float, dp: float, port: bool, p_ex: float,
+                         flow_guess: float | None, channels: Channels | None) -> Point:
+        """
+        Compute the forward map Q(n, dp) at one point with the effects.
+
+        Parameters
+        ----------
+        speed : float
+            Shaft speed n, [rad/s]
+        dp : float
+            Port drop if `port`, else chamber drop, [Pa]
+        port : bool
+            Whether `dp` is between the ports, [-]
+        p_ex : float
+            Pressure driving the external leakage when no effect names one, [Pa]
+        flow_guess : float or None
+            Starting estimate of Q for the coupled solve, [m^3/s]
+        channels : mapping of str to float or None
+            Measured channels by name, [-]
+
+        Returns
+        -------
+        Point
+            The operating point; Q and Q_vl hold the effects' extra loss.
+
+        """
+        model, p_ex, constant, status = self.conditions(channels, p_ex)
+        if model is None:
+            return _invalid(status)
+        first = model.absorbency_point(speed, dp if port else None, dp_i=None if port else dp,
+                                       p_ex=p_ex, flow_guess=flow_guess)
+        if (not self._terms and constant == 0.0) or first.status & _INVALID_FLAGS:
+            return first
+        if not port:
+            return self._with_extra(first, None, None, self._extra(speed, dp, constant),
+                                    first.status & _STALLED)
+        evaluator, d = model._point, model.derived  # noqa: SLF001
+
+        def chamber(q: float) -> float:
+            return max(dp - (d.ch_a * q + d.ch_b) * q, 0.0)
+
+        def excess(q: float) -> float:
+            dp_i = chamber(q)
+            at = evaluator.absorbency(speed, dp_i, False, p_ex, None)
+            return q - at.flow - self._extra(speed, dp_i, constant)
+
+        q0 = first.flow
+        step = abs(self._extra(speed, first.dp_i, constant)) + abs(q0) * 1e-6 + 1e-12
+        lo, hi = q0 - step, q0 + step
+        f_lo, f_hi = excess(lo), excess(hi)
+        for _ in range(_EXPANSIONS):
+            if f_lo < 0.0 < f_hi:
+                break
+            step *= 4.0
+            if not f_lo < 0.0:
+                lo = q0 - step
+                f_lo = excess(lo)
+            if not f_hi > 0.0:
+                hi = q0 + step
+                f_hi = excess(hi)
+        if not f_lo < 0.0 < f_hi:
+            return _invalid(int(PointStatus.NO_ROOT))
+        flow, done = _bracketed_root(excess, lo, f_lo, hi, f_hi)
+        if not (done and abs(excess(flow)) <= CHECK * abs(flow) + FLOW_ATOL):
+            return _invalid(int(PointStatus.NOT_CONVERGED))
+        dp_i = chamber(flow)
+        limited = _CHANNEL_LIMITED if dp - (d.ch_a * flow + d.ch_b) * flow < 0.0 else 0
+        point = evaluator.absorbency(speed, dp_i, False, p_ex, None)
+        point = self._with_extra(point, None, dp, self._extra(speed, dp_i, constant),
+                                 (point.status & _STALLED) | limited)
+        return point._replace(flow=flow)
+
+
+def points_to_array(points: list[Point], shape: tuple[int, ...], geometry: MotorGeometry,
+                    names: tuple[str, str], inputs: tuple[np.ndarray, np.ndarray],
+                    errors: str) -> OperatingPoints:
+    """
+    Assemble single points into read-only :class:`OperatingPoints`.
+
+    Parameters
+    ----------
+    points : list of Point
+        The points, in C order of `shape`, [-]
+    shape : tuple of int
+        Broadcast shape of the inputs, [-]
+    geometry : MotorGeometry
+        The motor, [-]
+    names : tuple of str
+        Names of the two inputs, for the error of ``errors='raise'``, [-]
+    inputs : tuple of ndarray
+        The two inputs broadcast to `shape`, quoted in that error, [SI]
+    errors : {'raise', 'mask'}
+        Raise on the first invalid element, or keep it as NaN, [-]
+
+    Returns
+    -------
+    OperatingPoints
+        The points as arrays.
+
+    Raises
+    ------
+    InvalidInputError
+        With ``errors='raise'``, naming the first invalid element and its flags.
+
+    """
+    table = np.array([p[:12] for p in points], dtype=float).reshape(*shape, 12)
+    status = np.array([p.status for p in points], dtype=np.uint8).reshape(shape)
+    if errors == 'raise' and (status & _INVALID_FLAGS).any():
+        i = int(np.flatnonzero(status & _INVALID_FLAGS)[0])
+        a, b = (x.reshape(-1)[i] for x in inputs)
+        msg = (f'element {i} ({names[0]} = {a!r}, {names[1]} = {b!r}) is invalid: '
+               f'{describe_status(int(status.reshape(-1)[i]))}')
+        raise InvalidInputError(msg)
+    columns = [np.ascontiguousarray(table[..., j]) for j in range(12)]
+    for column in (*columns, status):
+        column.setflags(write=False)
+    losses = LossBreakdown(**dict(zip(COMPONENTS, columns[4:])))
+    return OperatingPoints(columns[0], columns[1], columns[2], columns[3], losses, status,
+                           geometry)
+
+
+def map_points(point: Callable[..., Point], first: tuple[str, object],
+               second: tuple[str, object], p_ex: object, channels: Mapping[str, object] | None,
+               geometry: MotorGeometry, errors: str) -> OperatingPoints:
+    """
+    Evaluate a single-point function over broadcast arrays (the array maps with effects).
+
+    Parameters
+    ----------
+    point : callable
+        ``point(a, b, p_ex, channels) -> Point`` on floats, [-]
+    first, second : tuple of (str, array_like)
+        The two inputs by name (flow or speed; dp or dp_i), [SI]
+    p_ex : array_like
+        Pressure driving the external leakage, [Pa]
+    channels : mapping of str to array_like, or None
+        Measured channels by name, [-]
+    geometry : MotorGeometry
+        The motor, [-]
+    errors : {'raise', 'mask'}
+        Raise on the first invalid element, or keep it as NaN, [-]
+
+    Returns
+    -------
+    OperatingPoints
+        The points.
+
+    """
+    if errors not in ('raise', 'mask'):
+        msg = f"errors = {errors!r}: use 'raise' or 'mask'"
+        raise ModelError(msg)
+    names = (first[0], second[0], 'p_ex', *(channels or {}))
+    values = (first[1], second[1], p_ex, *(channels or {}).values())
+    try:
+        arrays = np.broadcast_arrays(*(_as_array(n, v) for n, v in zip(names, values)))
+    except ValueError as err:
+        msg = f'{", ".join(names)}: shapes do not broadcast ({err})'
+        raise InvalidInputError(msg) from None
+    shape = arrays[0].shape if arrays else ()
+    flat = [a.reshape(-1).tolist() for a in arrays]
+    keys = names[3:]
+    points = [point(a, b, c, dict(zip(keys, rest)))
+              for a, b, c, *rest in zip(*flat)] if flat[0] else []
+    return points_to_array(points, shape, geometry, names[:2], (arrays[0], arrays[1]), errors)
+
+
+def _as_array(name: str, value: object) -> np.ndarray:
+    array = np.asarray(value)
+    if array.dtype.kind not in 'iuf':
+        msg = f'{name} = {value!r}: expected numbers, got {array.dtype}'
+        raise InvalidInputError(msg)
+    return array.astype(float)
