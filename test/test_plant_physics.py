@@ -8,7 +8,8 @@ from hypothesis import given, settings, strategies as st
 import pytest
 
 from satmotor_ros.model import MotorModel
-from satmotor_ros.model.units import LPM, MPA
+from satmotor_ros.model.effects import effect_from_mapping
+from satmotor_ros.model.units import ATMOSPHERE, LPM, MPA
 from satmotor_ros.plant import (ConstantLoad, EffectParams, LineParams, Plant, PlantError,
                                 PlantParams, ShaftParams, SpeedProportionalLoad, StepLoad)
 
@@ -223,3 +224,22 @@ def test_any_command_sequence_keeps_the_plant_finite_bounded_and_balanced(liquid
             after_in, after_out = _volumes(plant)
             net_in = dt * (f.command - f.motor - f.relief - f.leakage + f.cavitation_in)
             assert after_in - before_in == pytest.approx(net_in, abs=1e-9 * dt * 1e-3)
+
+
+def test_a_calibrated_coefficient_file_runs_in_the_plant_with_its_effect():
+    """A set with effects: the plant supplies their channels and settles to the model's state."""
+    base = MODELS['water']
+    effects = (effect_from_mapping('external_leakage', {'regressor': 'p_out',
+                                                        'coefficient': 4e-12}, 'e'),
+               effect_from_mapping('term:dp^2*n', {'coefficient': 1e-21}, 'e'))
+    coef = dataclasses.replace(base.coef, external_leakage=4e-12)
+    calibrated = MotorModel(base.geometry, dataclasses.replace(
+        base.coefficient_set, coefficients=coef, effects=effects), base.valid_range)
+    plant = Plant(calibrated, load=ConstantLoad(60.0))
+    state = _settle(plant, 20 * LPM)
+    dp = state.inlet_pressure - state.outlet_pressure
+    channels = {'p_out': state.outlet_pressure - ATMOSPHERE}
+    expected = calibrated.speed_point(20 * LPM, dp, channels=channels)
+    assert state.speed == pytest.approx(expected.speed, rel=1e-8)
+    plain = _settle(Plant(base, load=ConstantLoad(60.0)), 20 * LPM)
+    assert state.speed < plain.speed - 1.0  # the extra losses cost speed

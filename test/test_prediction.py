@@ -10,10 +10,11 @@ import numpy as np
 import pytest
 
 from satmotor_ros.model import CoefficientSet, MotorModel, PointStatus
+from satmotor_ros.model.effects import effect_from_mapping
 from satmotor_ros.model.units import ATMOSPHERE, LPM, MPA
 from satmotor_ros.prediction import (check_value, check_values, combine_batch, Combiner,
                                      driving_times, INPUTS, Level, predict_batch,
-                                     predict_point, Rule)
+                                     predict_point, Progress, Rule)
 
 OIL = MotorModel.default('oil')
 RULE = Rule(timeout=0.5)
@@ -183,24 +184,74 @@ def _random_events(rng, n):
     return events
 
 
+def _calibrated():
+    """Return the oil model with effects on case pressure, temperature and time."""
+    k_ex = 1e-12
+    effects = (
+        effect_from_mapping('external_leakage', {'regressor': 'p_case', 'coefficient': k_ex}, 'e'),
+        effect_from_mapping('viscosity_temperature', {
+            'coefficient': 3.7, 'law': 'walther', 'reference_temperature': 40.0,
+            'reference_viscosity': 4e-5}, 'e'),
+        effect_from_mapping('clearance_wear', {'regressor': 'time', 'coefficient': 1e-8,
+                                               'reference': 0.0}, 'e'),
+        effect_from_mapping('channel:revolutions', {'coefficient': 1e-9, 'reference': 0.0},
+                            'e'))
+    coef = dataclasses.replace(OIL.coef, external_leakage=k_ex)
+    fitted = dataclasses.replace(OIL.coefficient_set, coefficients=coef, effects=effects,
+                                 viscosity_range=(1e-6, 1e-3))
+    return MotorModel(OIL.geometry, fitted, OIL.valid_range)
+
+
+CALIBRATED = _calibrated()
+
+
+def test_effects_read_their_channels_and_block_without_them():
+    assert CALIBRATED.channels == ('p_case', 'revolutions', 'temperature', 'time')
+    case = 0.5 * MPA + ATMOSPHERE
+    snap = _good(p_case=(case, 5 * MS), temperature=(55.0, 5 * MS)).snapshot(10 * MS)
+    pred = predict_point(CALIBRATED, snap, RULE.timeout, (0.01, 0.0))
+    ref = CALIBRATED.speed_point(20 * LPM, 19.8 * MPA,
+                                 channels={'p_case': 0.5 * MPA, 'temperature': 55.0,
+                                           'time': 0.01, 'revolutions': 0.0})
+    assert pred.level < Level.ERROR and pred.output('speed') == ref.speed
+    assert pred.output('external') == pytest.approx(1e-12 * 0.5 * MPA, rel=1e-12)
+    later = predict_point(CALIBRATED, snap, RULE.timeout, (100.0, 0.0))  # worn: less speed
+    assert later.output('speed') < pred.output('speed')
+    missing = predict_point(CALIBRATED, _good(p_case=(case, 5 * MS)).snapshot(10 * MS),
+                            RULE.timeout)
+    assert missing.level == Level.ERROR and not missing.valid
+    assert 'needs fluid_temperature.temperature: missing' in missing.message
+
+
+def test_speed_sensor_gain_corrects_the_measured_speed_in_the_residual():
+    effects = (effect_from_mapping('speed_sensor_gain', {'coefficient': 0.1}, 'e'),)
+    model = MotorModel(OIL.geometry, dataclasses.replace(OIL.coefficient_set, effects=effects),
+                       OIL.valid_range)
+    snap = _good(measured_speed=(55.0, 8 * MS)).snapshot(10 * MS)
+    pred = predict_point(model, snap, RULE.timeout)
+    assert pred.output('residual') == pytest.approx(55.0 / 1.1 - pred.output('speed'))
+
+
+@pytest.mark.parametrize('model', [OIL, CALIBRATED], ids=['packaged', 'calibrated'])
 @pytest.mark.parametrize('seed', range(6))
-def test_live_rule_and_batch_rule_give_identical_predictions(seed):
+def test_live_rule_and_batch_rule_give_identical_predictions(seed, model):
     """The node's per-message path and replay's array path agree (model paths to 1e-12)."""
     rng = np.random.default_rng(seed)
     events = _random_events(rng, 400)
-    combiner, live, snaps = Combiner(RULE), [], []
+    combiner, live, snaps, progress = Combiner(RULE), [], [], Progress()
     for name, value, t in events:
         combiner.update(name, value, t)
         if name == 'flow':
             snaps.append(combiner.snapshot(t))
-            live.append(predict_point(OIL, snaps[-1], RULE.timeout))
+            live.append(predict_point(model, snaps[-1], RULE.timeout,
+                                      progress.advance(snaps[-1])))
     series = {}
     for name in INPUTS:
         mine = [(t, v) for n, v, t in events if n == name]
         series[name] = (np.array([t for t, _ in mine], dtype=np.int64),
                         np.array([v for _, v in mine]))
     stamps = driving_times(RULE, series['flow'][0], events[0][2], events[-1][2])
-    batch = predict_batch(OIL, combine_batch(RULE, stamps, series), RULE.timeout)
+    batch = predict_batch(model, combine_batch(RULE, stamps, series), RULE.timeout)
     assert len(batch) == len(live) > 50
     assert {p.level for p in live} == {0, 1, 2}
     for i, pred in enumerate(live):

@@ -374,7 +374,7 @@ class ConditionedModel:
 
 
 def points_to_array(points: list[Point], shape: tuple[int, ...], geometry: MotorGeometry,
-                    names: tuple[str, str], inputs: tuple[np.ndarray, np.ndarray],
+                    names: tuple[str, ...], inputs: tuple[np.ndarray, ...],
                     errors: str) -> OperatingPoints:
     """
     Assemble single points into read-only :class:`OperatingPoints`.
@@ -388,9 +388,9 @@ def points_to_array(points: list[Point], shape: tuple[int, ...], geometry: Motor
     geometry : MotorGeometry
         The motor, [-]
     names : tuple of str
-        Names of the two inputs, for the error of ``errors='raise'``, [-]
+        Names of the inputs, for the error of ``errors='raise'``, [-]
     inputs : tuple of ndarray
-        The two inputs broadcast to `shape`, quoted in that error, [SI]
+        The inputs broadcast to `shape`, quoted in that error, [SI]
     errors : {'raise', 'mask'}
         Raise on the first invalid element, or keep it as NaN, [-]
 
@@ -409,9 +409,8 @@ def points_to_array(points: list[Point], shape: tuple[int, ...], geometry: Motor
     status = np.array([p.status for p in points], dtype=np.uint8).reshape(shape)
     if errors == 'raise' and (status & _INVALID_FLAGS).any():
         i = int(np.flatnonzero(status & _INVALID_FLAGS)[0])
-        a, b = (x.reshape(-1)[i] for x in inputs)
-        msg = (f'element {i} ({names[0]} = {a!r}, {names[1]} = {b!r}) is invalid: '
-               f'{describe_status(int(status.reshape(-1)[i]))}')
+        values = ', '.join(f'{n} = {float(x.reshape(-1)[i])!r}' for n, x in zip(names, inputs))
+        msg = f'element {i} ({values}) is invalid: {describe_status(int(status.reshape(-1)[i]))}'
         raise InvalidInputError(msg)
     columns = [np.ascontiguousarray(table[..., j]) for j in range(12)]
     for column in (*columns, status):
@@ -463,7 +462,7 @@ def map_points(point: Callable[..., Point], first: tuple[str, object],
     keys = names[3:]
     points = [point(a, b, c, dict(zip(keys, rest)))
               for a, b, c, *rest in zip(*flat)] if flat[0] else []
-    return points_to_array(points, shape, geometry, names[:2], (arrays[0], arrays[1]), errors)
+    return points_to_array(points, shape, geometry, names, tuple(arrays), errors)
 
 
 def _as_array(name: str, value: object) -> np.ndarray:

@@ -29,7 +29,7 @@ from satmotor_ros.nodes import _diagnostics as diag
 from satmotor_ros.nodes import _parameters as params
 from satmotor_ros.nodes._parameters import ParamSpec
 from satmotor_ros.prediction import (Combiner, FIELDS, INPUTS, Level, MODES, predict_point,
-                                     Prediction, Rule, TOPICS, UNITS)
+                                     Prediction, Progress, Rule, TOPICS, UNITS)
 from sensor_msgs.msg import FluidPressure, JointState, Temperature
 from std_msgs.msg import Float64
 
@@ -150,7 +150,7 @@ class MotorModelNode(Node):
         self._joint = values['joint_name']
         self._worst: Prediction | None = None  # the worst prediction since the last report
         self._published = self._rejected = self._no_joint = 0
-        self._origin_ns: int | None = None  # first prediction: the effects' time channel [ns]
+        self._progress = Progress()  # time and revolutions for the effects that read them
         self._last_level = -1
         depth = values['qos_depth']
         sensor = QoSProfile(depth=depth, reliability=qos_profile_sensor_data.reliability,
@@ -266,9 +266,8 @@ class MotorModelNode(Node):
             pred = Prediction(t_ns, snap.values, (), 0, Level.ERROR,
                               f'no model: {self._model_error}')
         else:
-            if self._origin_ns is None:
-                self._origin_ns = t_ns
-            pred = predict_point(self._model, snap, self._rule.timeout, self._origin_ns)
+            pred = predict_point(self._model, snap, self._rule.timeout,
+                                 self._progress.advance(snap))
         if self._worst is None or pred.level >= self._worst.level:
             self._worst = pred
         if pred.level != self._last_level:
@@ -330,7 +329,8 @@ class MotorModelNode(Node):
         if self._model is None:
             return Prediction(now, snap.values, (), 0, Level.ERROR,
                               f'no model: {self._model_error}')
-        pred = predict_point(self._model, snap, self._rule.timeout, self._origin_ns)
+        pred = predict_point(self._model, snap, self._rule.timeout,
+                             (0.0, self._progress.revolutions))
         if pred.valid:  # inputs fresh, but no flow_command drove a prediction
             return pred._replace(level=Level.WARN, message='no prediction within '
                                  f'input_timeout {self._rule.timeout:g} s')

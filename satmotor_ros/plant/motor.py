@@ -76,8 +76,9 @@ class MotorCache:
         return True
 
 
-def mirrored_point(model: MotorModel, speed: float, dp: float,
-                   flow_guess: float | None) -> tuple[float, float, float, float, int]:
+def mirrored_point(model: MotorModel, speed: float, dp: float, flow_guess: float | None,
+                   channels: dict[str, float] | None = None
+                   ) -> tuple[float, float, float, float, int]:
     """
     Evaluate the motor at any sign of speed and pressure drop.
 
@@ -96,6 +97,8 @@ def mirrored_point(model: MotorModel, speed: float, dp: float,
         Port pressure drop p_in - p_out, any sign, [Pa]
     flow_guess : float or None
         Warm start of the port-drop solve, [m^3/s]
+    channels : dict, optional
+        Channels a calibrated coefficient set's effects read, [-]
 
     Returns
     -------
@@ -107,7 +110,7 @@ def mirrored_point(model: MotorModel, speed: float, dp: float,
     qt = model.geometry.displacement
     a_speed, a_dp = abs(speed), abs(dp)
     guess = None if flow_guess is None else qt * a_speed + abs(flow_guess - qt * speed)
-    pt = model.absorbency_point(a_speed, a_dp, flow_guess=guess)
+    pt = model.absorbency_point(a_speed, a_dp, flow_guess=guess, channels=channels)
     loss = pt.flow - qt * a_speed - pt.inertia
     sign = 1.0 if dp >= 0.0 else -1.0
     return (qt * speed + math.copysign(pt.inertia, speed) + sign * loss,

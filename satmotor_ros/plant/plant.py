@@ -29,6 +29,7 @@ from typing import NamedTuple
 import numpy as np
 
 from satmotor_ros.model import MotorModel
+from satmotor_ros.model.units import ATMOSPHERE
 from satmotor_ros.plant.equations import case_pressure, friction_torque, viscosity_at
 from satmotor_ros.plant.errors import PlantError
 from satmotor_ros.plant.load import ConstantLoad, LoadProfile
@@ -270,12 +271,13 @@ class Plant:
         qt = self._qt
 
         # 1. the motor at the start of the step, linearised as Q_m' = q_t w' + G dp' + h
+        channels = self._channels() if self._motor.model.channels else None
         if w >= 0.0 and dp >= 0.0:
-            pt = self._point(w, dp, flow_guess=self._q_guess)
+            pt = self._point(w, dp, flow_guess=self._q_guess, channels=channels)
             q, dp_i, q_id, qx, self.model_status = pt[0], pt[3], pt[9], pt[10], pt[12]
         else:
             q, dp_i, qx, q_id, self.model_status = mirrored_point(self._motor.model, w, dp,
-                                                                  self._q_guess)
+                                                                  self._q_guess, channels)
         if q == q:
             self._q_guess = q
             qtw = qt * w
@@ -436,6 +438,12 @@ class Plant:
         """
         case = self.params.case
         return case_pressure(self._p_out, self._pt, case.offset, case.outlet_share)
+
+    def _channels(self) -> dict[str, float]:
+        """Return what a calibrated coefficient set's effects read (gauge Pa, degC, s, rev)."""
+        return {'p_case': max(self.case_pressure() - ATMOSPHERE, 0.0),
+                'p_out': max(self._p_out - ATMOSPHERE, 0.0), 'temperature': self._temp,
+                'time': self._t, 'revolutions': self._theta / (2.0 * math.pi)}
 
     def measure(self) -> Measurement:
         """

@@ -32,25 +32,66 @@ _I_CASE = INPUTS.index('p_case')
 _I_SPEED = INPUTS.index('measured_speed')
 _GAUGED = {'p_case': _I_CASE, 'p_out': _I_OUT}
 _MEASURED = {**_GAUGED, 'temperature': INPUTS.index('temperature')}
-CHANNELS = ('p_case', 'p_out', 'temperature', 'time')
+CHANNELS = ('p_case', 'p_out', 'temperature', 'time', 'revolutions')
 """
 Channels a calibrated effect may read (``MotorModel.channels``): case and outlet pressure
-made gauge (absolute - ATMOSPHERE, floored at 0) [Pa], temperature [degC], and time since
-the first prediction [s], as ``satmotor calibrate`` counts it from the start of a bag.
+made gauge (absolute - ATMOSPHERE, floored at 0) [Pa], temperature [degC], and the time [s]
+and shaft revolutions [rev] since the first prediction (see :class:`Progress`), as
+``satmotor calibrate`` counts them from the start of a bag.
 """
+
+_TWO_PI = 2.0 * math.pi
+
+
+class Progress:
+    """
+    Time and revolutions since the first prediction, advanced one prediction at a time.
+
+    Revolutions add the measured speed (when fresh) times the time since the previous
+    prediction; :func:`predict_batch` sums the same terms in the same order.
+    """
+
+    def __init__(self) -> None:
+        """Start before the first prediction."""
+        self.origin_ns: int | None = None
+        self.last_ns = 0
+        self.revolutions = 0.0
+
+    def advance(self, snap: Snapshot) -> tuple[float, float]:
+        """
+        Count the snapshot in and return the time and revolutions at it.
+
+        Parameters
+        ----------
+        snap : Snapshot
+            The inputs of the prediction about to be made, [-]
+
+        Returns
+        -------
+        tuple of float
+            Time since the first prediction [s] and revolutions [rev].
+
+        """
+        if self.origin_ns is None:
+            self.origin_ns = self.last_ns = snap.stamp_ns
+        if snap.states[_I_SPEED] == InputState.FRESH:
+            dt = (snap.stamp_ns - self.last_ns) * 1e-9
+            self.revolutions += snap.values[_I_SPEED] * dt / _TWO_PI
+        self.last_ns = snap.stamp_ns
+        return (snap.stamp_ns - self.origin_ns) * 1e-9, self.revolutions
 
 
 def _gauge(p: float) -> float:
     return p - ATMOSPHERE if p > ATMOSPHERE else 0.0
 
 
-def _channels(model: MotorModel, snap: Snapshot,
-              origin_ns: int) -> tuple[dict[str, float] | None, str]:
+def _channels(needed: tuple[str, ...], snap: Snapshot,
+              progress: tuple[float, float]) -> tuple[dict[str, float] | None, str]:
     """Return the channels the model's effects need, or None and why they are missing."""
     channels: dict[str, float] = {}
-    for name in model.channels:
-        if name == 'time':
-            channels[name] = (snap.stamp_ns - origin_ns) * 1e-9
+    for name in needed:
+        if name in ('time', 'revolutions'):
+            channels[name] = progress[name == 'revolutions']
             continue
         i = _MEASURED.get(name)
         if i is None:
@@ -136,7 +177,7 @@ def _input_level(states: tuple[int, ...]) -> int:
 
 
 def predict_point(model: MotorModel, snap: Snapshot, timeout: float,
-                  origin_ns: int | None = None) -> Prediction:
+                  progress: tuple[float, float] = (0.0, 0.0)) -> Prediction:
     """
     Predict from one snapshot of the inputs (the live node's path).
 
@@ -148,9 +189,9 @@ def predict_point(model: MotorModel, snap: Snapshot, timeout: float,
         The inputs at the driving time, [-]
     timeout : float
         The input timeout, quoted in messages, [s]
-    origin_ns : int, optional
-        Time of the first prediction, from which the ``time`` channel counts; the
-        snapshot's own time when omitted, [ns]
+    progress : tuple of float
+        Time since the first prediction [s] and revolutions [rev] (:class:`Progress`),
+        for effects that read them, [-]
 
     Returns
     -------
@@ -161,7 +202,7 @@ def predict_point(model: MotorModel, snap: Snapshot, timeout: float,
     inputs_level = _input_level(snap.states)
     channels, why = None, ''
     if inputs_level < Level.ERROR and model.channels:
-        channels, why = _channels(model, snap, snap.stamp_ns if origin_ns is None else origin_ns)
+        channels, why = _channels(model.channels, snap, progress)
     if inputs_level >= Level.ERROR or why:
         level, message = _messages(snap, timeout, 0, math.nan)
         if why:
@@ -196,6 +237,7 @@ class PredictionBatch(NamedTuple):
     status: npt.NDArray[np.uint8]  # PointStatus per prediction (0 where not run)
     level: npt.NDArray[np.uint8]  # Level per prediction
     timeout: float  # the input timeout [s]
+    channels: tuple[str, ...] = ()  # channels the model's effects read (MotorModel.channels)
 
     def __len__(self) -> int:
         """Return the number of predictions."""
@@ -258,12 +300,17 @@ class PredictionBatch(NamedTuple):
             ``'OK'`` or the problems.
 
         """
-        dp = float(self.snapshots.values[1, i] - self.snapshots.values[2, i])
-        return _messages(self.snapshot(i), self.timeout, int(self.status[i]), dp)[1]
+        snap = self.snapshot(i)
+        dp = float(snap.values[1] - snap.values[2])
+        message = _messages(snap, self.timeout, int(self.status[i]), dp)[1]
+        if self.channels and _input_level(snap.states) < Level.ERROR:
+            why = _channels(self.channels, snap, (0.0, 0.0))[1]
+            if why:
+                message = why if message == 'OK' else f'{message}; {why}'
+        return message
 
 
-def predict_batch(model: MotorModel, snaps: SnapshotBatch, timeout: float,
-                  origin_ns: int | None = None) -> PredictionBatch:
+def predict_batch(model: MotorModel, snaps: SnapshotBatch, timeout: float) -> PredictionBatch:
     """
     Predict from many snapshots at once (bag replay's path), as :func:`predict_point` would.
 
@@ -275,9 +322,6 @@ def predict_batch(model: MotorModel, snaps: SnapshotBatch, timeout: float,
         The inputs at every driving time, [-]
     timeout : float
         The input timeout, quoted in messages, [s]
-    origin_ns : int, optional
-        Time from which the ``time`` channel counts; the first driving time when
-        omitted, [ns]
 
     Returns
     -------
@@ -292,7 +336,7 @@ def predict_batch(model: MotorModel, snaps: SnapshotBatch, timeout: float,
         np.maximum(level, _LEVELS[i][states[i]], out=level)
     channels = None
     if model.channels:
-        level, channels = _batch_channels(model, snaps, level, origin_ns)
+        level, channels = _batch_channels(model, snaps, level)
     usable = level < Level.ERROR
     flow = np.where(usable, values[0], 0.0)
     dp = np.where(usable, values[1] - values[2], 0.0)
@@ -311,19 +355,30 @@ def predict_batch(model: MotorModel, snaps: SnapshotBatch, timeout: float,
     for row, column in zip(outputs, columns):
         row[:] = column
     outputs[:, level >= Level.ERROR] = np.nan
-    return PredictionBatch(snaps, outputs, status, level, timeout)
+    return PredictionBatch(snaps, outputs, status, level, timeout, model.channels)
 
 
-def _batch_channels(model: MotorModel, snaps: SnapshotBatch, level: npt.NDArray[np.uint8],
-                    origin_ns: int | None) -> tuple[npt.NDArray[np.uint8], dict[str, FloatArray]]:
+def _batch_progress(snaps: SnapshotBatch) -> tuple[FloatArray, FloatArray]:
+    """Return time [s] and revolutions [rev] at each prediction, as :class:`Progress`."""
+    stamps = snaps.stamp_ns
+    if not len(stamps):
+        return np.zeros(0), np.zeros(0)
+    dt = np.diff(stamps, prepend=stamps[0]) * 1e-9
+    fresh = snaps.states[_I_SPEED] == InputState.FRESH
+    with np.errstate(invalid='ignore', over='ignore'):  # inf or NaN where not fresh
+        turns = np.where(fresh, snaps.values[_I_SPEED] * dt / _TWO_PI, 0.0)
+    return (stamps - stamps[0]) * 1e-9, np.cumsum(turns)
+
+
+def _batch_channels(model: MotorModel, snaps: SnapshotBatch, level: npt.NDArray[np.uint8]
+                    ) -> tuple[npt.NDArray[np.uint8], dict[str, FloatArray]]:
     """Return the levels with missing channels made ERROR, and the channels (0 there)."""
     channels: dict[str, FloatArray] = {}
     level = level.copy()
-    stamps = snaps.stamp_ns
+    progress = _batch_progress(snaps)
     for name in model.channels:
-        if name == 'time':
-            origin = int(stamps[0]) if origin_ns is None and len(stamps) else origin_ns or 0
-            channels[name] = (stamps - origin) * 1e-9
+        if name in ('time', 'revolutions'):
+            channels[name] = progress[name == 'revolutions']
             continue
         i = _MEASURED.get(name)
         if i is None:

@@ -1,0 +1,192 @@
+# SPDX-License-Identifier: Apache-2.0
+"""A coefficient set's ``effects:`` block is data that the model evaluates as documented."""
+
+import copy
+import math
+
+import numpy as np
+import pytest
+from satmotor_ros.model import (ConfigError, InvalidInputError, load_motor, ModelError,
+                                MotorModel, PointStatus)
+from satmotor_ros.model.config import default_config_path, motor_from_mapping
+from satmotor_ros.model.units import LPM, MPA, RPM
+from satmotor_ros.model.viscosity import vogel_viscosity, walther_slope, walther_viscosity
+import yaml
+
+BASE = yaml.safe_load(default_config_path().read_text(encoding='utf-8'))
+OIL = MotorModel.default('oil')
+WATER = MotorModel.default('water')
+
+
+def model_with(liquid, effects, **coefficients):
+    doc = copy.deepcopy(BASE)
+    entry = doc['coefficient_sets'][liquid]
+    entry['effects'] = effects
+    entry['coefficients'].update(coefficients)
+    return MotorModel.from_spec(motor_from_mapping(doc), liquid)
+
+
+def balance(model, point):
+    return abs(model.geometry.displacement * point.speed + point.total - point.flow) / point.flow
+
+
+EFFECTS = {
+    'external_leakage': ({'external_leakage': {'regressor': 'p_out', 'coefficient': 2e-12}},
+                         {'p_out': 0.8 * MPA}),
+    'viscosity_temperature': ({'viscosity_temperature': {
+        'regressor': 'temperature', 'coefficient': 3.7, 'law': 'walther',
+        'reference_temperature': 45.0, 'reference_viscosity': 40e-6}}, {'temperature': 60.0}),
+    'clearance_wear': ({'clearance_wear': {'regressor': 'revolutions', 'coefficient': 1e-9,
+                                           'reference': 100.0}}, {'revolutions': 1100.0}),
+    'channel:aux': ({'channel:aux': {'coefficient': 0.3 * LPM, 'reference': 1.0}},
+                    {'aux': 3.0}),
+    'term:dp^2*n': ({'term:dp^2*n': {'coefficient': 2e-21}}, {}),
+}
+
+
+@pytest.mark.parametrize('name', list(EFFECTS))
+@pytest.mark.parametrize('law', ['eq33', 'eq39'])
+def test_each_effect_keeps_the_balance_and_round_trips(name, law):
+    effects, channels = EFFECTS[name]
+    extra = {'external_leakage': 2e-12} if name == 'external_leakage' else {}
+    doc = copy.deepcopy(BASE)
+    doc['coefficient_sets']['oil']['effects'] = effects
+    doc['coefficient_sets']['oil']['coefficients'].update(extra)
+    model = MotorModel.from_spec(motor_from_mapping(doc), 'oil', displacement_law=law)
+    bare = MotorModel.default('oil', law)
+    assert model.channels == tuple(sorted(channels))
+    for speed in (120 * RPM, 700 * RPM, 1500 * RPM):
+        for dp in (3 * MPA, 12 * MPA, 24 * MPA):
+            fwd = model.absorbency_point(speed, dp, channels=channels)
+            assert not fwd.status & ~int(PointStatus.EXTRAPOLATED), fwd
+            assert fwd.flow > bare.absorbency_point(speed, dp).flow  # every effect leaks more
+            assert balance(model, fwd) < 1e-9
+            back = model.speed_point(fwd.flow, dp, channels=channels)
+            assert back.speed == pytest.approx(speed, rel=1e-9)
+            assert back.dp_i == pytest.approx(fwd.dp_i, rel=1e-9)
+            assert balance(model, back) < 1e-9
+
+
+def test_extra_losses_are_what_the_yaml_says():
+    speed, dp_i = 600 * RPM, 15 * MPA
+    bare = OIL.breakdown_point(speed, dp_i)
+    channel = model_with('oil', EFFECTS['channel:aux'][0])
+    assert (channel.breakdown_point(speed, dp_i, channels={'aux': 3.0}).total - bare.total
+            == pytest.approx(0.3 * LPM * (3.0 - 1.0), rel=1e-12))
+    term = model_with('oil', EFFECTS['term:dp^2*n'][0])
+    assert (term.breakdown_point(speed, dp_i).total - bare.total
+            == pytest.approx(2e-21 * dp_i ** 2 * speed, rel=1e-12))
+    leak = model_with('oil', EFFECTS['external_leakage'][0], external_leakage=2e-12)
+    pt = leak.breakdown_point(speed, dp_i, p_ex=5 * MPA, channels={'p_out': 0.8 * MPA})
+    assert pt.external == pytest.approx(2e-12 * 0.8 * MPA, rel=1e-12)  # the channel, not p_ex
+
+
+def test_viscosity_and_wear_change_the_liquid_and_the_clearances():
+    speed, dp_i = 600 * RPM, 15 * MPA
+    visc = model_with('oil', EFFECTS['viscosity_temperature'][0])
+    nu = float(walther_viscosity(60.0, 45.0, 40e-6, 3.7))
+    thinner = MotorModel(OIL.geometry, OIL.coefficient_set, OIL.valid_range,
+                         OIL.liquid.__class__('thin', nu, OIL.liquid.density,
+                                              OIL.liquid.bulk_modulus))
+    got = visc.breakdown_point(speed, dp_i, channels={'temperature': 60.0})
+    assert got.flat_clearance == thinner.breakdown_point(speed, dp_i).flat_clearance
+    at_ref = visc.breakdown_point(speed, dp_i, channels={'temperature': 45.0})
+    assert at_ref.flat_clearance == pytest.approx(OIL.breakdown_point(speed, dp_i).flat_clearance,
+                                                  rel=1e-12)
+    wear = model_with('oil', EFFECTS['clearance_wear'][0])
+    g = OIL.geometry
+    worn = MotorModel(g.__class__(g.displacement, g.module, g.height, g.clearance_rotor + 1e-6,
+                                  g.clearance_satellites + 1e-6, g.commutation_diameter),
+                      OIL.coefficient_set, OIL.valid_range)
+    got = wear.breakdown_point(speed, dp_i, channels={'revolutions': 1100.0})
+    assert got.flat_clearance == pytest.approx(worn.breakdown_point(speed, dp_i).flat_clearance,
+                                               rel=1e-12)
+    unworn = wear.breakdown_point(speed, dp_i, channels={'revolutions': 0.0})  # clamped at 0
+    assert unworn.total == pytest.approx(OIL.breakdown_point(speed, dp_i).total, rel=1e-12)
+
+
+def test_viscosity_laws_match_their_references():
+    assert walther_slope(40.0, 46e-6, 100.0, 6.8e-6) == pytest.approx(3.684, abs=1e-3)
+    slope = walther_slope(40.0, 46e-6, 100.0, 6.8e-6)
+    assert float(walther_viscosity(100.0, 40.0, 46e-6, slope)) == pytest.approx(6.8e-6,
+                                                                                rel=1e-9)
+    # water: 1.0 mm^2/s at 20 degC falls to about 0.66 at 40 degC (Vogel B = 247.8 K)
+    nu40 = float(vogel_viscosity(40.0, 20.0, 1.0e-6, 247.8))
+    assert 0.63e-6 < nu40 < 0.69e-6
+
+
+def test_array_path_is_the_point_path_element_by_element():
+    model = model_with('water', {**EFFECTS['viscosity_temperature'][0],
+                                 'channel:aux': {'coefficient': 0.1 * LPM, 'reference': 0.0}})
+    rng = np.random.default_rng(5)
+    flow = rng.uniform(5, 40, 50) * LPM
+    dp = rng.uniform(2, 20, 50) * MPA
+    temperature = rng.uniform(20, 50, 50)
+    aux = rng.uniform(0, 2, 50)
+    op = model.speed(flow, dp, channels={'temperature': temperature, 'aux': aux})
+    for i in range(50):
+        pt = model.speed_point(flow[i], dp[i],
+                               channels={'temperature': temperature[i], 'aux': aux[i]})
+        assert (op.speed[i], op.losses.total[i], op.status[i]) == (pt.speed, pt.total,
+                                                                   pt.status)
+    assert not op.speed.flags.writeable and op.speed.base is not flow
+
+
+def test_missing_or_bad_channels_are_named():
+    model = model_with('oil', EFFECTS['viscosity_temperature'][0])
+    with pytest.raises(ModelError, match="channel 'temperature'"):
+        model.speed_point(10 * LPM, 10 * MPA)
+    pt = model.speed_point(10 * LPM, 10 * MPA, channels={'temperature': math.nan})
+    assert pt.status == PointStatus.NOT_FINITE and math.isnan(pt.speed)
+    with pytest.raises(InvalidInputError, match='temperature'):
+        model.speed([10 * LPM, 20 * LPM], 10 * MPA, channels={'temperature': [20.0, math.inf]})
+    masked = model.speed([10 * LPM, 20 * LPM], 10 * MPA, errors='mask',
+                         channels={'temperature': [20.0, math.inf]})
+    assert list(masked.status) == [int(PointStatus.EXTRAPOLATED), int(PointStatus.NOT_FINITE)]
+    with pytest.raises(InvalidInputError, match='broadcast'):
+        model.speed([10 * LPM, 20 * LPM], 10 * MPA, channels={'temperature': [1.0, 2.0, 3.0]})
+
+
+def test_a_term_that_takes_all_the_flow_stalls_the_shaft():
+    model = model_with('oil', {'term:dp^0.5': {'coefficient': 1e-7}})
+    pt = model.speed_point(1 * LPM, 20 * MPA)
+    assert pt.speed == 0.0 and pt.status & PointStatus.STALLED
+
+
+def test_sensor_effects_convert_readings_only():
+    gain = model_with('oil', {'flow_sensor_gain': {'coefficient': 0.05},
+                              'speed_sensor_gain': {'coefficient': -0.02}})
+    assert gain.channels == ()
+    assert gain.true_flow(10.5) == pytest.approx(10.0)
+    assert gain.true_speed(98.0) == pytest.approx(100.0)
+    assert gain.speed_point(20 * LPM, 10 * MPA) == OIL.speed_point(20 * LPM, 10 * MPA)
+    offset = model_with('oil', {'flow_sensor_offset': {'coefficient': 1e-5}})
+    assert offset.true_flow(3e-5) == pytest.approx(2e-5)
+
+
+@pytest.mark.parametrize('effects, match', [
+    ({'leakage': {'coefficient': 1.0}}, 'unknown effect'),
+    ({'channel': {'coefficient': 1.0, 'reference': 0.0}}, 'unknown effect'),
+    ({'term:dp^3': {'coefficient': 1.0}}, "unknown term 'dp\\^3'"),
+    ({'clearance_wear': {'coefficient': 1e-9, 'regressor': 'hours', 'reference': 0.0}},
+     "regressor = 'hours'"),
+    ({'clearance_wear': {'coefficient': 1e-9, 'regressor': 'time'}}, 'missing key.*reference'),
+    ({'viscosity_temperature': {'coefficient': 3.0, 'law': 'arrhenius',
+                                'reference_temperature': 40.0,
+                                'reference_viscosity': 4e-5}}, "law = 'arrhenius'"),
+    ({'flow_sensor_gain': {'coefficient': 'big'}}, "coefficient = 'big'"),
+    ({'flow_sensor_gain': {'coefficient': 0.9}}, r'coefficient = 0.9'),
+    ({'flow_sensor_gain': {'coefficient': 0.1, 'colour': 'red'}}, 'unknown key.*colour'),
+    ({'external_leakage': {'coefficient': 3e-12, 'regressor': 'p_case'}},
+     'differs from coefficients.external_leakage'),
+])
+def test_bad_effect_blocks_are_refused_naming_the_key(effects, match):
+    doc = copy.deepcopy(BASE)
+    doc['coefficient_sets']['oil']['effects'] = effects
+    with pytest.raises(ConfigError, match=match):
+        motor_from_mapping(doc)
+
+
+def test_packaged_config_has_no_effects():
+    assert load_motor().sets['oil'].effects == () and OIL.channels == ()
+    assert WATER.true_flow(1.0) == 1.0 and WATER.true_speed(2.0) == 2.0
