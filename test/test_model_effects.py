@@ -190,3 +190,11 @@ def test_bad_effect_blocks_are_refused_naming_the_key(effects, match):
 def test_packaged_config_has_no_effects():
     assert load_motor().sets['oil'].effects == () and OIL.channels == ()
     assert WATER.true_flow(1.0) == 1.0 and WATER.true_speed(2.0) == 2.0
+
+
+def test_dp_of_a_chamber_drop_point_includes_the_channel_drop_of_the_extra_flow():
+    model = model_with('oil', EFFECTS['channel:aux'][0])
+    pt = model.absorbency_point(600 * RPM, dp_i=15 * MPA, channels={'aux': 3.0})
+    back = model.absorbency_point(600 * RPM, pt.dp, channels={'aux': 3.0})
+    assert back.flow == pytest.approx(pt.flow, rel=1e-9)
+    assert back.dp_i == pytest.approx(15 * MPA, rel=1e-9)

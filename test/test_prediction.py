@@ -263,3 +263,16 @@ def test_live_rule_and_batch_rule_give_identical_predictions(seed, model):
         np.testing.assert_allclose(batch.outputs[:, i], np.array(pred.outputs), rtol=1e-12,
                                    atol=1e-300)
         np.testing.assert_array_equal(batch.snapshots.values[:, i], np.array(pred.inputs))
+
+
+def test_progress_counts_time_and_measured_revolutions_from_the_first_prediction():
+    progress = Progress()
+    assert progress.peek(5 * MS) == (0.0, 0.0)
+    first = _good(measured_speed=(2 * math.pi, 1 * MS)).snapshot(10 * MS)
+    assert progress.advance(first) == (0.0, 0.0)
+    second = _good(measured_speed=(2 * math.pi, 1010 * MS)).snapshot(1010 * MS)
+    time, turns = progress.advance(second)
+    assert time == pytest.approx(1.0) and turns == pytest.approx(1.0)  # 1 rev/s for 1 s
+    stale = _good().snapshot(3010 * MS)  # no measured speed: no revolutions counted
+    assert progress.advance(stale) == (pytest.approx(3.0), pytest.approx(1.0))
+    assert progress.peek(4010 * MS) == (pytest.approx(4.0), pytest.approx(1.0))

@@ -334,8 +334,10 @@ class ConditionedModel:
         if (not self._terms and constant == 0.0) or first.status & _INVALID_FLAGS:
             return first
         if not port:
-            return self._with_extra(first, None, None, self._extra(speed, dp, constant),
-                                    first.status & _STALLED)
+            point = self._with_extra(first, None, None, self._extra(speed, dp, constant),
+                                     first.status & _STALLED)
+            d = model.derived
+            return point._replace(dp=dp + (d.ch_a * point.flow + d.ch_b) * point.flow)
         evaluator, d = model._point, model.derived  # noqa: SLF001
 
         def chamber(q: float) -> float:

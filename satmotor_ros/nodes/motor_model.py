@@ -329,8 +329,7 @@ class MotorModelNode(Node):
         if self._model is None:
             return Prediction(now, snap.values, (), 0, Level.ERROR,
                               f'no model: {self._model_error}')
-        pred = predict_point(self._model, snap, self._rule.timeout,
-                             (0.0, self._progress.revolutions))
+        pred = predict_point(self._model, snap, self._rule.timeout, self._progress.peek(now))
         if pred.valid:  # inputs fresh, but no flow_command drove a prediction
             return pred._replace(level=Level.WARN, message='no prediction within '
                                  f'input_timeout {self._rule.timeout:g} s')

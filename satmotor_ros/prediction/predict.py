@@ -80,6 +80,24 @@ class Progress:
         self.last_ns = snap.stamp_ns
         return (snap.stamp_ns - self.origin_ns) * 1e-9, self.revolutions
 
+    def peek(self, stamp_ns: int) -> tuple[float, float]:
+        """
+        Return the time and revolutions at `stamp_ns` without counting a prediction.
+
+        Parameters
+        ----------
+        stamp_ns : int
+            Time, [ns]
+
+        Returns
+        -------
+        tuple of float
+            Time since the first prediction (0 before it) [s] and revolutions so far [rev].
+
+        """
+        origin = stamp_ns if self.origin_ns is None else self.origin_ns
+        return (stamp_ns - origin) * 1e-9, self.revolutions
+
 
 def _gauge(p: float) -> float:
     return p - ATMOSPHERE if p > ATMOSPHERE else 0.0
