@@ -6,8 +6,10 @@ import math
 
 import numpy as np
 import pytest
-from satmotor_ros.model import (ConfigError, InvalidInputError, load_motor, ModelError,
-                                MotorModel, PointStatus)
+from satmotor_ros.model import (COMPONENTS, ConfigError, INVALID, InvalidInputError, load_motor,
+                                ModelError, MotorModel, PointStatus)
+from satmotor_ros.model.conditioned import _bracketed_root
+from satmotor_ros.model.effects import flow_reading
 from satmotor_ros.model.config import default_config_path, motor_from_mapping
 from satmotor_ros.model.units import LPM, MPA, RPM
 from satmotor_ros.model.viscosity import vogel_viscosity, walther_slope, walther_viscosity
@@ -18,12 +20,17 @@ OIL = MotorModel.default('oil')
 WATER = MotorModel.default('water')
 
 
-def model_with(liquid, effects, **coefficients):
+def _doc_with(liquid, effects, **coefficients):
     doc = copy.deepcopy(BASE)
     entry = doc['coefficient_sets'][liquid]
     entry['effects'] = effects
     entry['coefficients'].update(coefficients)
-    return MotorModel.from_spec(motor_from_mapping(doc), liquid)
+    return doc
+
+
+def model_with(liquid, effects, **coefficients):
+    return MotorModel.from_spec(motor_from_mapping(_doc_with(liquid, effects, **coefficients)),
+                                liquid)
 
 
 def balance(model, point):
@@ -61,10 +68,17 @@ def test_each_effect_keeps_the_balance_and_round_trips(name, law):
             assert not fwd.status & ~int(PointStatus.EXTRAPOLATED), fwd
             assert fwd.flow > bare.absorbency_point(speed, dp).flow  # every effect leaks more
             assert balance(model, fwd) < 1e-9
+            assert fwd.dp == dp
             back = model.speed_point(fwd.flow, dp, channels=channels)
             assert back.speed == pytest.approx(speed, rel=1e-9)
             assert back.dp_i == pytest.approx(fwd.dp_i, rel=1e-9)
+            assert back.dp == dp and back.flow == fwd.flow
             assert balance(model, back) < 1e-9
+            inner = model.speed_point(fwd.flow, dp_i=fwd.dp_i, channels=channels)
+            assert inner.speed == pytest.approx(speed, rel=1e-9)
+            assert inner.dp == pytest.approx(dp, rel=1e-9)
+            chamber = model.absorbency_point(speed, dp_i=fwd.dp_i, channels=channels)
+            assert chamber.flow == pytest.approx(fwd.flow, rel=1e-9)
 
 
 def test_extra_losses_are_what_the_yaml_says():
@@ -127,8 +141,12 @@ def test_array_path_is_the_point_path_element_by_element():
     for i in range(50):
         pt = model.speed_point(flow[i], dp[i],
                                channels={'temperature': temperature[i], 'aux': aux[i]})
-        assert (op.speed[i], op.losses.total[i], op.status[i]) == (pt.speed, pt.total,
-                                                                   pt.status)
+        got = (op.flow[i], op.speed[i], op.dp[i], op.dp_i[i],
+               *(op.losses.as_dict()[c][i] for c in COMPONENTS), op.status[i])
+        assert got == tuple(pt)
+    assert op.geometry is model.geometry
+    with pytest.raises(ModelError, match="errors = 'ignore'"):
+        model.speed(flow, dp, errors='ignore', channels={'temperature': temperature, 'aux': aux})
     assert not op.speed.flags.writeable and op.speed.base is not flow
 
 
@@ -176,6 +194,10 @@ def test_sensor_effects_convert_readings_only():
                                 'reference_viscosity': 4e-5}}, "law = 'arrhenius'"),
     ({'flow_sensor_gain': {'coefficient': 'big'}}, "coefficient = 'big'"),
     ({'flow_sensor_gain': {'coefficient': 0.9}}, r'coefficient = 0.9'),
+    ({'speed_sensor_gain': {'coefficient': -0.5}}, r'coefficient = -0.5'),
+    ({'channel:aux': {'coefficient': 1.0, 'reference': 0.0, 'regressor': 'other'}},
+     'reads its own channel'),
+    ({'flow_sensor_gain': 0.1}, 'must be a mapping'),
     ({'flow_sensor_gain': {'coefficient': 0.1, 'colour': 'red'}}, 'unknown key.*colour'),
     ({'external_leakage': {'coefficient': 3e-12, 'regressor': 'p_case'}},
      'differs from coefficients.external_leakage'),
@@ -198,3 +220,67 @@ def test_dp_of_a_chamber_drop_point_includes_the_channel_drop_of_the_extra_flow(
     back = model.absorbency_point(600 * RPM, pt.dp, channels={'aux': 3.0})
     assert back.flow == pytest.approx(pt.flow, rel=1e-9)
     assert back.dp_i == pytest.approx(15 * MPA, rel=1e-9)
+
+
+def test_flags_of_the_point_survive_the_extra_loss():
+    model = model_with('oil', EFFECTS['term:dp^2*n'][0])
+    slow = model.absorbency_point(50 * RPM, 10 * MPA)  # below the validated 100 rpm
+    assert slow.status == PointStatus.EXTRAPOLATED
+    assert model.speed_point(slow.flow, 10 * MPA).status == PointStatus.EXTRAPOLATED
+    bare = OIL.speed_point(40 * LPM, 0.05 * MPA)
+    limited = model.speed_point(40 * LPM, 0.05 * MPA)  # the channels take the whole drop
+    assert bare.status & PointStatus.CHANNEL_LIMITED and limited.dp_i == 0.0
+    assert limited.status == bare.status
+    assert limited.speed == pytest.approx(bare.speed, rel=1e-12)
+    forward = model.absorbency_point(600 * RPM, 0.05 * MPA)
+    assert forward.status & PointStatus.CHANNEL_LIMITED and forward.dp_i == 0.0
+
+
+def test_an_extra_loss_without_a_root_is_flagged_not_returned():
+    gain = model_with('oil', {'term:n^2': {'coefficient': -2e-8}})  # Q(n) turns back down
+    pt = gain.speed_point(60 * LPM, 10 * MPA)
+    assert pt.status == PointStatus.NO_ROOT and math.isnan(pt.speed)
+    ok = gain.speed_point(2 * LPM, 10 * MPA)
+    assert not ok.status & INVALID and balance(gain, ok) < 1e-9
+    empirical = MotorModel.from_spec(motor_from_mapping(_doc_with(
+        'oil', {'term:dp^0.5': {'coefficient': 1e-7}})), 'oil', displacement_law='eq39')
+    assert empirical.speed_point(1 * LPM, 20 * MPA).status == PointStatus.NO_ROOT
+
+
+def test_wear_beyond_any_clearance_is_beyond_the_limit():
+    wear = model_with('oil', EFFECTS['clearance_wear'][0])
+    pt = wear.speed_point(10 * LPM, 10 * MPA, channels={'revolutions': 1e9})
+    assert pt.status == PointStatus.BEYOND_LIMIT and math.isnan(pt.speed)
+
+
+def test_root_search_stops_on_nan_and_converges_fast():
+    calls = []
+
+    def cubic(x):
+        calls.append(x)
+        return x ** 3 - 2.0
+
+    root, done = _bracketed_root(cubic, 0.0, -2.0, 4.0, 62.0)
+    assert done and root == pytest.approx(2.0 ** (1 / 3), rel=1e-15) and len(calls) < 40
+    assert _bracketed_root(lambda x: math.nan, 0.0, -1.0, 1.0, 1.0)[1] is False
+
+
+def test_water_follows_the_vogel_law():
+    model = model_with('water', {'viscosity_temperature': {
+        'coefficient': 247.8, 'law': 'vogel', 'reference_temperature': 20.0,
+        'reference_viscosity': 1.0e-6, 'vogel_c': 140.0}})
+    nu = float(vogel_viscosity(45.0, 20.0, 1.0e-6, 247.8, 140.0))
+    thin = MotorModel(WATER.geometry, WATER.coefficient_set, WATER.valid_range,
+                      WATER.liquid.__class__('w', nu, WATER.liquid.density,
+                                             WATER.liquid.bulk_modulus))
+    got = model.breakdown_point(600 * RPM, 10 * MPA, channels={'temperature': 45.0})
+    assert got.commutation == thin.breakdown_point(600 * RPM, 10 * MPA).commutation
+    assert 0.58e-6 < nu < 0.62e-6  # water at 45 degC: about 0.60 mm^2/s
+
+
+def test_flow_reading_inverts_true_flow():
+    for block in ({'flow_sensor_gain': {'coefficient': 0.05}},
+                  {'flow_sensor_offset': {'coefficient': 2e-5}}):
+        model = model_with('oil', block)
+        assert flow_reading(model.effects, model.true_flow(3e-4)) == pytest.approx(3e-4)
+        assert flow_reading(model.effects, 3e-4) != 3e-4

@@ -218,16 +218,21 @@ class ConditionedModel:
     def _extra(self, speed: float, dp_i: float, constant: float) -> float:
         return constant + sum(k * f(speed, dp_i) for k, f in self._terms)
 
-    def _with_extra(self, point: Point, flow: float | None, dp: float | None, extra: float,
-                    status: int) -> Point:
-        """Return `point` with `extra` in Q_vl (and in Q when `flow` is None)."""
+    @staticmethod
+    def _with_extra(model: MotorModel, point: Point, flow: float | None, dp: float | None,
+                    extra: float, status: int) -> Point:
+        """
+        Return `point` with `extra` in Q_vl, and in Q when `flow` is None.
+
+        A `dp` of None is dp_i plus the channel drop of eq. (35) at the final flow.
+        """
         if point.status & _INVALID_FLAGS:
             return point
         values = point._asdict()
         values['total'] = point.total + extra
-        values['flow'] = point.flow + extra if flow is None else flow
-        if dp is not None:
-            values['dp'] = dp
+        q = values['flow'] = point.flow + extra if flow is None else flow
+        d = model.derived
+        values['dp'] = point.dp_i + (d.ch_a * q + d.ch_b) * q if dp is None else dp
         values['status'] = (point.status & ~_STALLED) | status
         return Point(**values)
 
@@ -297,7 +302,7 @@ class ConditionedModel:
                 return _invalid(int(PointStatus.NOT_CONVERGED))
             status = 0
         point = evaluator.absorbency(speed, dp_i, False, p_ex, None)
-        return self._with_extra(point, flow, dp if port else None,
+        return self._with_extra(model, point, flow, dp if port else None,
                                 self._extra(speed, dp_i, constant), status | limited)
 
     def absorbency_point(self, speed: float, dp: float, port: bool, p_ex: float,
@@ -334,10 +339,8 @@ class ConditionedModel:
         if (not self._terms and constant == 0.0) or first.status & _INVALID_FLAGS:
             return first
         if not port:
-            point = self._with_extra(first, None, None, self._extra(speed, dp, constant),
-                                     first.status & _STALLED)
-            d = model.derived
-            return point._replace(dp=dp + (d.ch_a * point.flow + d.ch_b) * point.flow)
+            return self._with_extra(model, first, None, None, self._extra(speed, dp, constant),
+                                    first.status & _STALLED)
         evaluator, d = model._point, model.derived  # noqa: SLF001
 
         def chamber(q: float) -> float:
@@ -370,7 +373,7 @@ class ConditionedModel:
         dp_i = chamber(flow)
         limited = _CHANNEL_LIMITED if dp - (d.ch_a * flow + d.ch_b) * flow < 0.0 else 0
         point = evaluator.absorbency(speed, dp_i, False, p_ex, None)
-        point = self._with_extra(point, None, dp, self._extra(speed, dp_i, constant),
+        point = self._with_extra(model, point, None, dp, self._extra(speed, dp_i, constant),
                                  (point.status & _STALLED) | limited)
         return point._replace(flow=flow)
 
