@@ -284,3 +284,16 @@ def test_flow_reading_inverts_true_flow():
         model = model_with('oil', block)
         assert flow_reading(model.effects, model.true_flow(3e-4)) == pytest.approx(3e-4)
         assert flow_reading(model.effects, 3e-4) != 3e-4
+
+
+def test_without_a_leakage_effect_p_ex_drives_eq_24_on_both_paths():
+    model = model_with('oil', EFFECTS['term:dp^2*n'][0], external_leakage=1e-12)
+    speed = np.array([300.0, 900.0]) * RPM
+    p_ex = np.array([0.5, 2.0]) * MPA
+    forward = model.absorbency(speed, 10 * MPA, p_ex=p_ex)
+    inverse = model.speed(forward.flow, 10 * MPA, p_ex=p_ex)
+    np.testing.assert_allclose(inverse.speed, speed, rtol=1e-9)
+    for i in range(2):
+        pt = model.absorbency_point(float(speed[i]), 10 * MPA, p_ex=float(p_ex[i]))
+        assert pt.external == pytest.approx(1e-12 * p_ex[i], rel=1e-12)
+        assert forward.flow[i] == pt.flow
