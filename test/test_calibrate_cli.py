@@ -99,6 +99,17 @@ def test_calibrate_clean_data_exits_zero_with_effect_none(tmp_path, capsys):
     assert 'effects:' not in (tmp_path / 'o' / 'coefficients.yaml').read_text()
 
 
+def test_calibrate_line_names_a_near_tie(tmp_path, capsys):
+    table = generate(Plan(liquid='oil'), Injection.realistic('flow_sensor_gain'), seed=2)
+    data = _csv(tmp_path / 'gain.csv', table)
+    code, out, _ = _run(capsys, 'calibrate', data, '--liquid', 'oil', '--out', tmp_path / 'o')
+    assert code == 0
+    first, other = ('flow_sensor_gain', 'speed_sensor_gain')
+    if out.startswith('effect: speed_sensor_gain'):
+        first, other = other, first
+    assert out.startswith(f'effect: {first}') and f'near tie with {other}' in out
+
+
 @pytest.mark.parametrize(('text', 'match'), [
     ('speed [rpm],flow [l/min],p_in [MPa]\n1,2,3\n', "missing required column 'p_out'"),
     ('speed [rpm],flow [gal/h],p_in [MPa],p_out [MPa]\n1,2,3,4\n', "unknown flow unit 'gal/h'"),

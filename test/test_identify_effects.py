@@ -83,6 +83,18 @@ def test_gains_are_reported_as_a_near_tie():
     assert set(effects) == GAINS
 
 
+@pytest.mark.parametrize('effect', sorted(GAINS))
+def test_gains_are_a_near_tie_on_noise_free_data_too(effect):
+    """Both gains leave errors near zero; their ratio is no evidence, the report must say so."""
+    quiet = Plan(liquid='oil', noise_flow_lpm=0.0, noise_flow_rel=0.0, noise_speed_rpm=0.0,
+                 noise_pressure_mpa=0.0, noise_temperature_c=0.0)
+    cal = calibrate(generate(quiet, Injection.realistic(effect), seed=4), 'oil')
+    assert cal.chosen.effect in GAINS, cal.selection.verdict
+    runner = cal.selection.runner_up
+    assert runner is not None and runner.candidate.effect in GAINS - {cal.chosen.effect}
+    assert 'near tie' in cal.selection.verdict
+
+
 def test_a_larger_effect_is_not_needed_to_see_the_error_scale():
     plan = Plan(liquid='oil')
     table = generate(plan, Injection.realistic('channel:aux', 3.0), seed=1)

@@ -129,6 +129,9 @@ def command(data: str, liquid: str, out: str, motor: str | None, mode: str, alph
     if effect != 'none':
         line += (f' ({summary["regressor"]}, coefficient {summary["coefficient"]:.4g} '
                  f'{summary["unit"]})')
+    runner = cal.selection.runner_up
+    if runner is not None:
+        line += f', near tie with {runner.label}'
     print(f'{line}; out-of-sample RMSE of Q_vl {before:.4g} -> {after:.4g} l/min over '
           f'{summary["n_points"]} points; wrote {target}/calibration.json, coefficients.yaml, '
           'report.md')

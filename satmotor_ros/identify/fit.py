@@ -22,6 +22,7 @@ measured, and a factor moves away from 1 only as far as the data insist.
 from __future__ import annotations
 
 from dataclasses import dataclass
+import math
 from typing import Self
 
 import numpy as np
@@ -201,6 +202,14 @@ class LossFit:
         self._check_fitted()
         flow = self._predict(parts, self.u_)
         return flow if index is None else flow[index]
+
+    @property
+    def effect_coefficient(self) -> float:
+        """Return the fitted coefficient of the candidate effect, in its unit (no interval)."""
+        self._check_fitted()
+        if self.candidate is None:
+            return math.nan
+        return float(self.u_[3] * self.candidate.typical)
 
     @property
     def n_params(self) -> int:

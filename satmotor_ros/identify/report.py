@@ -244,7 +244,7 @@ def write_report(cal: Calibration, out: Path, summary: dict) -> Path:
               'identifiable from Q, n and dp and keep their packaged values.', '']
     lines += ['## Candidates', '', _table(
         [[f'`{s.label}`', f'{s.cv_rmse / LPM:.4g}', f'{s.p_value:.2g}',
-          f'{s.fit.report().values[3]:.4g} {s.candidate.unit}'] for s in sel.ranking],
+          f'{s.fit.effect_coefficient:.4g} {s.candidate.unit}'] for s in sel.ranking],
         ['candidate', 'CV RMSE [l/min]', 'p (F-test)', 'coefficient']), '',
         f'No effect: CV RMSE {sel.baseline.cv_rmse / LPM:.4g} l/min. An effect is accepted '
         f'when p < {sel.alpha:g}/{len(sel.ranking)} (Bonferroni) and it cuts the CV error by '

@@ -9,9 +9,11 @@ only if it passes two tests against the baseline (the model refitted
 without any effect): a nested-model F-test at the significance ``alpha``,
 Bonferroni-corrected for the number of candidates tried, and a cut of the
 cross-validated error by at least ``min_gain``. Otherwise the answer is
-``none``. A runner-up whose cross-validated error is within ``tie`` of the
-winner's and that passes the same tests is reported as a near tie; among
-near ties a named physical effect goes before ``channel:`` and ``term:``.
+``none``. A runner-up that passes the same tests is reported as a near tie
+when its cross-validated error is within ``tie`` of the winner's, or when it
+removes all but ``tie`` of the error the winner removes (on data with little
+noise both errors left are tiny, and their ratio means nothing); among the
+first kind a named physical effect goes before ``channel:`` and ``term:``.
 """
 
 from __future__ import annotations
@@ -151,7 +153,7 @@ class CrossValidatedSelector:
         Least relative cut of the cross-validated error, [-]
     tie : float
         Relative margin of cross-validated error within which the runner-up
-        counts as a near tie, [-]
+        counts as a near tie (of the winner's error, or of the error it removes), [-]
     time_ordered : bool
         Whether the points are in time order (contiguous folds), [-]
     c_floor : float
@@ -253,19 +255,25 @@ class CrossValidatedSelector:
                        f'error by {100 * gain:.1f} % (need > {100 * self.min_gain:.0f} %) with '
                        f'p = {top.p_value:.2g} (need < {self.alpha:g}/{m})')
             return Selection(baseline, ranking, None, None, verdict, self.alpha)
-        contenders = [s for s in ranking if s.cv_rmse <= (1.0 + self.tie) * top.cv_rmse
-                      and self._passes(s, baseline, m)]
+        removed = baseline.cv_rmse - top.cv_rmse
+        close = [s for s in ranking if self._passes(s, baseline, m) and (
+            s.cv_rmse <= (1.0 + self.tie) * top.cv_rmse
+            or s.cv_rmse - top.cv_rmse <= self.tie * removed)]
+        contenders = [s for s in close if s.cv_rmse <= (1.0 + self.tie) * top.cv_rmse]
         best = min(contenders, key=lambda s: (priority(s.candidate), s.cv_rmse))
-        others = [s for s in contenders if s.candidate.effect != best.candidate.effect]
+        # a runner-up also when it removes nearly all the error the winner removes: on data
+        # with little noise the two errors left are both tiny and far apart in ratio
+        others = [s for s in close if s.candidate.effect != best.candidate.effect]
         others.sort(key=lambda s: priority(s.candidate) != priority(best.candidate))
         runner = others[0] if others else None
         gain = 1.0 - best.cv_rmse / baseline.cv_rmse
         verdict = (f'{best.label}: cuts the cross-validated error by {100 * gain:.1f} %, '
                    f'p = {best.p_value:.2g} < {self.alpha:g}/{m}')
         if runner is not None:
+            runner_gain = 1.0 - runner.cv_rmse / baseline.cv_rmse
             verdict += (f'; near tie with {runner.label} (cross-validated error '
-                        f'{100 * (runner.cv_rmse / best.cv_rmse - 1):+.1f} %): the data '
-                        f'barely tell them apart')
+                        f'{100 * (runner.cv_rmse / best.cv_rmse - 1):+.1f} %, it cuts the '
+                        f'error by {100 * runner_gain:.1f} %): the data barely tell them apart')
             if priority(runner.candidate) > priority(best.candidate):
                 verdict += ', and a named physical effect goes before a generic term'
         return Selection(baseline, ranking, best, runner, verdict, self.alpha)
