@@ -54,11 +54,12 @@ def cycle(plant: Plant, steps: int, measure: bool = False) -> Callable[[], None]
     return run
 
 
-def node_factor(seconds: float, subscribed: bool) -> float:
+def node_factor(seconds: float, subscribed: bool, events: bool) -> float:
     """Run the virtual_motor node in sim mode for `seconds` of wall time; real-time factor."""
     import rclpy
     from rclpy.context import Context
     from rclpy.executors import SingleThreadedExecutor
+    from rclpy.experimental import EventsExecutor
     from rclpy.parameter import Parameter
     from rclpy.qos import qos_profile_sensor_data
     from sensor_msgs.msg import FluidPressure, JointState
@@ -67,7 +68,7 @@ def node_factor(seconds: float, subscribed: bool) -> float:
 
     context = Context()
     context.init()
-    executor = SingleThreadedExecutor(context=context)
+    executor = (EventsExecutor if events else SingleThreadedExecutor)(context=context)
     nodes = []
     try:
         motor = VirtualMotorNode(context=context, namespace=f'/bench_{os.getpid()}',
@@ -116,9 +117,10 @@ def main() -> int:
         calls = []
         point = model.absorbency_point
 
-        def spy(speed: float, dp: float, flow_guess: float | None = None) -> object:
+        def spy(speed: float, dp: float, flow_guess: float | None = None,
+                channels: dict[str, float] | None = None) -> object:
             calls.append((speed, dp, flow_guess))
-            return point(speed, dp, flow_guess=flow_guess)
+            return point(speed, dp, flow_guess=flow_guess, channels=channels)
         plant._point = spy
         cycle(plant, steps)()
         plant._point = point
@@ -150,12 +152,13 @@ def main() -> int:
     if args.node_seconds > 0.0:
         print()
         print('| virtual_motor node, sim mode, all topics at 100 Hz, 1 kHz physics '
-              '| real-time factor |')
-        print('| --- | ---: |')
+              '| SingleThreadedExecutor | EventsExecutor | ratio |')
+        print('| --- | ---: | ---: | ---: |')
         for subscribed in (False, True):
-            factor = node_factor(args.node_seconds, subscribed)
+            single = node_factor(args.node_seconds, subscribed, events=False)
+            events = node_factor(args.node_seconds, subscribed, events=True)
             who = 'with a listener on 3 topics' if subscribed else 'no subscribers'
-            print(f'| {who} | {factor:.1f} |')
+            print(f'| {who} | {single:.1f} | {events:.1f} | {events / single:.2f} |')
     return 0
 
 
