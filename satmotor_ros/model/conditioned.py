@@ -155,10 +155,12 @@ class ConditionedModel:
         return float(channels[name])
 
     def _variant(self, viscosity: float, growth: float) -> MotorModel:
+        bare = self._bare
+        if growth == 0.0 and viscosity == bare.liquid.kinematic_viscosity:
+            return bare
         key = (viscosity, growth)
         model = self._variants.get(key)
         if model is None:
-            bare = self._bare
             g: MotorGeometry = bare.geometry
             if growth:
                 g = replace(g, clearance_rotor=g.clearance_rotor + growth,
