@@ -28,6 +28,7 @@ from satmotor_ros.model import (COMPONENTS, describe_status, load_motor, ModelEr
 from satmotor_ros.nodes import _diagnostics as diag
 from satmotor_ros.nodes import _parameters as params
 from satmotor_ros.nodes._parameters import ParamSpec
+from satmotor_ros.nodes._spin import spin
 from satmotor_ros.prediction import (Combiner, FIELDS, INPUTS, Level, MODES, predict_point,
                                      Prediction, Progress, Rule, TOPICS, UNITS)
 from sensor_msgs.msg import FluidPressure, JointState, Temperature
@@ -350,7 +351,7 @@ def main(args: list[str] | None = None) -> None:
     node = None
     try:
         node = MotorModelNode()
-        rclpy.spin(node)
+        spin(node)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:

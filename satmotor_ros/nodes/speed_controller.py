@@ -27,6 +27,7 @@ from satmotor_ros.model.units import RPM
 from satmotor_ros.nodes import _diagnostics as diag
 from satmotor_ros.nodes import _parameters as params
 from satmotor_ros.nodes._parameters import ParamSpec
+from satmotor_ros.nodes._spin import spin
 from satmotor_ros.plant.controller import ControllerParams, FEEDFORWARDS, SpeedController
 from satmotor_ros.plant.errors import PlantError
 from sensor_msgs.msg import FluidPressure, JointState
@@ -243,7 +244,7 @@ def main(args: list[str] | None = None) -> None:
     node = None
     try:
         node = SpeedControllerNode()
-        rclpy.spin(node)
+        spin(node)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     except (ValueError, OSError) as err:  # bad start-up parameters: one line, no traceback

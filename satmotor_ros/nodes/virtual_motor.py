@@ -36,6 +36,7 @@ from satmotor_ros.model.units import LPM
 from satmotor_ros.nodes import _diagnostics as diag
 from satmotor_ros.nodes import _parameters as params
 from satmotor_ros.nodes._parameters import ParamSpec
+from satmotor_ros.nodes._spin import spin
 from satmotor_ros.plant import make_load, Plant
 from satmotor_ros.plant.config import parameter_specs, params_from_flat
 from satmotor_ros.plant.load import LOAD_KINDS
@@ -341,7 +342,7 @@ def main(args: list[str] | None = None) -> None:
     node = None
     try:
         node = VirtualMotorNode()
-        rclpy.spin(node)
+        spin(node)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     except (ValueError, OSError) as err:  # bad start-up parameters: one line, no traceback
