@@ -8,7 +8,7 @@ from satmotor_ros.identify import calibrate
 from satmotor_ros.identify.effects import CalibratedModel
 from satmotor_ros.identify.output import write_yaml
 from satmotor_ros.identify.synthetic import generate, Injection, Plan, REALISTIC
-from satmotor_ros.model import MotorModel
+from satmotor_ros.model import load_motor, MotorModel
 from satmotor_ros.model.units import LPM
 
 
@@ -31,3 +31,14 @@ def test_calibrated_yaml_with_its_effect_reproduces_the_data(tmp_path, liquid, e
     assert rmse < 1.5 * noise
     if effect != 'none':
         assert before > rmse
+
+
+def test_calibrating_again_from_a_calibrated_file_starts_without_its_effect(tmp_path):
+    plan = Plan(liquid='water')
+    table = generate(plan, Injection.realistic('viscosity_temperature', 1.0, 'water'), seed=5)
+    path = tmp_path / 'coefficients.yaml'
+    write_yaml(calibrate(table, 'water'), path)
+    again = calibrate(table, 'water', load_motor(path))
+    assert again.chosen is not None and again.chosen.effect == 'viscosity_temperature'
+    assert any('were left out' in note for note in again.table.notes)
+    assert not again.model.effects

@@ -242,9 +242,13 @@ def test_an_extra_loss_without_a_root_is_flagged_not_returned():
     assert pt.status == PointStatus.NO_ROOT and math.isnan(pt.speed)
     ok = gain.speed_point(2 * LPM, 10 * MPA)
     assert not ok.status & INVALID and balance(gain, ok) < 1e-9
+    # eq. (39) has no answer between n = 0 and its speed floor: a flow just above the losses
+    # at rest has no root with or without the effect
     empirical = MotorModel.from_spec(motor_from_mapping(_doc_with(
-        'oil', {'term:dp^0.5': {'coefficient': 1e-7}})), 'oil', displacement_law='eq39')
-    assert empirical.speed_point(1 * LPM, 20 * MPA).status == PointStatus.NO_ROOT
+        'oil', {'term:dp^0.5': {'coefficient': 1e-12}})), 'oil', displacement_law='eq39')
+    at_rest = empirical.breakdown_point(0.0, 20 * MPA).total
+    assert empirical.speed_point(1.001 * at_rest, dp_i=20 * MPA).status == PointStatus.NO_ROOT
+    assert empirical.speed_point(0.999 * at_rest, dp_i=20 * MPA).status & PointStatus.STALLED
 
 
 def test_wear_beyond_any_clearance_is_beyond_the_limit():
@@ -297,3 +301,14 @@ def test_without_a_leakage_effect_p_ex_drives_eq_24_on_both_paths():
         pt = model.absorbency_point(float(speed[i]), 10 * MPA, p_ex=float(p_ex[i]))
         assert pt.external == pytest.approx(1e-12 * p_ex[i], rel=1e-12)
         assert forward.flow[i] == pt.flow
+
+
+def test_a_stall_under_eq39_stays_a_stall_with_an_effect():
+    doc = _doc_with('oil', {'term:dp^2*n': {'coefficient': 1e-30}})
+    model = MotorModel.from_spec(motor_from_mapping(doc), 'oil', displacement_law='eq39')
+    bare = MotorModel.default('oil', 'eq39')
+    for flow in (0.01 * LPM, 0.3 * LPM, 3 * LPM):
+        got, ref = model.speed_point(flow, dp_i=12 * MPA), bare.speed_point(flow, dp_i=12 * MPA)
+        assert got.status == ref.status
+        assert got.speed == pytest.approx(ref.speed, rel=1e-9, abs=1e-12)
+    assert model.speed_point(0.01 * LPM, dp_i=12 * MPA).status & PointStatus.STALLED

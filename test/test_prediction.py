@@ -276,3 +276,21 @@ def test_progress_counts_time_and_measured_revolutions_from_the_first_prediction
     stale = _good().snapshot(3010 * MS)  # no measured speed: no revolutions counted
     assert progress.advance(stale) == (pytest.approx(3.0), pytest.approx(1.0))
     assert progress.peek(4010 * MS) == (pytest.approx(4.0), pytest.approx(1.0))
+
+
+def test_p_ex_output_is_the_pressure_the_leakage_effect_read():
+    effects = (effect_from_mapping('external_leakage', {'regressor': 'p_out',
+                                                        'coefficient': 1e-12}, 'e'),)
+    coef = dataclasses.replace(OIL.coef, external_leakage=1e-12)
+    model = MotorModel(OIL.geometry, dataclasses.replace(
+        OIL.coefficient_set, coefficients=coef, effects=effects), OIL.valid_range)
+    snap = _good(p_case=(0.5 * MPA + ATMOSPHERE, 5 * MS)).snapshot(10 * MS)
+    pred = predict_point(model, snap, RULE.timeout)
+    assert pred.output('p_ex') == 0.2 * MPA - ATMOSPHERE  # gauge p_out, not p_case
+    assert pred.output('external') == pytest.approx(1e-12 * (0.2 * MPA - ATMOSPHERE))
+    t = np.array([5 * MS, 10 * MS], dtype=np.int64)
+    series = {'flow': (t[1:], np.array([20 * LPM])), 'p_in': (t[:1], np.array([20 * MPA])),
+              'p_out': (t[:1], np.array([0.2 * MPA])),
+              'p_case': (t[:1], np.array([0.5 * MPA + ATMOSPHERE]))}
+    batch = predict_batch(model, combine_batch(RULE, t[1:], series), RULE.timeout)
+    assert batch.output('p_ex')[0] == pred.output('p_ex')

@@ -9,7 +9,7 @@ composes them and collects what ``calibration.json`` reports.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, Literal
 
 import numpy as np
@@ -151,6 +151,22 @@ def _errors(parts: LossParts, error: np.ndarray) -> Errors:
     return Errors.of(error, parts.loss)
 
 
+def _without_effects(spec: MotorSpec, liquid: str,
+                     table: BenchTable) -> tuple[MotorSpec, BenchTable]:
+    """Start from a set's coefficients without its effects: the calibration looks anew."""
+    fitted = spec.sets[liquid]
+    if not fitted.effects:
+        return spec, table
+    coef = fitted.coefficients
+    if any(e.kind == 'external_leakage' for e in fitted.effects):
+        coef = replace(coef, external_leakage=0.0)  # its effect named the pressure; gone too
+    bare = replace(fitted, coefficients=coef, effects=())
+    names = ', '.join(e.name for e in fitted.effects)
+    note = f'{spec.source}: its effects ({names}) were left out; the calibration looks anew'
+    return (replace(spec, sets={**spec.sets, liquid: bare}),
+            replace(table, notes=table.notes + (note,)))
+
+
 def calibrate(table: BenchTable, liquid: str = 'oil', spec: MotorSpec | None = None,
               options: Options | None = None) -> Calibration:
     """
@@ -183,6 +199,7 @@ def calibrate(table: BenchTable, liquid: str = 'oil', spec: MotorSpec | None = N
     if liquid not in spec.sets:
         msg = f'liquid {liquid!r} is not a coefficient set of {spec.name} ({", ".join(spec.sets)})'
         raise IdentificationError(msg)
+    spec, table = _without_effects(spec, liquid, table)
     model = MotorModel.from_spec(spec, liquid)
     points = steady_points(table, options.mode, options.steady)
     parts, usable = loss_parts(model, points)

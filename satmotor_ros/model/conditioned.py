@@ -38,6 +38,7 @@ _EXPANSIONS = 60
 _INVALID_FLAGS = int(INVALID)
 _STALLED = int(PointStatus.STALLED)
 _CHANNEL_LIMITED = int(PointStatus.CHANNEL_LIMITED)
+_SCREENED = int(PointStatus.NOT_FINITE | PointStatus.NEGATIVE | PointStatus.BEYOND_LIMIT)
 
 
 def _invalid(status: int) -> Point:
@@ -272,9 +273,12 @@ class ConditionedModel:
                                      dp_i=None if port else dp, p_ex=p_ex)
         first = model.speed_point(flow, dp if port else None, dp_i=None if port else dp,
                                   p_ex=p_ex)
-        if first.status & _INVALID_FLAGS:
+        if first.status & _SCREENED:  # bad input or beyond the limit, whatever the effect
             return first
-        dp_i, limited = first.dp_i, first.status & _CHANNEL_LIMITED
+        d = model.derived
+        dp_i = dp - (d.ch_a * flow + d.ch_b) * flow if port else dp  # eqs. (34)-(35)
+        limited = _CHANNEL_LIMITED if dp_i < 0.0 else 0
+        dp_i = max(dp_i, 0.0)
         evaluator = model._point  # noqa: SLF001 -- the same equations, on floats
 
         def excess(n: float) -> float:
@@ -286,7 +290,9 @@ class ConditionedModel:
         if f_lo != f_lo:
             return _invalid(int(PointStatus.NO_ROOT))
         if f_lo >= 0.0:
-            if lo > 0.0:  # eq. (39) below its speed floor has no answer, as in point.py
+            # eq. (39) has no answer between n = 0 and its speed floor (as in point.py),
+            # unless the flow does not even cover the losses at rest: a stall
+            if lo > 0.0 and not excess(0.0) >= 0.0:
                 return _invalid(int(PointStatus.NO_ROOT))
             speed, status = 0.0, _STALLED
         else:
@@ -300,7 +306,7 @@ class ConditionedModel:
             if not f_hi >= 0.0:
                 return _invalid(int(PointStatus.NO_ROOT))
             speed, done = _bracketed_root(excess, lo, f_lo, hi, f_hi)
-            if not (done and abs(excess(speed)) <= CHECK * flow + FLOW_ATOL):
+            if not (done and abs(excess(speed)) <= CHECK * abs(flow) + FLOW_ATOL):
                 return _invalid(int(PointStatus.NOT_CONVERGED))
             status = 0
         point = evaluator.absorbency(speed, dp_i, False, p_ex, None)

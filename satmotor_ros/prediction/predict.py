@@ -99,6 +99,11 @@ class Progress:
         return (stamp_ns - origin) * 1e-9, self.revolutions
 
 
+def _leakage_channel(model: MotorModel) -> str | None:
+    """Return the channel an external-leakage effect reads p_ex from, or None."""
+    return next((e.regressor for e in model.effects if e.kind == 'external_leakage'), None)
+
+
 def _gauge(p: float) -> float:
     return p - ATMOSPHERE if p > ATMOSPHERE else 0.0
 
@@ -231,6 +236,9 @@ def predict_point(model: MotorModel, snap: Snapshot, timeout: float,
     p_ex = _gauge(snap.values[_I_CASE]) if snap.states[_I_CASE] == InputState.FRESH else 0.0
     dp = p_in - p_out
     point = model.speed_point(flow, dp, p_ex=p_ex, channels=channels)
+    leak = _leakage_channel(model)
+    if leak is not None and channels is not None:
+        p_ex = channels[leak]  # the pressure the effect drove eq. (24) with
     status = point.status
     speed = point.speed
     residual = (model.true_speed(snap.values[_I_SPEED]) - speed
@@ -361,6 +369,9 @@ def predict_batch(model: MotorModel, snaps: SnapshotBatch, timeout: float) -> Pr
     p_ex = np.where(usable & (states[_I_CASE] == InputState.FRESH),
                     np.maximum(values[_I_CASE] - ATMOSPHERE, 0.0), 0.0)
     op = model.speed(flow, dp, p_ex=p_ex, errors='mask', channels=channels)
+    leak = _leakage_channel(model)
+    if leak is not None and channels is not None:
+        p_ex = channels[leak]  # the pressure the effect drove eq. (24) with
     status = np.where(usable, op.status, 0).astype(np.uint8)
     model_level = np.where(status & int(INVALID), np.uint8(Level.ERROR),
                            np.where(status & int(_NOTED), np.uint8(Level.WARN), np.uint8(0)))
