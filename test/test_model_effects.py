@@ -312,3 +312,23 @@ def test_a_stall_under_eq39_stays_a_stall_with_an_effect():
         assert got.status == ref.status
         assert got.speed == pytest.approx(ref.speed, rel=1e-9, abs=1e-12)
     assert model.speed_point(0.01 * LPM, dp_i=12 * MPA).status & PointStatus.STALLED
+
+
+def test_effects_that_leave_the_model_are_beyond_its_limit():
+    beyond = int(PointStatus.BEYOND_LIMIT)
+    gain = model_with('oil', {'channel:x': {'coefficient': 1e-5, 'reference': 0.0}})
+    assert gain.absorbency_point(1.0, dp_i=10 * MPA, channels={'x': -1.0}).status == beyond
+    assert gain.speed_point(0.0, 10 * MPA, channels={'x': -1.0}).status == beyond  # Q_vl < 0
+    steep = model_with('oil', {'channel:x': {'coefficient': 10.0, 'reference': 0.0}})
+    assert steep.speed_point(20 * LPM, 10 * MPA, channels={'x': 1e308}).status == beyond
+    pump = model_with('oil', {'term:dp^0.5': {'coefficient': -1e-8}})
+    assert pump.absorbency_point(1.0, 10 * MPA).status == beyond  # flow out of the inlet
+    huge = model_with('oil', {'term:n^2': {'coefficient': 1e-9}})
+    masked = huge.absorbency([100.0, 1e160], dp_i=10 * MPA, errors='mask')
+    assert int(masked.status[0]) in (0, int(PointStatus.EXTRAPOLATED))
+    assert masked.status[1] == beyond
+    cold = model_with('water', {'viscosity_temperature': {
+        'coefficient': 800.0, 'law': 'vogel', 'reference_temperature': 40.0,
+        'reference_viscosity': 46e-6}})
+    for t in (-140.0, -273.15):  # at or below the Vogel pole, C = 140 K
+        assert cold.speed_point(20 * LPM, 10 * MPA, channels={'temperature': t}).status == beyond

@@ -26,7 +26,7 @@ from satmotor_ros.model.errors import ConfigError, InvalidInputError, ModelError
 from satmotor_ros.model.results import (COMPONENTS, describe_status, INVALID, LossBreakdown,
                                         OperatingPoints, Point, PointStatus)
 from satmotor_ros.model.screening import CHECK, FLOW_ATOL
-from satmotor_ros.model.viscosity import vogel_viscosity, walther_viscosity
+from satmotor_ros.model.viscosity import KELVIN, vogel_viscosity, walther_viscosity
 
 if TYPE_CHECKING:
     from satmotor_ros.model.motor import MotorModel
@@ -63,6 +63,8 @@ def effect_viscosity(effect: Effect, temperature: float) -> float:
 
     """
     if effect.law == 'vogel':
+        if temperature + KELVIN <= effect.vogel_c:  # at or below the law's pole
+            return math.nan
         return float(vogel_viscosity(temperature, effect.reference_temperature,
                                      effect.reference_viscosity, effect.coefficient,
                                      effect.vogel_c))
@@ -216,10 +218,15 @@ class ConditionedModel:
             return None, p_ex, 0.0, int(PointStatus.BEYOND_LIMIT)
         constant = math.fsum(e.coefficient * (values[e.name] - e.reference)
                              for e in self._constant)
+        if not math.isfinite(constant):
+            return None, p_ex, 0.0, int(PointStatus.BEYOND_LIMIT)
         return model, p_ex, constant, 0
 
     def _extra(self, speed: float, dp_i: float, constant: float) -> float:
-        return constant + sum(k * f(speed, dp_i) for k, f in self._terms)
+        try:
+            return constant + sum(k * f(speed, dp_i) for k, f in self._terms)
+        except OverflowError:
+            return math.inf  # flagged BEYOND_LIMIT by _with_extra
 
     @staticmethod
     def _with_extra(model: MotorModel, point: Point, flow: float | None, dp: float | None,
@@ -232,8 +239,11 @@ class ConditionedModel:
         if point.status & _INVALID_FLAGS:
             return point
         values = point._asdict()
-        values['total'] = point.total + extra
+        total = values['total'] = point.total + extra
         q = values['flow'] = point.flow + extra if flow is None else flow
+        if not (total >= 0.0 and q >= 0.0 and total < math.inf):
+            # a negative or unbounded Q_vl, or flow out of the inlet: past the model
+            return _invalid(int(PointStatus.BEYOND_LIMIT))
         d = model.derived
         values['dp'] = point.dp_i + (d.ch_a * q + d.ch_b) * q if dp is None else dp
         values['status'] = (point.status & ~_STALLED) | status
@@ -383,7 +393,7 @@ class ConditionedModel:
         point = evaluator.absorbency(speed, dp_i, False, p_ex, None)
         point = self._with_extra(model, point, None, dp, self._extra(speed, dp_i, constant),
                                  (point.status & _STALLED) | limited)
-        return point._replace(flow=flow)
+        return point if point.status & _INVALID_FLAGS else point._replace(flow=flow)
 
 
 def points_to_array(points: list[Point], shape: tuple[int, ...], geometry: MotorGeometry,
