@@ -172,3 +172,56 @@ def test_wall_clock_mode_keeps_pace_with_the_wall_clock(ros):
     elapsed = time.monotonic() - start
     assert node.plant.state.time == pytest.approx(elapsed, abs=0.3)
     assert not clock
+
+
+def test_every_message_carries_its_own_tick(ros):
+    """The refilled messages: each one has the stamp, readings and frame of its own tick."""
+    context, executor, probe = ros
+    node = _motor(context, executor, **{'load.torque': 40.0, 'frame_id': 'rig',
+                                        'sensors.inlet_pressure.noise': 1.0e4})
+    node._command = 20.0 * LPM
+    joints = _collect(probe, JointState, 'joint_states')
+    inlet = _collect(probe, FluidPressure, 'inlet_pressure')
+    clock = _collect(probe, Clock, '/clock', 10)
+    assert _spin_until(executor, lambda: len(joints) > 20 and len(inlet) > 20 and len(clock) > 20)
+
+    def seconds(stamp):
+        return stamp.sec + 1e-9 * stamp.nanosec
+    ticks = {seconds(c.clock) for c in clock}
+    for stamps in ([seconds(j.header.stamp) for j in joints],
+                   [seconds(p.header.stamp) for p in inlet]):
+        assert all(b - a == pytest.approx(0.01, abs=1e-9) for a, b in zip(stamps, stamps[1:]))
+        assert set(stamps) <= ticks
+    angles = [j.position[0] for j in joints]
+    assert all(b > a for a, b in zip(angles, angles[1:]))
+    assert len({p.fluid_pressure for p in inlet}) == len(inlet)  # seeded noise: all differ
+    assert {p.header.frame_id for p in inlet} == {'rig'} and inlet[-1].variance == 1.0e8
+    node.set_parameters([Parameter('joint_name', value='shaft_2')])
+    count = len(joints)
+    assert _spin_until(executor, lambda: len(joints) > count + 2)
+    assert joints[-1].name == ['shaft_2']
+
+
+def test_clock_mode_and_max_speedup_switch_at_run_time(ros):
+    """Free-running sim, then wall clock, then paced sim: each keeps its own pace."""
+    context, executor, probe = ros
+    node = _motor(context, executor)
+    clock = _collect(probe, Clock, '/clock', 10)
+
+    def pace(seconds):
+        sim0, wall0 = node.plant.state.time, time.monotonic()
+        _spin_until(executor, lambda: time.monotonic() - wall0 > seconds, timeout=seconds + 1)
+        return (node.plant.state.time - sim0) / (time.monotonic() - wall0)
+    assert pace(0.5) > 3.0  # as fast as possible is far faster than the wall clock
+    assert node.set_parameters([Parameter('clock_mode', value='wall')])[0].successful
+    _spin_until(executor, lambda: False, timeout=0.05)
+    published = len(clock)
+    assert pace(1.0) == pytest.approx(1.0, abs=0.2)
+    _spin_until(executor, lambda: False, timeout=0.1)
+    assert len(clock) == published  # no /clock on the wall clock
+    assert node.set_parameters([Parameter('clock_mode', value='sim'),
+                                Parameter('max_speedup', value=2.0)])[0].successful
+    assert pace(1.0) == pytest.approx(2.0, abs=0.4)
+    assert len(clock) > published
+    assert node.set_parameters([Parameter('max_speedup', value=0.0)])[0].successful
+    assert pace(0.5) > 3.0
