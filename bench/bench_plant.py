@@ -112,7 +112,7 @@ def node_factor(seconds: float, subscribed: bool) -> tuple[float, float]:
         listener = subprocess.Popen([sys.executable, '-c', LISTENER, namespace]) \
             if subscribed else None
         deadline = time.monotonic() + 30.0
-        while listener is not None and motor._joint_pub.get_subscription_count() == 0:
+        while listener is not None and motor.count_subscribers(f'{namespace}/joint_states') == 0:
             executor.spin_once(timeout_sec=0.1)
             if time.monotonic() > deadline:
                 raise RuntimeError('the listener process did not subscribe within 30 s')
