@@ -171,17 +171,21 @@ class VirtualMotorNode(Node):
         # The publishers go without rclpy's default QoS-event handlers: each adds two
         # entities to every wait of the executor, once per tick, and a subscriber with an
         # incompatible QoS still reports it on its own side.
-        sensor = {'qos_profile': qos_profile_sensor_data,
-                  'event_callbacks': PublisherEventCallbacks(use_default_callbacks=False)}
-        self._pub = {name: self.create_publisher(FluidPressure, name, **sensor)
+        quiet = PublisherEventCallbacks(use_default_callbacks=False)
+        sensor = qos_profile_sensor_data
+        self._pub = {name: self.create_publisher(FluidPressure, name, sensor,
+                                                 event_callbacks=quiet)
                      for name in PRESSURE_TOPICS}
-        self._flow_pub = self.create_publisher(Float64, 'flow_measured', **sensor)
-        self._joint_pub = self.create_publisher(JointState, 'joint_states', **sensor)
-        self._temp_pub = self.create_publisher(Temperature, 'fluid_temperature', **sensor)
+        self._flow_pub = self.create_publisher(Float64, 'flow_measured', sensor,
+                                               event_callbacks=quiet)
+        self._joint_pub = self.create_publisher(JointState, 'joint_states', sensor,
+                                                event_callbacks=quiet)
+        self._temp_pub = self.create_publisher(Temperature, 'fluid_temperature', sensor,
+                                               event_callbacks=quiet)
         self._diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10,
-                                               event_callbacks=sensor['event_callbacks'])
+                                               event_callbacks=quiet)
         self._clock_pub = self.create_publisher(ClockMsg, '/clock', QoSProfile(depth=10),
-                                                event_callbacks=sensor['event_callbacks'])
+                                                event_callbacks=quiet)
         self._pressure = {name: FluidPressure() for name in PRESSURE_TOPICS}
         self._flow, self._joint, self._temperature = Float64(), JointState(), Temperature()
         self._clock_msg = ClockMsg()
