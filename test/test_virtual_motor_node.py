@@ -196,10 +196,13 @@ def test_every_message_carries_its_own_tick(ros):
     assert all(b > a for a, b in zip(angles, angles[1:]))
     assert len({p.fluid_pressure for p in inlet}) == len(inlet)  # seeded noise: all differ
     assert {p.header.frame_id for p in inlet} == {'rig'} and inlet[-1].variance == 1.0e8
-    node.set_parameters([Parameter('joint_name', value='shaft_2')])
-    count = len(joints)
-    assert _spin_until(executor, lambda: len(joints) > count + 2)
-    assert joints[-1].name == ['shaft_2']
+    node.set_parameters([Parameter('joint_name', value='shaft_2'),
+                         Parameter('frame_id', value='rig_2'),
+                         Parameter('sensors.inlet_pressure.noise', value=2.0e4)])
+    count, pressures = len(joints), len(inlet)
+    assert _spin_until(executor, lambda: len(joints) > count + 2 and len(inlet) > pressures + 2)
+    assert joints[-1].name == ['shaft_2'] and joints[-1].header.frame_id == 'rig_2'
+    assert inlet[-1].header.frame_id == 'rig_2' and inlet[-1].variance == 4.0e8
 
 
 def test_clock_mode_and_max_speedup_switch_at_run_time(ros):
@@ -221,7 +224,7 @@ def test_clock_mode_and_max_speedup_switch_at_run_time(ros):
     assert len(clock) == published  # no /clock on the wall clock
     assert node.set_parameters([Parameter('clock_mode', value='sim'),
                                 Parameter('max_speedup', value=2.0)])[0].successful
-    assert pace(1.0) == pytest.approx(2.0, abs=0.4)
+    assert 1.3 < pace(1.0) < 2.3  # rcl timers skip missed periods: under load only below 2
     assert len(clock) > published
     assert node.set_parameters([Parameter('max_speedup', value=0.0)])[0].successful
     assert pace(0.5) > 3.0

@@ -169,8 +169,8 @@ class VirtualMotorNode(Node):
         self.last_rejection = ''
         self._rejected_since_diagnostics = 0
         # The publishers go without rclpy's default QoS-event handlers: each adds two
-        # entities to every wait of the executor, once per tick, and a subscriber with an
-        # incompatible QoS still reports it on its own side.
+        # entities to every wait of the executor, once per tick, and a subscriber keeping
+        # its client library's default handlers still reports an incompatible QoS or type.
         quiet = PublisherEventCallbacks(use_default_callbacks=False)
         sensor = qos_profile_sensor_data
         self._pub = {name: self.create_publisher(FluidPressure, name, sensor,
@@ -283,8 +283,10 @@ class VirtualMotorNode(Node):
 
     def _free_tick(self) -> None:
         self._tick()
-        if isinstance(self._driver, GuardCondition):  # not switched to a timer meanwhile
-            self._driver.trigger()
+        driver = self._driver
+        # set_parameters() called directly from another thread may have swapped the driver
+        if isinstance(driver, GuardCondition):
+            driver.trigger()
 
     def _tick(self) -> None:
         plant = self.plant
