@@ -218,7 +218,8 @@ def main() -> int:
         for subscribed in (False, True):
             alone = plant_factor(args.node_seconds)
             wall, cpu = node_factor(args.node_seconds, subscribed)
-            who = 'a listener process on the 6 sensor topics and /clock' if subscribed else 'no subscribers'
+            who = ('a listener process on the 6 sensor topics and /clock' if subscribed
+                   else 'no subscribers')
             print(f'| {who} | {wall:.1f} | {cpu:.1f} | {alone[0]:.0f} | {wall / alone[0]:.2f} |')
     return 0
 
