@@ -8,8 +8,6 @@ set-point given as a parameter, then to one given on ``speed_setpoint``.
 """
 
 import os
-import signal
-import subprocess
 import time
 
 import pytest
@@ -29,22 +27,10 @@ NAMESPACE = f'/controller_process_test_{os.getpid()}'
 
 
 def _start(env, cwd, name, *ros_args):
-    executable = build._executable_path(build.PACKAGE, name)
-    assert executable is not None, f'{name} is not installed'
-    return subprocess.Popen(
-        [str(executable), '--ros-args', '-r', f'__ns:={NAMESPACE}', *ros_args], cwd=cwd,
-        env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    return build.start_installed(env, cwd, NAMESPACE, name, *ros_args)
 
 
-def _stop(process):
-    if process.poll() is None:
-        process.send_signal(signal.SIGINT)
-        try:
-            process.wait(timeout=10.0)
-        except subprocess.TimeoutExpired:
-            process.kill()
-            process.wait()
-    return process.returncode, process.stdout.read()
+_stop = build.stop_process
 
 
 def test_installed_controller_drives_the_installed_virtual_motor_on_sim_time(

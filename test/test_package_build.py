@@ -14,6 +14,7 @@ import json
 import os
 from pathlib import Path
 import shutil
+import signal
 import subprocess
 import sys
 import zipfile
@@ -181,6 +182,27 @@ def _executable_path(package_name, executable_name):
                 matches.append(Path(path))
     assert len(matches) <= 1, f'several executables named {executable_name}: {matches}'
     return matches[0] if matches else None
+
+
+def start_installed(env, cwd, namespace, name, *ros_args):
+    """Start installed executable `name` as ``ros2 run`` would, in `namespace`; output piped."""
+    executable = _executable_path(PACKAGE, name)
+    assert executable is not None, f'{name} is not installed'
+    return subprocess.Popen(
+        [str(executable), '--ros-args', '-r', f'__ns:={namespace}', *ros_args], cwd=cwd,
+        env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+
+
+def stop_process(process):
+    """Stop `process` with SIGINT (kill after 10 s); return its exit code and output."""
+    if process.poll() is None:
+        process.send_signal(signal.SIGINT)
+        try:
+            process.wait(timeout=10.0)
+        except subprocess.TimeoutExpired:
+            process.kill()
+            process.wait()
+    return process.returncode, process.stdout.read()
 
 
 @pytest.fixture(scope='module')

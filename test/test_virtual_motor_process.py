@@ -9,8 +9,6 @@ pressures, speed and /clock out, bad commands survived, clean exit on SIGINT.
 
 import math
 import os
-import signal
-import subprocess
 import time
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
@@ -27,30 +25,15 @@ import test_package_build as build
 
 colcon_build = build.colcon_build  # the module-scoped build, as a fixture of this module
 sourced_install = build.sourced_install
-_executable_path = build._executable_path
-PACKAGE = build.PACKAGE
 
 NAMESPACE = f'/vm_process_test_{os.getpid()}'
 
 
-def _start(sourced_install, tmp_path, name, *ros_args):
-    executable = _executable_path(PACKAGE, name)
-    assert executable is not None, f'{name} is not installed'
-    return subprocess.Popen(
-        [str(executable), '--ros-args', '-r', f'__ns:={NAMESPACE}', *ros_args],
-        cwd=tmp_path, env=sourced_install, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-        text=True)
+def _start(env, cwd, name, *ros_args):
+    return build.start_installed(env, cwd, NAMESPACE, name, *ros_args)
 
 
-def _stop(process):
-    if process.poll() is None:
-        process.send_signal(signal.SIGINT)
-        try:
-            process.wait(timeout=10.0)
-        except subprocess.TimeoutExpired:
-            process.kill()
-            process.wait()
-    return process.returncode, process.stdout.read()
+_stop = build.stop_process
 
 
 @pytest.fixture()
