@@ -35,7 +35,21 @@ setup(
         ('share/' + package_name + '/config', config_files),
     ],
     python_requires='>=3.10',
-    install_requires=['numpy', 'pyyaml', 'matplotlib'],
+    # Every third-party module satmotor_ros imports (test_package_build checks the list against
+    # the imports and installs the wheel with only these into a clean venv).  rclpy and the
+    # message packages are not on PyPI as such: they come from the ROS 2 installation
+    # (package.xml), and only the nodes and `satmotor demo` import them.
+    install_requires=[
+        'numpy',
+        'scipy',  # identify/: least squares, t and F distributions
+        'PyYAML',
+        'matplotlib',  # plots of calibrate, replay, characteristics, demo
+        'rosbags',  # bag writing (and the readers rosbags provides)
+        'lz4',  # lz4-compressed MCAP chunks
+        # zstd-compressed bags (file mode, message mode, MCAP chunks); the stdlib has
+        # compression.zstd from Python 3.14 on, which backports.zstd backports
+        'backports.zstd; python_version < "3.14"',
+    ],
     zip_safe=False,
     maintainer='satmotor_ros developers',
     maintainer_email='satmotor_ros@example.com',

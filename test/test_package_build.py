@@ -8,24 +8,45 @@ The executable is then found as ``ros2 run`` finds it (ros2cli ``ros2run/api``:
 ``get_package_prefix`` from the ament index, then an executable file of that name under
 ``<prefix>/lib/<package>``), and run with the environment that sourcing the install's
 setup script would give (its ``share/<package>/package.dsv`` hooks).
+
+pip builds a wheel, which is installed into a clean venv (no system site packages, no ROS)
+together with what setup.py declares, fetched from the package index (the versions pinned in
+requirements.txt): the wheel alone must calibrate a bench table and replay a zstd-compressed
+bag.  Every third-party module the package imports must be declared there and in package.xml.
 """
 
+import ast
+import csv
+from email.parser import Parser
+import importlib.metadata
 import json
 import os
 from pathlib import Path
+import re
 import shutil
 import signal
 import subprocess
 import sys
+import xml.etree.ElementTree as ElementTree
 import zipfile
 
 from ament_index_python.packages import get_package_prefix
+import numpy as np
 import pytest
+from rosbags.rosbag2 import CompressionFormat, CompressionMode, StoragePlugin, Writer
+from rosbags.typesys import get_typestore, Stores
+from satmotor_ros.cli import main
 
 PACKAGE = 'satmotor_ros'
 REPO_ROOT = Path(__file__).resolve().parent.parent
 BUILD_TIMEOUT = 180.0  # a clean build takes a few seconds, [s]
 RUN_TIMEOUT = 60.0  # one CLI call, [s]
+INSTALL_TIMEOUT = 300.0  # the venv and its packages; about 15 s from pip's cache, [s]
+BENCH_CSV = REPO_ROOT / 'test' / 'data' / 'bench_leak_water.csv'
+# rosdep keys of the PyPI distributions that have one; the others are named in a comment of
+# package.xml (rosdep has no key for them)
+ROSDEP_KEYS = {'numpy': 'python3-numpy', 'scipy': 'python3-scipy', 'pyyaml': 'python3-yaml',
+               'matplotlib': 'python3-matplotlib'}
 
 # Top-level entries of a checkout that are not package source.
 NOT_SOURCE = {'.git', '.venv', '.pytest_cache', '.hypothesis', 'build', 'install', 'log', 'out'}
@@ -350,18 +371,214 @@ def test_installed_satmotor_computes_the_oil_operating_point(sourced_install, tm
     assert result['speed_rpm'] == pytest.approx(133.2, abs=0.1)
 
 
-def test_pip_wheel_ships_config_as_package_data(tmp_path):
-    """A wheel (what ``pip install`` installs) carries config/*.yaml in satmotor_ros/config."""
-    source = _copy_source(tmp_path / 'src')
-    wheels = tmp_path / 'wheels'
+@pytest.fixture(scope='module')
+def wheel(tmp_path_factory):
+    """Build the package's wheel with ``pip wheel`` from a copy of the source; its path."""
+    tmp = tmp_path_factory.mktemp('wheel')
+    source = _copy_source(tmp / 'src')
+    wheels = tmp / 'wheels'
     proc = subprocess.run(
         [sys.executable, '-m', 'pip', 'wheel', '--no-deps', '--wheel-dir', str(wheels),
          str(source)],
-        cwd=tmp_path, capture_output=True, text=True, timeout=BUILD_TIMEOUT)
+        cwd=tmp, capture_output=True, text=True, timeout=BUILD_TIMEOUT)
     assert proc.returncode == 0, f'pip wheel failed:\n{proc.stdout}\n{proc.stderr}'
-    (wheel,) = wheels.glob(f'{PACKAGE}-*.whl')
+    (built,) = wheels.glob(f'{PACKAGE}-*.whl')
+    return built
+
+
+def _clean_environment():
+    """Return this process's environment without what would leak the checkout or ROS in."""
+    env = dict(os.environ)
+    for name in ('PYTHONPATH', 'PYTHONHOME', 'VIRTUAL_ENV', 'AMENT_PREFIX_PATH',
+                 'COLCON_PREFIX_PATH', 'LD_LIBRARY_PATH'):
+        env.pop(name, None)
+    return env
+
+
+@pytest.fixture(scope='module')
+def clean_venv(wheel, tmp_path_factory):
+    """
+    Install the wheel and its declared dependencies, nothing else, into a new venv.
+
+    Returns
+    -------
+    dict
+        ``bin``: the venv's script directory; ``env``: the environment to run it with, [-]
+
+    """
+    venv = tmp_path_factory.mktemp('clean') / 'venv'
+    env = _clean_environment()
+    made = subprocess.run([sys.executable, '-m', 'venv', str(venv)], env=env,
+                          capture_output=True, text=True, timeout=INSTALL_TIMEOUT)
+    assert made.returncode == 0, made.stderr
+    assert 'include-system-site-packages = false' in (venv / 'pyvenv.cfg').read_text()
+    # the pins of requirements.txt as constraints: the index's versions the suite runs with
+    install = [str(venv / 'bin' / 'python'), '-m', 'pip', 'install', '--no-compile',
+               '--constraint', str(REPO_ROOT / 'requirements.txt'), str(wheel)]
+    proc = subprocess.run(install, env=env, capture_output=True, text=True,
+                          timeout=INSTALL_TIMEOUT)
+    assert proc.returncode == 0, f'pip install failed:\n{proc.stdout}\n{proc.stderr}'
+    env['PATH'] = os.pathsep.join([str(venv / 'bin'), env.get('PATH', '')])
+    return {'bin': venv / 'bin', 'env': env}
+
+
+def test_pip_wheel_ships_config_as_package_data(wheel):
+    """A wheel (what ``pip install`` installs) carries config/*.yaml in satmotor_ros/config."""
     with zipfile.ZipFile(wheel) as archive:
         names = set(archive.namelist())
     for yaml_file in (REPO_ROOT / 'config').glob('*.yaml'):
         assert f'{PACKAGE}/config/{yaml_file.name}' in names
     assert f'{PACKAGE}/py.typed' in names
+
+
+def _third_party_imports():
+    """Map each module imported by satmotor_ros from outside it and the stdlib to a file."""
+    found = {}
+    for path in sorted((REPO_ROOT / PACKAGE).rglob('*.py')):
+        for node in ast.walk(ast.parse(path.read_text(), str(path))):
+            if isinstance(node, ast.Import):
+                names = [alias.name for alias in node.names]
+            elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+                # `from backports import zstd` imports backports.zstd
+                names = [f'{node.module}.{alias.name}' for alias in node.names]
+            else:
+                continue
+            for name in names:
+                top = name.partition('.')[0]
+                if top != PACKAGE and top not in sys.stdlib_module_names:
+                    found.setdefault(name, path.relative_to(REPO_ROOT))
+    return found
+
+
+def _normalised(name):
+    """Return a distribution name as pip compares it (PEP 503)."""
+    return re.sub(r'[-_.]+', '-', name).lower()
+
+
+def _distribution_of(module):
+    """Name the installed distribution whose files hold `module` (normalised), else None."""
+    top = module.partition('.')[0]
+    parts = module.split('.')
+    for dist in importlib.metadata.packages_distributions().get(top, []):
+        files = {Path(str(f)).with_suffix('').parts for f in importlib.metadata.files(dist)}
+        # the deepest existing module or package of the dotted name
+        for depth in range(len(parts), 0, -1):
+            if tuple(parts[:depth]) in files or (*parts[:depth], '__init__') in files:
+                return _normalised(dist)
+    return None
+
+
+def test_every_third_party_import_is_declared_in_setup_py_and_package_xml(wheel):
+    """A module from a ROS package is an exec_depend; any other is a requirement of the wheel."""
+    with zipfile.ZipFile(wheel) as archive:
+        (metadata,) = [n for n in archive.namelist() if n.endswith('.dist-info/METADATA')]
+        requires = Parser().parsestr(archive.read(metadata).decode()).get_all('Requires-Dist')
+    declared = {_normalised(re.match(r'[A-Za-z0-9._-]+', r).group()) for r in requires or []}
+    manifest = (REPO_ROOT / 'package.xml').read_text()
+    exec_depends = {e.text for e in ElementTree.fromstring(manifest).iter('exec_depend')}
+    problems = []
+    for module, where in sorted(_third_party_imports().items()):
+        if module.partition('.')[0] in exec_depends:
+            continue  # a ROS package, found by rosdep and by colcon
+        dist = _distribution_of(module)
+        if dist is None or dist not in declared:
+            problems.append(f'{where}: {module} (distribution {dist}) is in neither '
+                            'setup.py install_requires nor package.xml exec_depend')
+        elif dist in ROSDEP_KEYS and ROSDEP_KEYS[dist] not in exec_depends:
+            problems.append(f'{where}: package.xml lacks <exec_depend>{ROSDEP_KEYS[dist]}')
+        elif dist not in ROSDEP_KEYS and dist not in _normalised(manifest):
+            problems.append(f'{where}: {dist} is not named in package.xml (the comment on '
+                            'packages without a rosdep key)')
+    assert not problems, '\n'.join(dict.fromkeys(problems))
+
+
+def test_clean_venv_has_the_wheel_and_no_ros(clean_venv, tmp_path):
+    """The venv's satmotor_ros is the installed wheel, rclpy is absent, and pip check passes."""
+    probe = ('import importlib.util, json, sys, satmotor_ros\n'
+             'print(json.dumps({"module": satmotor_ros.__file__, "prefix": sys.prefix,\n'
+             '    "rclpy": importlib.util.find_spec("rclpy") is not None}))\n')
+    proc = _run([clean_venv['bin'] / 'python', '-c', probe], clean_venv['env'], tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    found = json.loads(proc.stdout)
+    assert Path(found['module']).is_relative_to(found['prefix']), found
+    assert not found['rclpy'], found
+    check = _run([clean_venv['bin'] / 'python', '-m', 'pip', 'check'], clean_venv['env'],
+                 tmp_path)
+    assert check.returncode == 0, check.stdout + check.stderr
+
+
+def test_wheel_alone_runs_satmotor_calibrate(clean_venv, tmp_path):
+    """
+    ``satmotor calibrate`` of the wheel finds the external leakage of a bench table.
+
+    test/data/bench_leak_water.csv is the synthetic generator's table of
+    ``generate(Plan(liquid='water'), Injection.realistic('external_leakage', 1, 'water'),
+    seed=7)``, written as test_calibrate_cli writes it: 100 points, leakage through p_case.
+    """
+    argv = [clean_venv['bin'] / 'satmotor', 'calibrate', BENCH_CSV, '--liquid', 'water',
+            '--out', tmp_path / 'out']
+    proc = _run(argv, clean_venv['env'], tmp_path)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    result = json.loads((tmp_path / 'out' / 'calibration.json').read_text())
+    assert (result['effect'], result['regressor'], result['n_points']) == \
+        ('external_leakage', 'p_case', 100)
+    report = (tmp_path / 'out' / 'report.md').read_text()
+    assert '(residuals.png)' in report
+    assert (tmp_path / 'out' / 'residuals.png').read_bytes()[:8] == b'\x89PNG\r\n\x1a\n'
+
+
+def _zstd_bag(path, n):
+    """
+    Write the model's input topics, n messages each at 100 Hz, as a zstd-compressed bag.
+
+    rosbags' writer compresses the whole storage file (``--compression-mode file``, as
+    ``ros2 bag record`` does), leaving only metadata.yaml and a ``.db3.zstd`` file.
+    """
+    typestore = get_typestore(Stores.ROS2_KILTED)
+    types = typestore.types
+    rng = np.random.default_rng(3)
+    t = 1_700_000_000_000_000_000 + np.arange(n, dtype=np.int64) * 10_000_000
+    writer = Writer(path, version=9, storage_plugin=StoragePlugin.SQLITE3)
+    writer.set_compression(CompressionMode.FILE, CompressionFormat.ZSTD)
+    with writer:
+        flow = writer.add_connection('/flow_command', 'std_msgs/msg/Float64',
+                                     typestore=typestore)
+        ports = [writer.add_connection(name, 'sensor_msgs/msg/FluidPressure',
+                                       typestore=typestore)
+                 for name in ('/inlet_pressure', '/outlet_pressure')]
+        for k, stamp in enumerate(t.tolist()):
+            header = types['std_msgs/msg/Header'](
+                stamp=types['builtin_interfaces/msg/Time'](sec=stamp // 10**9,
+                                                           nanosec=stamp % 10**9),
+                frame_id='')
+            for port, pressure in zip(ports, (rng.uniform(5e6, 25e6), rng.uniform(2e5, 1e6))):
+                message = types['sensor_msgs/msg/FluidPressure'](
+                    header=header, fluid_pressure=pressure, variance=0.0)
+                writer.write(port, stamp, typestore.serialize_cdr(
+                    message, 'sensor_msgs/msg/FluidPressure'))
+            command = types['std_msgs/msg/Float64'](data=rng.uniform(5, 40) / 60000.0)
+            writer.write(flow, stamp + 1_000_000 + k % 2, typestore.serialize_cdr(
+                command, 'std_msgs/msg/Float64'))
+    assert sorted(p.suffix for p in path.iterdir()) == ['.yaml', '.zstd']
+
+
+def _rows(path):
+    with open(path, newline='') as stream:
+        return list(csv.DictReader(stream))
+
+
+def test_wheel_alone_replays_a_zstd_compressed_bag(clean_venv, tmp_path, capsys):
+    """``satmotor replay`` of the wheel reads a file-compressed bag as the source tree does."""
+    _zstd_bag(tmp_path / 'bag', 200)
+    argv = [clean_venv['bin'] / 'satmotor', 'replay', tmp_path / 'bag', '--no-plot',
+            '--out', tmp_path / 'wheel.csv']
+    proc = _run(argv, clean_venv['env'], tmp_path)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert '200 driving messages, 200 predictions' in proc.stdout
+    assert main(['replay', str(tmp_path / 'bag'), '--no-plot',
+                 '--out', str(tmp_path / 'source.csv')]) == 0
+    capsys.readouterr()
+    wheel_rows = _rows(tmp_path / 'wheel.csv')
+    assert len(wheel_rows) == 200
+    assert all(float(r['speed [rpm]']) > 0 for r in wheel_rows)
+    assert wheel_rows == _rows(tmp_path / 'source.csv')
