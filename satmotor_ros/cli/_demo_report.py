@@ -4,19 +4,30 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any, NamedTuple, Sequence
 
 import matplotlib
 import numpy as np
 
 from satmotor_ros.bags import OutTopic, read_series, write_bag
-from satmotor_ros.cli.demo import RunResult
 from satmotor_ros.model import COMPONENTS, MotorModel
 from satmotor_ros.model.units import LPM, RPM
 from satmotor_ros.plant.scenario import Cycle, step_metrics, StepMetrics
 
 matplotlib.use('Agg')
 import matplotlib.pyplot as plt  # noqa: E402, I100
+
+
+class RunResult(NamedTuple):
+    """One run of the cycle: where its bag is and what was recorded."""
+
+    liquid: str
+    feedforward: str
+    bag: Path
+    messages: dict[str, list[tuple[int, bytes]]]  # topic -> (log time [ns], CDR)
+    types: dict[str, str]  # topic -> message type
+    wall: float  # wall-clock duration of the run [s]
+    sim: float  # simulated duration [s]
 
 
 def write_run_bag(path: Path, messages: dict[str, list[tuple[int, bytes]]],
@@ -350,4 +361,5 @@ def write_report(out: Path, runs: list[RunResult], cycle: Cycle,
     return path
 
 
-__all__ = ['Tracking', 'hold', 'read_run', 'summary', 'write_report', 'write_run_bag']
+__all__ = ['RunResult', 'Tracking', 'hold', 'read_run', 'summary', 'write_report',
+           'write_run_bag']

@@ -17,7 +17,7 @@ import os
 from pathlib import Path
 import sys
 import time
-from typing import Any, NamedTuple
+from typing import Any
 
 from satmotor_ros.cli._common import CliError, fail
 from satmotor_ros.plant.params import EffectParams
@@ -25,40 +25,6 @@ from satmotor_ros.plant.scenario import default_cycle
 
 LIQUIDS = ('water', 'oil')
 FEEDFORWARDS = ('model', 'none')
-CONTROL_RATE = 100.0
-"""Rate of the controller and of the set-point script, [Hz]."""
-
-RECORDED = (  # topic relative to the run's namespace, type, reliable publisher?
-    ('flow_command', 'std_msgs/msg/Float64', True),
-    ('load_torque', 'std_msgs/msg/Float64', True),
-    ('speed_setpoint', 'std_msgs/msg/Float64', True),
-    ('inlet_pressure', 'sensor_msgs/msg/FluidPressure', False),
-    ('outlet_pressure', 'sensor_msgs/msg/FluidPressure', False),
-    ('case_pressure', 'sensor_msgs/msg/FluidPressure', False),
-    ('flow_measured', 'std_msgs/msg/Float64', False),
-    ('joint_states', 'sensor_msgs/msg/JointState', False),
-    ('fluid_temperature', 'sensor_msgs/msg/Temperature', False),
-    ('/diagnostics', 'diagnostic_msgs/msg/DiagnosticArray', True),
-    ('/clock', 'rosgraph_msgs/msg/Clock', True),
-    ('predicted_joint_state', 'sensor_msgs/msg/JointState', True),
-    ('speed_residual', 'std_msgs/msg/Float64', True),
-    *((f'losses/{c}', 'std_msgs/msg/Float64', True) for c in (
-        'flat_clearance', 'commutation', 'compressibility', 'deformation', 'backlash',
-        'inertia', 'external', 'total')),
-)
-"""Every topic of a run, relative to its namespace (DESIGN.md names and types)."""
-
-
-class RunResult(NamedTuple):
-    """One run of the cycle: where its bag is and what was recorded."""
-
-    liquid: str
-    feedforward: str
-    bag: Path
-    messages: dict[str, list[tuple[int, bytes]]]  # topic -> (log time [ns], CDR)
-    types: dict[str, str]  # topic -> message type
-    wall: float  # wall-clock duration of the run [s]
-    sim: float  # simulated duration [s]
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -251,4 +217,4 @@ class Progress:
         sys.stderr.write('\n')
 
 
-__all__ = ['RunResult', 'add_parser', 'command', 'parse_effects']
+__all__ = ['add_parser', 'command', 'parse_effects']
