@@ -106,22 +106,7 @@ def _has_both(motor: str | None) -> bool:
 
 
 def constant_flow(model: MotorModel, dp_i: np.ndarray) -> tuple[Figure, Figure]:
-    """
-    Compute Q_vl (Fig. 8 kind) and the speed loss n_i, eq. (41), over dp_i at constant flow.
-
-    Parameters
-    ----------
-    model : MotorModel
-        The model, [-]
-    dp_i : ndarray
-        Chamber pressure drops, [Pa]
-
-    Returns
-    -------
-    tuple of Figure
-        Losses and speed loss, one curve per flow of :data:`FLOWS_LPM`.
-
-    """
+    """Compute Q_vl (Fig. 8 kind) and n_i (eq. 41) over `dp_i` [Pa] at each of FLOWS_LPM."""
     op = model.speed(np.array(FLOWS_LPM)[:, None] * LPM, dp_i=dp_i[None, :], errors='mask')
     speed = op.speed / RPM
     return (Figure('constant_flow', 'Volumetric losses at constant flow (Fig. 8 kind)',
@@ -134,22 +119,7 @@ def constant_flow(model: MotorModel, dp_i: np.ndarray) -> tuple[Figure, Figure]:
 
 
 def constant_speed(model: MotorModel, dp_i: np.ndarray) -> Figure:
-    """
-    Compute Q_vl and its parts over dp_i at constant speed (Figs. 9-10 kind).
-
-    Parameters
-    ----------
-    model : MotorModel
-        The model, [-]
-    dp_i : ndarray
-        Chamber pressure drops, [Pa]
-
-    Returns
-    -------
-    Figure
-        One curve per speed of :data:`SPEEDS_RPM`.
-
-    """
+    """Compute Q_vl and its parts over `dp_i` [Pa] at each of SPEEDS_RPM (Figs. 9-10 kind)."""
     op = model.absorbency(np.array(SPEEDS_RPM)[:, None] * RPM, dp_i=dp_i[None, :],
                           errors='mask')
     losses = op.losses
@@ -164,22 +134,7 @@ def constant_speed(model: MotorModel, dp_i: np.ndarray) -> Figure:
 
 
 def displacement(model: MotorModel, dp_i: np.ndarray) -> Figure:
-    """
-    Compute the change of displacement over dp_i, eqs. (33) and (39) (Figs. 11-12 kind).
-
-    Parameters
-    ----------
-    model : MotorModel
-        The model, [-]
-    dp_i : ndarray
-        Chamber pressure drops, [Pa]
-
-    Returns
-    -------
-    Figure
-        One curve per speed of :data:`SPEEDS_RPM`.
-
-    """
+    """Compute dq of eqs. (33) and (39) over `dp_i` [Pa] at each of SPEEDS_RPM (Figs. 11-12)."""
     n = np.array(SPEEDS_RPM)[:, None] * RPM
     to_cm3 = 2.0 * np.pi * 1.0e6
     dq33 = displacement_change(dp_i[None, :], n, model.c, model.coef.c_id, model.geometry)

@@ -57,7 +57,7 @@ def write_json(cal: Calibration, path: str | Path) -> dict[str, Any]:
     Parameters
     ----------
     cal : Calibration
-        The result, [-]
+        The result; its ``summary()`` is what is written, [-]
     path : str or pathlib.Path
         File to write, [-]
 
@@ -79,7 +79,7 @@ def fitted_coefficients(cal: Calibration) -> LossCoefficients:
     Parameters
     ----------
     cal : Calibration
-        The result, [-]
+        Its final fit holds s_L, s_C and s_id first, then the effect's coefficient, [-]
 
     Returns
     -------
@@ -105,7 +105,7 @@ def effect_block(cal: Calibration) -> dict[str, Any]:
     Parameters
     ----------
     cal : Calibration
-        The result, [-]
+        The result; nothing to describe when it chose no effect, [-]
 
     Returns
     -------
@@ -136,21 +136,8 @@ def effect_block(cal: Calibration) -> dict[str, Any]:
     return {chosen.effect: entry}
 
 
-def coefficients_document(cal: Calibration) -> dict[str, Any]:
-    """
-    Build the ``coefficients.yaml`` document.
-
-    Parameters
-    ----------
-    cal : Calibration
-        The result, [-]
-
-    Returns
-    -------
-    dict
-        A motor document with one coefficient set (plain SI numbers).
-
-    """
+def _document(cal: Calibration) -> dict[str, Any]:
+    """Build the ``coefficients.yaml`` motor document: one coefficient set, plain SI numbers."""
     spec = cal.spec
     coef = fitted_coefficients(cal)
     liquid = cal.model.liquid
@@ -209,6 +196,6 @@ def write_yaml(cal: Calibration, path: str | Path) -> None:
             f'c x{s_c:.4g}, c_id x{s_id:.4g}.\n'
             "# Plain numbers are SI (temperature degC); loss coefficients in the paper's "
             'fitting units.\n')
-    body = yaml.safe_dump(coefficients_document(cal), sort_keys=False, allow_unicode=True,
+    body = yaml.safe_dump(_document(cal), sort_keys=False, allow_unicode=True,
                           width=99)
     Path(path).write_text(head + body, encoding='utf-8')

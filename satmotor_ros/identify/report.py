@@ -28,22 +28,8 @@ def _pyplot():
     return pyplot
 
 
-def regressors(cal: Calibration) -> dict[str, FloatArray]:
-    """
-    Collect the regressors the residual is plotted against, in display units.
-
-    Parameters
-    ----------
-    cal : Calibration
-        The result, [-]
-
-    Returns
-    -------
-    dict of str to ndarray
-        ``'label [unit]'`` -> values: speed, pressure drop, flow, p_out, every
-        channel and, if a term was chosen, its expression.
-
-    """
+def _regressors(cal: Calibration) -> dict[str, FloatArray]:
+    """Map ``'label [unit]'`` to speed, dp, flow, p_out, each channel and a chosen term."""
     parts = cal.parts
     out = {'n [rpm]': parts.speed / RPM, 'dp [MPa]': parts.dp / MPA,
            'flow [l/min]': parts.flow / LPM, 'p_out [MPa]': cal.table.p_out / MPA}
@@ -57,20 +43,10 @@ def regressors(cal: Calibration) -> dict[str, FloatArray]:
     return out
 
 
-def plot_residuals(cal: Calibration, path: Path) -> None:
-    """
-    Plot the out-of-sample residual of Q_vl against each regressor, before and after.
-
-    Parameters
-    ----------
-    cal : Calibration
-        The result, [-]
-    path : pathlib.Path
-        PNG to write, [-]
-
-    """
+def _plot_residuals(cal: Calibration, path: Path) -> None:
+    """Plot the out-of-sample residual of Q_vl against each regressor, before and after."""
     plt = _pyplot()
-    regs = regressors(cal)
+    regs = _regressors(cal)
     cols = 3
     rows = int(np.ceil(len(regs) / cols))
     fig, axes = plt.subplots(rows, cols, figsize=(12, 3.0 * rows), squeeze=False)
@@ -101,18 +77,8 @@ def _fitted_model(cal: Calibration) -> MotorModel:
                       cal.model.valid_range, cal.model.liquid)
 
 
-def plot_characteristics(cal: Calibration, path: Path) -> None:
-    """
-    Plot measured Q_vl against dp with the model's curves, and measured against predicted.
-
-    Parameters
-    ----------
-    cal : Calibration
-        The result, [-]
-    path : pathlib.Path
-        PNG to write, [-]
-
-    """
+def _plot_characteristics(cal: Calibration, path: Path) -> None:
+    """Plot measured Q_vl against dp with the model's curves, and measured against predicted."""
     plt = _pyplot()
     parts = cal.parts
     fig, (left, right) = plt.subplots(1, 2, figsize=(12, 4.8))
@@ -153,18 +119,8 @@ def plot_characteristics(cal: Calibration, path: Path) -> None:
     plt.close(fig)
 
 
-def plot_ranking(cal: Calibration, path: Path) -> None:
-    """
-    Plot the candidates' cross-validated errors against the baseline's.
-
-    Parameters
-    ----------
-    cal : Calibration
-        The result, [-]
-    path : pathlib.Path
-        PNG to write, [-]
-
-    """
+def _plot_ranking(cal: Calibration, path: Path) -> None:
+    """Plot the candidates' cross-validated errors against the baseline's."""
     plt = _pyplot()
     ranking = cal.selection.ranking[:15]
     fig, ax = plt.subplots(figsize=(8, 0.35 * len(ranking) + 1.5))
@@ -183,6 +139,11 @@ def plot_ranking(cal: Calibration, path: Path) -> None:
                         top=1 - 0.4 / (0.35 * len(ranking) + 1.5))
     fig.savefig(path, dpi=80)
     plt.close(fig)
+
+
+PLOTS = {'residuals': _plot_residuals, 'characteristics': _plot_characteristics,
+         'ranking': _plot_ranking}
+"""The report's plots: ``<name>.png`` beside ``report.md``, in the report's order."""
 
 
 def _table(rows: list[list[str]], header: list[str]) -> str:
@@ -210,9 +171,8 @@ def write_report(cal: Calibration, out: Path, summary: dict) -> Path:
         The report's path.
 
     """
-    plot_residuals(cal, out / 'residuals.png')
-    plot_characteristics(cal, out / 'characteristics.png')
-    plot_ranking(cal, out / 'ranking.png')
+    for name, plot in PLOTS.items():
+        plot(cal, out / f'{name}.png')
     sel = cal.selection
     lines = [f'# Calibration of {cal.spec.name} on {cal.liquid}', '',
              f'Data: `{cal.table.source}`, {len(cal.parts)} steady operating points.']
@@ -256,13 +216,13 @@ def write_report(cal: Calibration, out: Path, summary: dict) -> Path:
     if block:
         lines += ['', '## The effect in `coefficients.yaml`', '', '```json',
                   json.dumps(block, indent=2), '```']
-    lines += ['', '## Plots', '', '![residuals](residuals.png)', '',
-              '![characteristics](characteristics.png)', '', '![ranking](ranking.png)', '',
-              '## calibration.json', '', '```json', json.dumps(summary, indent=2), '```', '']
+    lines += ['', '## Plots', '']
+    for name in PLOTS:
+        lines += [f'![{name}]({name}.png)', '']
+    lines += ['## calibration.json', '', '```json', json.dumps(summary, indent=2), '```', '']
     path = out / 'report.md'
     path.write_text('\n'.join(lines), encoding='utf-8')
     return path
 
 
-__all__ = ['SCALES', 'plot_characteristics', 'plot_ranking', 'plot_residuals', 'regressors',
-           'write_report']
+__all__ = ['PLOTS', 'SCALES', 'write_report']

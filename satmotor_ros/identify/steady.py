@@ -122,28 +122,11 @@ def _channels(table: BenchTable, tol: SteadyTolerance) -> list[tuple[FloatArray,
     return [(x, rel, max(absolute, 2.0 * sample_noise(x))) for x, rel, absolute in pairs]
 
 
-def steady_mask(table: BenchTable, time: FloatArray, tol: SteadyTolerance) -> np.ndarray:
-    """
-    Flag the samples whose centred window is steady.
-
-    Parameters
-    ----------
-    table : BenchTable
-        Raw samples in time order, [-]
-    time : ndarray
-        Sample times, increasing, [s]
-    tol : SteadyTolerance
-        The tolerances, [-]
-
-    Returns
-    -------
-    ndarray of bool
-        True where every required channel is steady.
-
-    """
-    channels = _channels(table, tol)
+def _steady_mask(channels: list[tuple[FloatArray, float, float]], time: FloatArray,
+                 window: float) -> np.ndarray:
+    """Flag the samples whose centred `window` [s] is steady on every channel."""
     dt = float(np.median(np.diff(time))) if time.size > 1 else 1.0
-    w = max(3, int(round(tol.window / dt)) if dt > 0 else 3)
+    w = max(3, int(round(window / dt)) if dt > 0 else 3)
     steady = np.ones(time.size, dtype=bool)
     for x, rel, absolute in channels:
         mean, std = _rolling(x, w)
@@ -180,8 +163,8 @@ def steady_runs(table: BenchTable, time: FloatArray,
         Sample index ranges ``[start, stop)``, one per steady operating point.
 
     """
-    mask = steady_mask(table, time, tol)
     channels = _channels(table, tol)
+    mask = _steady_mask(channels, time, tol.window)
     edges = np.flatnonzero(np.diff(np.concatenate(([0], mask.astype(np.int8), [0]))))
     runs = []
     stack = []

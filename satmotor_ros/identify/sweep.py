@@ -74,12 +74,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     Parameters
     ----------
     argv : sequence of str, optional
-        Command-line arguments, [-]
+        Options such as ``--seeds 20``; the process's own when omitted, [-]
 
     Returns
     -------
     int
-        0.
+        0, once the table is printed.
 
     """
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
