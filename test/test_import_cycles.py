@@ -49,10 +49,10 @@ def import_graph(package: str) -> dict[str, set[str]]:
     """
     directory = ROOT.parent.joinpath(*package.split('.'))
     files = {_module_name(path): path for path in directory.rglob('*.py')}
-    graph = {}
+    graph: dict[str, set[str]] = {}
     for module, path in files.items():
         is_package = path.name == '__init__.py'
-        targets = set()
+        targets: set[str] = set()
         for node in ast.walk(ast.parse(path.read_text(encoding='utf-8'))):
             targets.update(t for t in _imported(node, module, is_package) if t in files)
         # Importing a.b.c runs a and a.b first; that parent edge is no cycle of the code.
@@ -78,7 +78,7 @@ def cycles(graph: dict[str, set[str]]) -> list[list[str]]:
     index: dict[str, int] = {}
     low: dict[str, int] = {}
     stack: list[str] = []
-    found = []
+    found: list[list[str]] = []
 
     def visit(v: str) -> None:
         index[v] = low[v] = len(index)
