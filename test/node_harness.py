@@ -20,11 +20,10 @@ from rclpy.parameter import Parameter
 from rclpy.parameter_client import AsyncParameterClient
 from rclpy.qos import qos_profile_sensor_data
 from rosgraph_msgs.msg import Clock
+from satmotor_ros.interface import (CHANNELS, JOINT_NAME, LOSS_COMPONENTS, LOSSES_ARRAY,
+                                    LOSSES_PREFIX, PREDICTED_JOINT_STATE, SPEED_RESIDUAL)
 from sensor_msgs.msg import FluidPressure, JointState, Temperature
-from std_msgs.msg import Float64
-
-COMPONENTS = ('flat_clearance', 'commutation', 'compressibility', 'deformation', 'backlash',
-              'inertia', 'external', 'total')
+from std_msgs.msg import Float64, Float64MultiArray
 
 
 def unique_namespace(tag):
@@ -48,26 +47,31 @@ def unique_namespace(tag):
 class Motor:
     """The harness's view of one motor: publishers of its inputs, inboxes of its outputs."""
 
-    def __init__(self, node, namespace, joint='motor_shaft'):
+    def __init__(self, node, namespace, joint=JOINT_NAME):
         """Create the publishers and subscriptions under `namespace`."""
         self.node, self.ns, self.joint = node, namespace, joint
         sensor = qos_profile_sensor_data
-        self.flow = node.create_publisher(Float64, f'{namespace}/flow_command', 10)
-        self.p_in = node.create_publisher(FluidPressure, f'{namespace}/inlet_pressure', sensor)
-        self.p_out = node.create_publisher(FluidPressure, f'{namespace}/outlet_pressure',
-                                           sensor)
-        self.p_case = node.create_publisher(FluidPressure, f'{namespace}/case_pressure', sensor)
-        self.temp = node.create_publisher(Temperature, f'{namespace}/fluid_temperature', sensor)
-        self.joints = node.create_publisher(JointState, f'{namespace}/joint_states', sensor)
+
+        def topic(name):
+            return f'{namespace}/{CHANNELS[name].topic}'
+        self.flow = node.create_publisher(Float64, topic('flow'), 10)
+        self.p_in = node.create_publisher(FluidPressure, topic('p_in'), sensor)
+        self.p_out = node.create_publisher(FluidPressure, topic('p_out'), sensor)
+        self.p_case = node.create_publisher(FluidPressure, topic('p_case'), sensor)
+        self.temp = node.create_publisher(Temperature, topic('temperature'), sensor)
+        self.joints = node.create_publisher(JointState, topic('measured_speed'), sensor)
         self.predicted, self.residual, self.diagnostics = [], [], []
-        self.losses = {c: [] for c in COMPONENTS}
-        node.create_subscription(JointState, f'{namespace}/predicted_joint_state',
+        self.losses = {c: [] for c in LOSS_COMPONENTS}
+        self.losses_array = []
+        node.create_subscription(JointState, f'{namespace}/{PREDICTED_JOINT_STATE}',
                                  self.predicted.append, 100)
-        node.create_subscription(Float64, f'{namespace}/speed_residual', self.residual.append,
+        node.create_subscription(Float64, f'{namespace}/{SPEED_RESIDUAL}', self.residual.append,
                                  100)
-        for c in COMPONENTS:
-            node.create_subscription(Float64, f'{namespace}/losses/{c}', self.losses[c].append,
-                                     100)
+        for c in LOSS_COMPONENTS:
+            node.create_subscription(Float64, f'{namespace}/{LOSSES_PREFIX}{c}',
+                                     self.losses[c].append, 100)
+        node.create_subscription(Float64MultiArray, f'{namespace}/{LOSSES_ARRAY}',
+                                 self.losses_array.append, 100)
 
     def inputs(self, p_in=None, p_out=None, p_case=None, temperature=None, speed=None):
         """Publish each input that is given, in SI units."""
@@ -86,6 +90,7 @@ class Motor:
         self.diagnostics.clear()
         for inbox in self.losses.values():
             inbox.clear()
+        self.losses_array.clear()
 
 
 class Harness:
@@ -109,7 +114,7 @@ class Harness:
                 if status.name.startswith(motor.ns + '/'):
                     motor.diagnostics.append(status)
 
-    def motor(self, namespace, joint='motor_shaft'):
+    def motor(self, namespace, joint=JOINT_NAME):
         """
         Attach a motor's topics.
 

@@ -4,6 +4,7 @@
 from node_harness import Harness, unique_namespace
 import pytest
 from rclpy.parameter import Parameter
+from satmotor_ros.interface import LOSS_COMPONENTS
 from satmotor_ros.model import MotorModel
 from satmotor_ros.model.units import LPM, MPA
 from satmotor_ros.nodes.motor_model import MotorModelNode, PARAMETERS
@@ -70,3 +71,62 @@ def test_every_parameter_states_its_unit_and_range():
             assert desc.floating_point_range, spec.name
         if spec.choices:
             assert all(c in desc.additional_constraints for c in spec.choices)
+
+
+@pytest.mark.parametrize(('fmt', 'every'), [('array', 1), ('both', 1), ('array', 3)])
+def test_losses_as_one_array_named_by_its_layout_and_thinned(harness, fmt, every):
+    """losses_format 'array': one Float64MultiArray on losses instead of eight topics."""
+    ns = unique_namespace('losses')
+    node = MotorModelNode(context=harness.context, namespace=ns, parameter_overrides=[
+        Parameter('losses_format', value=fmt), Parameter('losses_every', value=every)])
+    harness.executor.add_node(node)
+    try:
+        motor = harness.motor(ns)
+        harness.wait_connected(motor)
+        for _ in range(3):
+            motor.inputs(p_in=20 * MPA, p_out=0.5 * MPA)
+            harness.spin_for(0.03)
+        flows = [(5 + k) * LPM for k in range(6)]
+        for flow in flows:
+            motor.flow.publish(Float64(data=flow))
+            harness.spin_for(0.02)
+        assert harness.spin_until(lambda: len(motor.predicted) == len(flows), 5.0)
+        assert harness.spin_until(lambda: len(motor.losses_array) == len(flows) // every, 5.0)
+        harness.spin_for(0.2)
+        assert len(motor.losses_array) == len(flows) // every
+        (dim,) = motor.losses_array[0].layout.dim
+        assert dim.label.split(',') == list(LOSS_COMPONENTS) and dim.size == 8
+        model = MotorModel.default('oil')
+        for k, msg in enumerate(motor.losses_array):
+            point = model.speed_point(flows[(k + 1) * every - 1], 19.5 * MPA)
+            assert list(msg.data) == [getattr(point, c) for c in LOSS_COMPONENTS]
+        per_topic = len(motor.losses['total'])
+        assert per_topic == (len(flows) if fmt == 'both' else 0)
+    finally:
+        harness.executor.remove_node(node)
+        node.destroy_node()
+
+
+@pytest.mark.parametrize('module', ['motor_model', 'speed_controller', 'virtual_motor'])
+def test_every_node_takes_the_same_motor_and_liquid_parameters(harness, module):
+    """One declaration (nodes._parameters.MOTOR_PARAMETERS) and one MotorOptions.build_model."""
+    import importlib
+
+    from satmotor_ros.nodes._parameters import MOTOR_PARAMETERS
+    node_module = importlib.import_module(f'satmotor_ros.nodes.{module}')
+    cls = next(getattr(node_module, n) for n in dir(node_module)
+               if n.endswith('Node') and n != 'Node')
+    overrides = [Parameter('liquid', value='water'), Parameter('viscosity', value=2.0e-6),
+                 Parameter('displacement_law', value='eq39')]
+    node = cls(context=harness.context, namespace=unique_namespace(module),
+               parameter_overrides=overrides)
+    try:
+        for spec in MOTOR_PARAMETERS:
+            assert node.has_parameter(spec.name), spec.name
+        model = {'motor_model': lambda: node._model, 'speed_controller': lambda: node.law.model,
+                 'virtual_motor': lambda: node.plant.model}[module]()
+        assert model.coefficient_set.name == 'water' and model.displacement_law == 'eq39'
+        assert model.liquid.kinematic_viscosity == 2.0e-6
+        assert model.liquid.name == 'user liquid on the water set'
+    finally:
+        node.destroy_node()

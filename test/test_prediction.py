@@ -12,9 +12,8 @@ import pytest
 from satmotor_ros.model import CoefficientSet, MotorModel, PointStatus
 from satmotor_ros.model.effects import effect_from_mapping
 from satmotor_ros.model.units import ATMOSPHERE, LPM, MPA
-from satmotor_ros.prediction import (check_value, check_values, combine_batch, Combiner,
-                                     driving_times, INPUTS, Level, predict_batch,
-                                     predict_point, Progress, Rule)
+from satmotor_ros.prediction import (combine_batch, Combiner, driving_times, input_state,
+                                     INPUTS, Level, predict, Progress, Rule)
 
 OIL = MotorModel.default('oil')
 RULE = Rule(timeout=0.5)
@@ -36,7 +35,7 @@ def _good(**overrides):
 
 
 def test_prediction_equals_the_library_for_the_same_inputs():
-    pred = predict_point(OIL, _good().snapshot(10 * MS), RULE.timeout)
+    pred = predict(OIL, _good().snapshot(10 * MS), RULE.timeout)
     op = OIL.speed(20 * LPM, 19.8 * MPA)
     assert pred.level == Level.OK and pred.message == 'OK' and pred.valid
     assert pred.output('speed') == pytest.approx(float(op.speed), rel=1e-14)
@@ -57,7 +56,7 @@ def test_prediction_equals_the_library_for_the_same_inputs():
     ('p_case', math.nan, 'case_pressure.fluid_pressure = nan Pa: not finite'),
 ])
 def test_bad_input_gives_no_prediction_and_names_field_and_value(name, value, text):
-    pred = predict_point(OIL, _good(**{name: (value, 5 * MS)}).snapshot(10 * MS), RULE.timeout)
+    pred = predict(OIL, _good(**{name: (value, 5 * MS)}).snapshot(10 * MS), RULE.timeout)
     assert pred.level == Level.ERROR and not pred.valid
     assert text in pred.message
     assert all(math.isnan(v) for v in pred.outputs)
@@ -65,43 +64,43 @@ def test_bad_input_gives_no_prediction_and_names_field_and_value(name, value, te
 
 def test_missing_and_stale_inputs_give_no_prediction():
     combiner = _combiner(flow=(20 * LPM, 0), p_in=(20 * MPA, 0))
-    pred = predict_point(OIL, combiner.snapshot(0), RULE.timeout)
+    pred = predict(OIL, combiner.snapshot(0), RULE.timeout)
     assert pred.level == Level.ERROR and 'outlet_pressure: no message received' in pred.message
     combiner.update('p_out', 1 * MPA, 0)
     combiner.update('flow', 20 * LPM, 600 * MS)
-    pred = predict_point(OIL, combiner.snapshot(600 * MS), RULE.timeout)
+    pred = predict(OIL, combiner.snapshot(600 * MS), RULE.timeout)
     assert pred.level == Level.ERROR
     assert pred.message == ('inlet_pressure: last message 0.6 s old (input_timeout 0.5 s); '
                             'outlet_pressure: last message 0.6 s old (input_timeout 0.5 s)')
     combiner.update('p_in', 20 * MPA, 601 * MS)
     combiner.update('p_out', 1 * MPA, 601 * MS)
-    assert predict_point(OIL, combiner.snapshot(601 * MS), RULE.timeout).level == Level.OK
+    assert predict(OIL, combiner.snapshot(601 * MS), RULE.timeout).level == Level.OK
 
 
 def test_input_exactly_at_the_timeout_is_still_used():
-    pred = predict_point(OIL, _good(flow=(20 * LPM, 500 * MS)).snapshot(500 * MS), RULE.timeout)
+    pred = predict(OIL, _good(flow=(20 * LPM, 500 * MS)).snapshot(500 * MS), RULE.timeout)
     assert pred.level == Level.OK  # the pressures are exactly 0.5 s old
-    pred = predict_point(OIL, _good(flow=(20 * LPM, 500 * MS)).snapshot(500 * MS + 1),
-                         RULE.timeout)
+    pred = predict(OIL, _good(flow=(20 * LPM, 500 * MS)).snapshot(500 * MS + 1),
+                   RULE.timeout)
     assert pred.level == Level.ERROR and 'inlet_pressure: last message' in pred.message
 
 
 def test_zero_flow_is_a_stalled_motor_published_with_a_warning():
-    pred = predict_point(OIL, _good(flow=(0.0, 10 * MS)).snapshot(10 * MS), RULE.timeout)
+    pred = predict(OIL, _good(flow=(0.0, 10 * MS)).snapshot(10 * MS), RULE.timeout)
     assert pred.level == Level.WARN and pred.valid
     assert pred.output('speed') == 0.0 and pred.status & PointStatus.STALLED
     assert 'STALLED' in pred.message and 'flow_command.data = 0.0' in pred.message
 
 
 def test_pressure_beyond_the_model_limit_is_an_error_with_the_model_status():
-    pred = predict_point(OIL, _good(p_in=(60 * MPA, 0)).snapshot(10 * MS), RULE.timeout)
+    pred = predict(OIL, _good(p_in=(60 * MPA, 0)).snapshot(10 * MS), RULE.timeout)
     assert pred.level == Level.ERROR and pred.status & PointStatus.BEYOND_LIMIT
     assert 'BEYOND_LIMIT' in pred.message and 'dp = 59800000.0 Pa' in pred.message
     assert math.isnan(pred.output('speed'))
 
 
 def test_extrapolated_point_is_published_with_a_warning():
-    pred = predict_point(OIL, _good(p_in=(40 * MPA, 0)).snapshot(10 * MS), RULE.timeout)
+    pred = predict(OIL, _good(p_in=(40 * MPA, 0)).snapshot(10 * MS), RULE.timeout)
     assert pred.level == Level.WARN and pred.status & PointStatus.EXTRAPOLATED
     assert pred.output('speed') > 0.0
 
@@ -112,30 +111,30 @@ def test_case_pressure_drives_external_leakage_and_blocks_when_stale():
         spec_set.name, spec_set.liquid,
         dataclasses.replace(spec_set.coefficients, external_leakage=1e-12)), OIL.valid_range)
     case = 0.5 * MPA + ATMOSPHERE  # FluidPressure is absolute; eq. (24) takes gauge
-    pred = predict_point(leaky, _good(p_case=(case, 5 * MS)).snapshot(10 * MS),
-                         RULE.timeout)
+    pred = predict(leaky, _good(p_case=(case, 5 * MS)).snapshot(10 * MS),
+                   RULE.timeout)
     assert pred.output('p_ex') == 0.5 * MPA
     assert pred.output('external') == pytest.approx(1e-12 * 0.5 * MPA, rel=1e-12)
     ref = leaky.speed(20 * LPM, 19.8 * MPA, p_ex=0.5 * MPA)
     assert pred.output('speed') == pytest.approx(float(ref.speed), rel=1e-14)
-    without = predict_point(leaky, _good().snapshot(10 * MS), RULE.timeout)
+    without = predict(leaky, _good().snapshot(10 * MS), RULE.timeout)
     assert without.output('p_ex') == 0.0 and without.output('speed') > pred.output('speed')
-    stale = predict_point(leaky, _good(p_case=(case, 0)).snapshot(900 * MS),
-                          RULE.timeout)
+    stale = predict(leaky, _good(p_case=(case, 0)).snapshot(900 * MS),
+                    RULE.timeout)
     assert stale.level == Level.ERROR and 'case_pressure: last message' in stale.message
 
 
 def test_measured_speed_gives_the_residual_and_its_absence_only_a_warning():
-    pred = predict_point(OIL, _good(measured_speed=(50.0, 8 * MS)).snapshot(10 * MS),
-                         RULE.timeout)
+    pred = predict(OIL, _good(measured_speed=(50.0, 8 * MS)).snapshot(10 * MS),
+                   RULE.timeout)
     assert pred.output('residual') == 50.0 - pred.output('speed')
-    stale = predict_point(OIL, _good(measured_speed=(50.0, 0), flow=(20 * LPM, 700 * MS),
-                                     p_in=(20 * MPA, 700 * MS), p_out=(0.2 * MPA, 700 * MS))
-                          .snapshot(700 * MS), RULE.timeout)
+    stale = predict(OIL, _good(measured_speed=(50.0, 0), flow=(20 * LPM, 700 * MS),
+                               p_in=(20 * MPA, 700 * MS), p_out=(0.2 * MPA, 700 * MS))
+                    .snapshot(700 * MS), RULE.timeout)
     assert stale.level == Level.WARN and stale.valid and math.isnan(stale.output('residual'))
     assert 'joint_states: last message 0.7 s old' in stale.message
-    odd_temp = predict_point(OIL, _good(temperature=(math.nan, 1)).snapshot(10 * MS),
-                             RULE.timeout)
+    odd_temp = predict(OIL, _good(temperature=(math.nan, 1)).snapshot(10 * MS),
+                       RULE.timeout)
     assert odd_temp.level == Level.WARN and 'fluid_temperature.temperature = nan' \
         in odd_temp.message
 
@@ -157,10 +156,14 @@ def test_driving_times_follow_the_mode():
     assert ticks.tolist() == [0, 10 * MS, 20 * MS, 30 * MS, 40 * MS]
 
 
-@settings(max_examples=200, deadline=None)
-@given(st.floats(allow_nan=True, allow_infinity=True), st.sampled_from(INPUTS))
-def test_scalar_and_array_value_checks_agree(value, name):
-    assert check_values(name, np.array([value]))[0] == check_value(name, value)
+@settings(max_examples=300, deadline=None)
+@given(st.floats(allow_nan=True, allow_infinity=True), st.sampled_from(INPUTS),
+       st.sampled_from([math.nan, 0.0, 5e8, 5e8 + 1.0]))
+def test_input_state_is_the_same_on_a_float_and_on_an_array(value, name, age_ns):
+    one = input_state(name, value, age_ns, RULE.timeout_ns)
+    many = input_state(name, np.array([value, value]), np.array([age_ns, age_ns]),
+                       RULE.timeout_ns)
+    assert many.tolist() == [one, one]
 
 
 def _random_events(rng, n):
@@ -209,16 +212,16 @@ def test_effects_read_their_channels_and_block_without_them():
     assert CALIBRATED.channels == ('p_case', 'revolutions', 'temperature', 'time')
     case = 0.5 * MPA + ATMOSPHERE
     snap = _good(p_case=(case, 5 * MS), temperature=(55.0, 5 * MS)).snapshot(10 * MS)
-    pred = predict_point(CALIBRATED, snap, RULE.timeout, (0.01, 0.0))
+    pred = predict(CALIBRATED, snap, RULE.timeout, (0.01, 0.0))
     ref = CALIBRATED.speed_point(20 * LPM, 19.8 * MPA,
                                  channels={'p_case': 0.5 * MPA, 'temperature': 55.0,
                                            'time': 0.01, 'revolutions': 0.0})
     assert pred.level < Level.ERROR and pred.output('speed') == ref.speed
     assert pred.output('external') == pytest.approx(1e-12 * 0.5 * MPA, rel=1e-12)
-    later = predict_point(CALIBRATED, snap, RULE.timeout, (100.0, 0.0))  # worn: less speed
+    later = predict(CALIBRATED, snap, RULE.timeout, (100.0, 0.0))  # worn: less speed
     assert later.output('speed') < pred.output('speed')
-    missing = predict_point(CALIBRATED, _good(p_case=(case, 5 * MS)).snapshot(10 * MS),
-                            RULE.timeout)
+    missing = predict(CALIBRATED, _good(p_case=(case, 5 * MS)).snapshot(10 * MS),
+                      RULE.timeout)
     assert missing.level == Level.ERROR and not missing.valid
     assert 'needs fluid_temperature.temperature: missing' in missing.message
 
@@ -228,7 +231,7 @@ def test_speed_sensor_gain_corrects_the_measured_speed_in_the_residual():
     model = MotorModel(OIL.geometry, dataclasses.replace(OIL.coefficient_set, effects=effects),
                        OIL.valid_range)
     snap = _good(measured_speed=(55.0, 8 * MS)).snapshot(10 * MS)
-    pred = predict_point(model, snap, RULE.timeout)
+    pred = predict(model, snap, RULE.timeout)
     assert pred.output('residual') == pytest.approx(55.0 / 1.1 - pred.output('speed'))
 
 
@@ -243,15 +246,16 @@ def test_live_rule_and_batch_rule_give_identical_predictions(seed, model):
         combiner.update(name, value, t)
         if name == 'flow':
             snaps.append(combiner.snapshot(t))
-            live.append(predict_point(model, snaps[-1], RULE.timeout,
-                                      progress.advance(snaps[-1])))
+            live.append(predict(model, snaps[-1], RULE.timeout,
+                                progress.advance(snaps[-1])))
     series = {}
     for name in INPUTS:
         mine = [(t, v) for n, v, t in events if n == name]
         series[name] = (np.array([t for t, _ in mine], dtype=np.int64),
                         np.array([v for _, v in mine]))
     stamps = driving_times(RULE, series['flow'][0], events[0][2], events[-1][2])
-    batch = predict_batch(model, combine_batch(RULE, stamps, series), RULE.timeout)
+    recorded = combine_batch(RULE, stamps, series)
+    batch = predict(model, recorded, RULE.timeout, Progress().advance(recorded))
     assert len(batch) == len(live) > 50
     assert {p.level for p in live} == {0, 1, 2}
     for i, pred in enumerate(live):
@@ -285,12 +289,12 @@ def test_p_ex_output_is_the_pressure_the_leakage_effect_read():
     model = MotorModel(OIL.geometry, dataclasses.replace(
         OIL.coefficient_set, coefficients=coef, effects=effects), OIL.valid_range)
     snap = _good(p_case=(0.5 * MPA + ATMOSPHERE, 5 * MS)).snapshot(10 * MS)
-    pred = predict_point(model, snap, RULE.timeout)
+    pred = predict(model, snap, RULE.timeout)
     assert pred.output('p_ex') == 0.2 * MPA - ATMOSPHERE  # gauge p_out, not p_case
     assert pred.output('external') == pytest.approx(1e-12 * (0.2 * MPA - ATMOSPHERE))
     t = np.array([5 * MS, 10 * MS], dtype=np.int64)
     series = {'flow': (t[1:], np.array([20 * LPM])), 'p_in': (t[:1], np.array([20 * MPA])),
               'p_out': (t[:1], np.array([0.2 * MPA])),
               'p_case': (t[:1], np.array([0.5 * MPA + ATMOSPHERE]))}
-    batch = predict_batch(model, combine_batch(RULE, t[1:], series), RULE.timeout)
+    batch = predict(model, combine_batch(RULE, t[1:], series), RULE.timeout)
     assert batch.output('p_ex')[0] == pred.output('p_ex')

@@ -9,13 +9,12 @@ import pytest
 from rclpy.qos import qos_profile_sensor_data
 from satmotor_ros.bags import FLOAT64, FLUID_PRESSURE, JOINT_STATE, OutTopic, write_bag
 from satmotor_ros.cli.main import main
+from satmotor_ros.interface import LOSS_COMPONENTS as COMPONENTS
 from satmotor_ros.model.units import LPM, MPA
 from satmotor_ros.nodes.motor_model import MotorModelNode
 from sensor_msgs.msg import FluidPressure, JointState
 from std_msgs.msg import Float64
 
-COMPONENTS = ('flat_clearance', 'commutation', 'compressibility', 'deformation', 'backlash',
-              'inertia', 'external', 'total')
 
 
 class Recorder:

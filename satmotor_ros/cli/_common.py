@@ -1,14 +1,15 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Options shared by the subcommands: which motor, which liquid, which Delta q law."""
+"""What the subcommands share: registration, the motor options, quantities, errors."""
 
 from __future__ import annotations
 
 import argparse
-import dataclasses
+from collections.abc import Callable
 import math
 import sys
+from typing import Any
 
-from satmotor_ros.model import Liquid, load_motor, ModelError, MotorModel
+from satmotor_ros.interface import DISPLACEMENT_LAWS, MotorOptions, OptionError
 from satmotor_ros.model.units import parse_quantity, UnitError
 
 
@@ -16,30 +17,109 @@ class CliError(Exception):
     """A user-facing error: printed as one line, exit code 1."""
 
 
-def add_model_options(parser: argparse.ArgumentParser) -> None:
+MOTOR_FLAGS = {'liquid': '--liquid', 'motor_file': '--motor', 'displacement_law': '--law',
+               'viscosity': '--viscosity', 'density': '--density',
+               'bulk_modulus': '--bulk-modulus'}
+"""Each :class:`MotorOptions` field and its ``satmotor`` option."""
+
+_USER_LIQUID = {'viscosity': ('viscosity', 'cSt'), 'density': ('density', 'kg/m^3'),
+                'bulk_modulus': ('pressure', 'MPa')}  # option -> (kind, default unit)
+_PREFIX = 'motor_options.'  # the argparse dest of a motor option: prefix + field
+
+
+def subcommand(sub: argparse._SubParsersAction, name: str, command: Callable[..., int],
+               help_text: str, description: str) -> argparse.ArgumentParser:
     """
-    Add ``--liquid``, ``--motor``, ``--law`` and the liquid-property overrides.
+    Add a subcommand whose parsed options are passed to `command` as keywords.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The ``satmotor`` subparsers, [-]
+    name : str
+        The subcommand, [-]
+    command : callable
+        Runs it and returns the exit code, [-]
+    help_text, description : str
+        Short and long help, [-]
+
+    Returns
+    -------
+    argparse.ArgumentParser
+        The subcommand's parser, for its own options.
+
+    """
+    parser = sub.add_parser(name, help=help_text, description=description)
+    parser.set_defaults(command=command)
+    return parser
+
+
+def add_motor_options(parser: argparse.ArgumentParser, *, liquid_required: bool = False,
+                      model_options: bool = True) -> None:
+    """
+    Add the motor options; the command receives them as one ``options`` :class:`MotorOptions`.
 
     Parameters
     ----------
     parser : argparse.ArgumentParser
         The subcommand's parser, [-]
+    liquid_required : bool
+        ``--liquid`` has no default, [-]
+    model_options : bool
+        Also ``--law`` and the user-liquid properties (not for a calibration, which fits
+        the set's own liquid), [-]
 
     """
     group = parser.add_argument_group('motor and liquid')
-    group.add_argument('--liquid', default='oil',
+    group.add_argument('--liquid', dest=_PREFIX + 'liquid', required=liquid_required,
+                       default=None if liquid_required else MotorOptions.liquid,
                        help="coefficient set and its liquid: 'oil' or 'water' for the packaged "
-                            'SM-0,75/25, or any set in --motor (default: oil)')
-    group.add_argument('--motor', default=None, metavar='YAML',
-                       help='motor specification file (default: the packaged SM-0,75/25)')
-    group.add_argument('--law', choices=('eq33', 'eq39'), default='eq33',
+                            'SM-0,75/25, or any set in --motor'
+                            + ('' if liquid_required else ' (default: oil)'))
+    group.add_argument('--motor', dest=_PREFIX + 'motor_file', default='', metavar='YAML',
+                       help='motor specification or calibrated coefficients file (default: '
+                            'the packaged SM-0,75/25)')
+    if not model_options:
+        return
+    group.add_argument('--law', dest=_PREFIX + 'displacement_law', choices=DISPLACEMENT_LAWS,
+                       default=MotorOptions.displacement_law,
                        help='change of displacement: physical eq. (33) or empirical eq. (39)')
-    group.add_argument('--viscosity', default=None, metavar='NU',
+    group.add_argument('--viscosity', dest=_PREFIX + 'viscosity', default=None, metavar='NU',
                        help='run a user liquid on the set: kinematic viscosity (default cSt)')
-    group.add_argument('--density', default=None, metavar='RHO',
+    group.add_argument('--density', dest=_PREFIX + 'density', default=None, metavar='RHO',
                        help='user liquid density (default kg/m^3)')
-    group.add_argument('--bulk-modulus', default=None, metavar='K',
-                       help='user liquid bulk modulus (default MPa)')
+    group.add_argument('--bulk-modulus', dest=_PREFIX + 'bulk_modulus', default=None,
+                       metavar='K', help='user liquid bulk modulus (default MPa)')
+
+
+def take_motor_options(args: dict[str, Any]) -> dict[str, Any]:
+    """
+    Replace the parsed motor options by one ``options`` :class:`MotorOptions` (SI).
+
+    Parameters
+    ----------
+    args : dict
+        Parsed arguments; left as they are when the subcommand has no motor options, [-]
+
+    Returns
+    -------
+    dict
+        The arguments for the command.
+
+    Raises
+    ------
+    CliError
+        If a user-liquid property cannot be parsed or is not > 0, naming the option.
+
+    """
+    typed = {k[len(_PREFIX):]: args.pop(k) for k in list(args) if k.startswith(_PREFIX)}
+    if not typed:
+        return args
+    for name, (kind, unit) in _USER_LIQUID.items():
+        text = typed.pop(name, None)
+        if text is not None:
+            typed[name] = quantity(MOTOR_FLAGS[name], text, kind, unit, positive=True)
+    return {**args, 'options': MotorOptions(**typed)}
 
 
 def quantity(flag: str, text: str, kind: str, default_unit: str, *,
@@ -81,58 +161,6 @@ def quantity(flag: str, text: str, kind: str, default_unit: str, *,
     return value
 
 
-def build_model(liquid: str, motor: str | None, law: str, viscosity: str | None,
-                density: str | None, bulk_modulus: str | None) -> MotorModel:
-    """
-    Build the model the options describe.
-
-    Parameters
-    ----------
-    liquid : str
-        Name of the coefficient set, [-]
-    motor : str or None
-        Motor YAML path, [-]
-    law : str
-        ``'eq33'`` or ``'eq39'``, [-]
-    viscosity, density, bulk_modulus : str or None
-        Overrides of the set's liquid, as typed, [-]
-
-    Returns
-    -------
-    MotorModel
-        The model.
-
-    Raises
-    ------
-    CliError
-        If the motor file, the set or a liquid property is invalid.
-
-    """
-    try:
-        spec = load_motor(motor)
-        if liquid not in spec.sets:
-            raise CliError(f'--liquid {liquid!r}: not a coefficient set of {spec.name} '
-                           f'(has: {", ".join(spec.sets)})')
-        base = spec.sets[liquid].liquid
-        overrides = {}
-        if viscosity is not None:
-            overrides['kinematic_viscosity'] = quantity('--viscosity', viscosity, 'viscosity',
-                                                        'cSt', positive=True)
-        if density is not None:
-            overrides['density'] = quantity('--density', density, 'density', 'kg/m^3',
-                                            positive=True)
-        if bulk_modulus is not None:
-            overrides['bulk_modulus'] = quantity('--bulk-modulus', bulk_modulus, 'pressure',
-                                                 'MPa', positive=True)
-        user: Liquid | None = None
-        if overrides:
-            user = dataclasses.replace(base, name=f'user liquid on the {liquid} set',
-                                       **overrides)
-        return MotorModel.from_spec(spec, liquid, user, law)
-    except ModelError as err:
-        raise CliError(str(err)) from None
-
-
 def fail(err: Exception) -> int:
     """
     Print one error line to stderr.
@@ -140,7 +168,7 @@ def fail(err: Exception) -> int:
     Parameters
     ----------
     err : Exception
-        The error to report, [-]
+        The error to report; an :class:`OptionError` names the ``satmotor`` option, [-]
 
     Returns
     -------
@@ -148,5 +176,7 @@ def fail(err: Exception) -> int:
         The exit code 1.
 
     """
+    if isinstance(err, OptionError):
+        err = CliError(f'{MOTOR_FLAGS[err.option]} {err.value!r}: {err.reason}')
     print(f'satmotor: error: {err}', file=sys.stderr)
     return 1

@@ -6,37 +6,25 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from satmotor_ros.cli._common import fail
+from satmotor_ros.cli._common import add_motor_options, fail, subcommand
 from satmotor_ros.identify import BenchTable, calibrate, DataError, IdentificationError, Options
 from satmotor_ros.identify import read_csv
 from satmotor_ros.identify.output import write_json, write_yaml
 from satmotor_ros.identify.report import write_report
-from satmotor_ros.model import load_motor, ModelError
+from satmotor_ros.interface import MotorOptions
+from satmotor_ros.model import ModelError
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
-    """
-    Register the subcommand.
-
-    Parameters
-    ----------
-    sub : argparse._SubParsersAction
-        The ``satmotor`` subparsers, [-]
-
-    """
-    parser = sub.add_parser(
-        'calibrate', help='fit the model to bench data and find the effect it lacks',
-        description='Fit the loss model to a bench table (CSV with "name [unit]" headers: '
-                    'speed, flow, p_in, p_out, and any other channels) or a rosbag2 '
-                    'recording, test candidate effects by cross-validation, and write '
-                    'calibration.json, coefficients.yaml and report.md into --out.')
+    """Register ``satmotor calibrate`` and its options."""
+    parser = subcommand(
+        sub, 'calibrate', command, 'fit the model to bench data and find the effect it lacks',
+        'Fit the loss model to a bench table (CSV with "name [unit]" headers: speed, flow, '
+        'p_in, p_out, and any other channels) or a rosbag2 recording, test candidate effects '
+        'by cross-validation, and write calibration.json, coefficients.yaml and report.md '
+        'into --out.')
     parser.add_argument('data', metavar='DATA', help='bench CSV or rosbag2 directory')
-    parser.add_argument('--liquid', required=True,
-                        help="coefficient set to calibrate: 'oil' or 'water' (or a set of "
-                             '--motor)')
     parser.add_argument('--out', required=True, metavar='DIR', help='output directory')
-    parser.add_argument('--motor', default=None, metavar='YAML',
-                        help='motor specification (default: the packaged SM-0,75/25)')
     parser.add_argument('--mode', choices=('auto', 'points', 'series'), default='auto',
                         help='rows are steady points, a time series, or decide from the data '
                              '(default: auto)')
@@ -44,7 +32,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                         help='family-wise significance level of the effect test (default 0.05)')
     parser.add_argument('--folds', type=int, default=5,
                         help='cross-validation folds (default 5)')
-    parser.set_defaults(command=command)
+    add_motor_options(parser, liquid_required=True, model_options=False)
 
 
 def load_data(data: str) -> BenchTable:
@@ -77,8 +65,8 @@ def load_data(data: str) -> BenchTable:
     return read_csv(path)
 
 
-def command(data: str, liquid: str, out: str, motor: str | None, mode: str, alpha: float,
-            folds: int) -> int:
+def command(data: str, out: str, mode: str, alpha: float, folds: int,
+            options: MotorOptions) -> int:
     """
     Calibrate and write the three outputs.
 
@@ -86,18 +74,16 @@ def command(data: str, liquid: str, out: str, motor: str | None, mode: str, alph
     ----------
     data : str
         Bench CSV or rosbag2 directory, [-]
-    liquid : str
-        Coefficient set, [-]
     out : str
         Output directory, [-]
-    motor : str or None
-        Motor YAML, [-]
     mode : str
         ``'auto'``, ``'points'`` or ``'series'``, [-]
     alpha : float
         Significance level, [-]
     folds : int
         Cross-validation folds, [-]
+    options : MotorOptions
+        The motor and the coefficient set to calibrate (its own liquid), [-]
 
     Returns
     -------
@@ -107,13 +93,10 @@ def command(data: str, liquid: str, out: str, motor: str | None, mode: str, alph
 
     """
     try:
-        spec = load_motor(motor)
-        if liquid not in spec.sets:
-            msg = f'--liquid {liquid!r}: not a coefficient set of {spec.name} (has: ' \
-                  f'{", ".join(spec.sets)})'
-            raise IdentificationError(msg)
+        spec = options.spec()
         table = load_data(data)
-        cal = calibrate(table, liquid, spec, Options(alpha=alpha, n_folds=folds, mode=mode))
+        cal = calibrate(table, options.liquid, spec,
+                        Options(alpha=alpha, n_folds=folds, mode=mode))
         target = Path(out)
         target.mkdir(parents=True, exist_ok=True)
         summary = write_json(cal, target / 'calibration.json')

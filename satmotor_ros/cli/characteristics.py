@@ -10,7 +10,8 @@ from pathlib import Path
 
 import numpy as np
 
-from satmotor_ros.cli._common import add_model_options, build_model, CliError, fail
+from satmotor_ros.cli._common import add_motor_options, CliError, fail, subcommand
+from satmotor_ros.interface import MotorOptions
 from satmotor_ros.model import load_motor, ModelError, MotorModel
 from satmotor_ros.model.losses import displacement_change, displacement_change_empirical
 from satmotor_ros.model.units import LPM, MPA, RPM
@@ -36,28 +37,18 @@ class Figure:
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
-    """
-    Register the subcommand.
-
-    Parameters
-    ----------
-    sub : argparse._SubParsersAction
-        The ``satmotor`` subparsers, [-]
-
-    """
-    parser = sub.add_parser(
-        'characteristics', help='write characteristic plots (PNG) and their data (CSV)',
-        description="Characteristics of the paper's Figs. 8-16 kind over the chamber pressure "
-                    'drop: losses at constant flow and at constant speed, change of '
-                    'displacement, speed loss, and water against oil.')
+    """Register ``satmotor characteristics`` and its options."""
+    parser = subcommand(
+        sub, 'characteristics', command, 'write characteristic plots (PNG) and their data (CSV)',
+        "Characteristics of the paper's Figs. 8-16 kind over the chamber pressure drop: losses "
+        'at constant flow and at constant speed, change of displacement, speed loss, and '
+        'water against oil.')
     parser.add_argument('--out', required=True, metavar='DIR', help='output directory')
     parser.add_argument('--points', type=int, default=60, help='points per curve (default 60)')
-    add_model_options(parser)
-    parser.set_defaults(command=command)
+    add_motor_options(parser)
 
 
-def command(out: str, points: int, liquid: str, motor: str | None, law: str,
-            viscosity: str | None, density: str | None, bulk_modulus: str | None) -> int:
+def command(out: str, points: int, options: MotorOptions) -> int:
     """
     Write the characteristics of one liquid, plus water against oil.
 
@@ -67,8 +58,8 @@ def command(out: str, points: int, liquid: str, motor: str | None, law: str,
         Output directory (created), [-]
     points : int
         Points per curve, [-]
-    liquid, motor, law, viscosity, density, bulk_modulus : str or None
-        Model options, see :func:`satmotor_ros.cli._common.build_model`, [-]
+    options : MotorOptions
+        Motor, liquid and Delta q law, [-]
 
     Returns
     -------
@@ -79,12 +70,13 @@ def command(out: str, points: int, liquid: str, motor: str | None, law: str,
     try:
         if points < 2:
             raise CliError(f'--points {points}: need at least 2')
-        model = build_model(liquid, motor, law, viscosity, density, bulk_modulus)
+        model = options.build_model()
         dp_i = np.linspace(0.5 * MPA, model.valid_range.dp_max, points)
         figures = [*constant_flow(model, dp_i), constant_speed(model, dp_i),
                    displacement(model, dp_i)]
-        others = {name: build_model(name, motor, law, None, None, None)
-                  for name in ('oil', 'water')} if _has_both(motor) else None
+        others = {name: MotorOptions(name, options.motor_file,
+                                     options.displacement_law).build_model()
+                  for name in ('oil', 'water')} if _has_both(options) else None
         if others is not None:
             figures.append(water_against_oil(others['water'], others['oil'], dp_i))
         directory = Path(out)
@@ -101,8 +93,8 @@ def command(out: str, points: int, liquid: str, motor: str | None, law: str,
     return 0
 
 
-def _has_both(motor: str | None) -> bool:
-    return {'oil', 'water'} <= set(load_motor(motor).sets)
+def _has_both(options: MotorOptions) -> bool:
+    return {'oil', 'water'} <= set(load_motor(options.motor_file or None).sets)
 
 
 def constant_flow(model: MotorModel, dp_i: np.ndarray) -> tuple[Figure, Figure]:

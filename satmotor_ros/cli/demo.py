@@ -19,7 +19,7 @@ import sys
 import time
 from typing import Any
 
-from satmotor_ros.cli._common import CliError, fail
+from satmotor_ros.cli._common import CliError, fail, subcommand
 from satmotor_ros.plant.params import EffectParams
 from satmotor_ros.plant.scenario import default_cycle
 
@@ -28,21 +28,13 @@ FEEDFORWARDS = ('model', 'none')
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
-    """
-    Register the subcommand.
-
-    Parameters
-    ----------
-    sub : argparse._SubParsersAction
-        The ``satmotor`` subparsers, [-]
-
-    """
-    parser = sub.add_parser(
-        'demo', help='run virtual motor, model and controller over ROS; bag + report',
-        description='Runs the virtual motor, the motor_model node and the speed controller '
-                    'together over real ROS topics through a cycle of speed and load steps, '
-                    'with and without feed-forward, faster than real time; records every '
-                    'topic to an MCAP bag per run and writes report.md with plots.')
+    """Register ``satmotor demo`` and its options."""
+    parser = subcommand(
+        sub, 'demo', command, 'run virtual motor, model and controller over ROS; bag + report',
+        'Runs the virtual motor, the motor_model node and the speed controller together over '
+        'real ROS topics through a cycle of speed and load steps, with and without '
+        'feed-forward, faster than real time; records every topic to an MCAP bag per run and '
+        'writes report.md with plots.')
     parser.add_argument('--liquid', choices=(*LIQUIDS, 'both'), default='both',
                         help='liquid(s) to run (default: both)')
     parser.add_argument('--duration', default='24',
@@ -55,7 +47,6 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     parser.add_argument('--out', default='out/demo', metavar='DIR',
                         help='output directory (default out/demo)')
     parser.add_argument('--quiet', action='store_true', help='no progress bar')
-    parser.set_defaults(command=command)
 
 
 def parse_effects(items: list[str]) -> dict[str, Any]:

@@ -9,6 +9,7 @@ import sys
 
 from satmotor_ros import __version__
 from satmotor_ros.cli import calibrate, characteristics, demo, operating_point, replay
+from satmotor_ros.cli._common import CliError, fail, take_motor_options
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -50,6 +51,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = vars(build_parser().parse_args(argv))
     args.pop('subcommand')
     command = args.pop('command')
+    try:
+        args = take_motor_options(args)
+    except CliError as err:
+        return fail(err)
     return command(**args)
 
 

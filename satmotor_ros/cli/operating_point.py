@@ -6,7 +6,8 @@ from __future__ import annotations
 import argparse
 import json
 
-from satmotor_ros.cli._common import add_model_options, build_model, CliError, fail, quantity
+from satmotor_ros.cli._common import add_motor_options, CliError, fail, quantity, subcommand
+from satmotor_ros.interface import MotorOptions
 from satmotor_ros.model import (COMPONENTS, describe_status, ModelError, MotorModel,
                                 OperatingPoints, PointStatus)
 from satmotor_ros.model.units import LPM, MPA, RPM
@@ -24,20 +25,12 @@ _LABELS = {
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
-    """
-    Register the subcommand.
-
-    Parameters
-    ----------
-    sub : argparse._SubParsersAction
-        The ``satmotor`` subparsers, [-]
-
-    """
-    parser = sub.add_parser(
-        'operating-point', help='speed and losses at one flow and pressure drop',
-        description='Effective speed (eq. 40), speed loss (eq. 41) and the volumetric-loss '
-                    'breakdown (eq. 31) at one operating point. Quantities take an optional '
-                    'unit: --flow 8.3e-5m^3/s, --dp 250bar.')
+    """Register ``satmotor operating-point`` and its options."""
+    parser = subcommand(
+        sub, 'operating-point', command, 'speed and losses at one flow and pressure drop',
+        'Effective speed (eq. 40), speed loss (eq. 41) and the volumetric-loss breakdown '
+        '(eq. 31) at one operating point. Quantities take an optional unit: '
+        '--flow 8.3e-5m^3/s, --dp 250bar.')
     parser.add_argument('--flow', required=True, help='flow into the motor (default l/min)')
     drop = parser.add_mutually_exclusive_group(required=True)
     drop.add_argument('--dp', help='pressure drop between the ports (default MPa); the '
@@ -48,13 +41,11 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                                                     'eq. (24) (default MPa; default 0)')
     parser.add_argument('--json', action='store_true', dest='as_json',
                         help='print one JSON object')
-    add_model_options(parser)
-    parser.set_defaults(command=command)
+    add_motor_options(parser)
 
 
-def command(flow: str, dp: str | None, dp_i: str | None, p_ex: str, as_json: bool, liquid: str,
-            motor: str | None, law: str, viscosity: str | None, density: str | None,
-            bulk_modulus: str | None) -> int:
+def command(flow: str, dp: str | None, dp_i: str | None, p_ex: str, as_json: bool,
+            options: MotorOptions) -> int:
     """
     Print the operating point.
 
@@ -68,8 +59,8 @@ def command(flow: str, dp: str | None, dp_i: str | None, p_ex: str, as_json: boo
         Pressure driving the external leakage as typed, [MPa by default]
     as_json : bool
         Print JSON instead of a table, [-]
-    liquid, motor, law, viscosity, density, bulk_modulus : str or None
-        Model options, see :func:`satmotor_ros.cli._common.build_model`, [-]
+    options : MotorOptions
+        Motor, liquid and Delta q law, [-]
 
     Returns
     -------
@@ -78,7 +69,7 @@ def command(flow: str, dp: str | None, dp_i: str | None, p_ex: str, as_json: boo
 
     """
     try:
-        model = build_model(liquid, motor, law, viscosity, density, bulk_modulus)
+        model = options.build_model()
         q = quantity('--flow', flow, 'flow', 'l/min')
         pex = quantity('--p-ex', p_ex, 'pressure', 'MPa')
         if dp is not None:

@@ -20,18 +20,15 @@ from satmotor_ros.bags import (BagError, describe_topics, encode_many, FLOAT64, 
                                list_topics, missing_topics, OutTopic, parse_topic_map,
                                read_series, Series, write_bag)
 from satmotor_ros.cli import _fastcsv as fastcsv
-from satmotor_ros.cli._common import add_model_options, build_model, CliError, fail
-from satmotor_ros.model import COMPONENTS, describe_status, ModelError
+from satmotor_ros.cli._common import add_motor_options, CliError, fail, subcommand
+from satmotor_ros.interface import (CHANNELS, JOINT_NAME, LOSS_COMPONENTS, LOSSES_PREFIX,
+                                    MotorOptions, PREDICTED_JOINT_STATE, SPEED_RESIDUAL)
+from satmotor_ros.model import describe_status, ModelError
 from satmotor_ros.model.units import LPM, MPA, RPM
 from satmotor_ros.prediction import (combine_batch, driving_times, INPUTS, InputState, Level,
-                                     MODES, predict_batch, PredictionBatch, REQUIRED, Rule,
+                                     MODES, predict, PredictionBatch, Progress, REQUIRED, Rule,
                                      TOPICS)
 from satmotor_ros.prediction.rule import input_level
-
-FIELD_OF = {'flow': 'data', 'p_in': 'fluid_pressure', 'p_out': 'fluid_pressure',
-            'p_case': 'fluid_pressure', 'temperature': 'temperature',
-            'measured_speed': 'velocity'}
-"""The Series field each input is read from."""
 
 # (name, CSV header, unit in SI, decimal places written)
 _INPUT_COLUMNS = (('flow', 'flow [l/min]', LPM, 12), ('p_in', 'p_in [MPa]', MPA, 9),
@@ -40,27 +37,18 @@ _INPUT_COLUMNS = (('flow', 'flow [l/min]', LPM, 12), ('p_in', 'p_in [MPa]', MPA,
                   ('measured_speed', 'measured_speed [rpm]', RPM, 9))
 _OUTPUT_COLUMNS = (('dp', 'dp [MPa]', MPA, 9), ('dp_i', 'dp_i [MPa]', MPA, 9),
                    ('speed', 'speed [rpm]', RPM, 9), ('speed', 'speed [rad/s]', 1.0, 12),
-                   *((c, f'{c} [l/min]', LPM, 15) for c in COMPONENTS),
+                   *((c, f'{c} [l/min]', LPM, 15) for c in LOSS_COMPONENTS),
                    ('residual', 'residual [rpm]', RPM, 9))
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
-    """
-    Register the subcommand.
-
-    Parameters
-    ----------
-    sub : argparse._SubParsersAction
-        The ``satmotor`` subparsers, [-]
-
-    """
-    parser = sub.add_parser(
-        'replay', help="run the motor_model node's prediction over a recorded bag",
-        description='Replay a rosbag2 bag (sqlite3 or MCAP) through the motor_model '
-                    "node's prediction, as fast as it can: the inputs are combined in "
-                    "log-time order by the node's rule. With a measured speed "
-                    '(joint_states) it prints residual statistics and plots predicted '
-                    'against measured speed.')
+    """Register ``satmotor replay`` and its options."""
+    parser = subcommand(
+        sub, 'replay', command, "run the motor_model node's prediction over a recorded bag",
+        "Replay a rosbag2 bag (sqlite3 or MCAP) through the motor_model node's prediction, as "
+        "fast as it can: the inputs are combined in log-time order by the node's rule. With a "
+        'measured speed (joint_states) it prints residual statistics and plots predicted '
+        'against measured speed.')
     parser.add_argument('bag', help='bag directory, or a single .db3/.mcap file')
     parser.add_argument('--out', default=None, metavar='FILE.csv',
                         help='write one row per driving message (units in the header)')
@@ -80,17 +68,15 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                         help='predict on every flow_command (default) or at --rate')
     parser.add_argument('--rate', type=float, default=50.0, metavar='HZ',
                         help='prediction rate with --mode rate (default 50 Hz)')
-    parser.add_argument('--joint', default='motor_shaft', metavar='NAME',
+    parser.add_argument('--joint', default=JOINT_NAME, metavar='NAME',
                         help='joint of the measured speed in joint_states (default '
-                             'motor_shaft)')
-    add_model_options(parser)
-    parser.set_defaults(command=command)
+                             f'{JOINT_NAME})')
+    add_motor_options(parser)
 
 
 def command(bag: str, out: str | None, out_bag: str | None, plot: str | None, no_plot: bool,
             topic_map: list[str], timeout: float, mode: str, rate: float, joint: str,
-            liquid: str, motor: str | None, law: str, viscosity: str | None,
-            density: str | None, bulk_modulus: str | None) -> int:
+            options: MotorOptions) -> int:
     """
     Replay a bag through the prediction and report.
 
@@ -116,8 +102,8 @@ def command(bag: str, out: str | None, out_bag: str | None, plot: str | None, no
         Prediction rate in ``'rate'`` mode, [Hz]
     joint : str
         Joint of the measured speed, [-]
-    liquid, motor, law, viscosity, density, bulk_modulus : str or None
-        Model options, see :func:`satmotor_ros.cli._common.build_model`, [-]
+    options : MotorOptions
+        Motor, liquid and Delta q law, as the node's parameters, [-]
 
     Returns
     -------
@@ -131,7 +117,7 @@ def command(bag: str, out: str | None, out_bag: str | None, plot: str | None, no
     except ValueError as err:
         return fail(CliError(f'--{str(err).split(" ", 1)[0]} {err}'))
     try:
-        model = build_model(liquid, motor, law, viscosity, density, bulk_modulus)
+        model = options.build_model()
         renames = parse_topic_map(topic_map)
         series = read_series(bag, [TOPICS[name] for name in INPUTS], renames, joint,
                              keep_raw=out_bag is not None)
@@ -190,7 +176,7 @@ def inputs_of(series: dict[str, Series]) -> dict[str, tuple[np.ndarray, np.ndarr
     for name in INPUTS:
         found = series.get(TOPICS[name])
         if found is not None and len(found):
-            inputs[name] = (found.t_ns, found.fields[FIELD_OF[name]])
+            inputs[name] = (found.t_ns, found.fields[CHANNELS[name].field])
     return inputs
 
 
@@ -199,7 +185,8 @@ def _predict(model, rule: Rule, series: dict[str, Series]) -> PredictionBatch:  
     first = min(int(t[0]) for t, _ in inputs.values())
     last = max(int(t[-1]) for t, _ in inputs.values())
     stamps = driving_times(rule, inputs['flow'][0], first, last)
-    return predict_batch(model, combine_batch(rule, stamps, inputs), rule.timeout)
+    snaps = combine_batch(rule, stamps, inputs)
+    return predict(model, snaps, rule.timeout, Progress().advance(snaps))
 
 
 def summary(bag: str, batch: PredictionBatch, seconds: float) -> str:
@@ -348,15 +335,15 @@ def _write_bag(path: Path, series: dict[str, Series], batch: PredictionBatch,
                        s.t_ns, s.raw) for s in series.values() if len(s)]
     valid = batch.valid
     t_ns = batch.snapshots.stamp_ns[valid]
-    topics.append(OutTopic(prefix + 'predicted_joint_state', JOINT_STATE, t_ns, encode_many(
+    topics.append(OutTopic(prefix + PREDICTED_JOINT_STATE, JOINT_STATE, t_ns, encode_many(
         JOINT_STATE, {'velocity': batch.output('speed')[valid]}, t_ns, joint=joint)))
-    for c in COMPONENTS:
-        topics.append(OutTopic(f'{prefix}losses/{c}', FLOAT64, t_ns,
+    for c in LOSS_COMPONENTS:
+        topics.append(OutTopic(prefix + LOSSES_PREFIX + c, FLOAT64, t_ns,
                                encode_many(FLOAT64, {'data': batch.output(c)[valid]})))
     residual = batch.output('residual')
     has = valid & np.isfinite(residual)
     if has.any():
-        topics.append(OutTopic(prefix + 'speed_residual', FLOAT64,
+        topics.append(OutTopic(prefix + SPEED_RESIDUAL, FLOAT64,
                                batch.snapshots.stamp_ns[has],
                                encode_many(FLOAT64, {'data': residual[has]})))
     write_bag(path, topics)

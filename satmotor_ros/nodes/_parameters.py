@@ -22,6 +22,7 @@ from rcl_interfaces.msg import (FloatingPointRange, IntegerRange, ParameterDescr
 from rclpy.exceptions import InvalidParameterTypeException, InvalidParameterValueException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
+from satmotor_ros.interface import DISPLACEMENT_LAWS, MotorOptions
 
 
 @dataclass(frozen=True)
@@ -168,3 +169,41 @@ def values(node: Node, specs: Iterable[ParamSpec]) -> dict[str, Any]:
 
     """
     return {spec.name: node.get_parameter(spec.name).value for spec in specs}
+
+
+MOTOR_PARAMETERS = (
+    ParamSpec('liquid', MotorOptions.liquid, "coefficient set and its liquid: 'oil' or 'water' "
+              'for the packaged SM-0,75/25, or any set of motor_file'),
+    ParamSpec('viscosity', MotorOptions.viscosity, 'kinematic viscosity of a user liquid run '
+              "on the set; 0: the set's own liquid", 'm^2/s', 0.0, 1.0e-2),
+    ParamSpec('density', MotorOptions.density, "density of a user liquid; 0: the set's own",
+              'kg/m^3', 0.0, 1.0e5),
+    ParamSpec('bulk_modulus', MotorOptions.bulk_modulus,
+              "bulk modulus of a user liquid; 0: the set's own", 'Pa', 0.0, 1.0e12),
+    ParamSpec('motor_file', MotorOptions.motor_file, 'motor specification or calibrated '
+              'coefficients YAML; empty: the packaged SM-0,75/25'),
+    ParamSpec('displacement_law', MotorOptions.displacement_law, 'change of displacement: '
+              'physical eq. (33) or empirical eq. (39)', choices=DISPLACEMENT_LAWS),
+)
+"""The motor and liquid parameters every node declares (:class:`MotorOptions`, same names)."""
+
+MOTOR_KEYS = tuple(spec.name for spec in MOTOR_PARAMETERS)
+"""Their names: a change to any of them rebuilds the model."""
+
+
+def motor_options(values: Mapping[str, Any]) -> MotorOptions:
+    """
+    Collect the motor and liquid parameters into options.
+
+    Parameters
+    ----------
+    values : mapping
+        Parameter name -> value (at least :data:`MOTOR_KEYS`), [SI]
+
+    Returns
+    -------
+    MotorOptions
+        The options; ``build_model()`` builds the model.
+
+    """
+    return MotorOptions(**{name: values[name] for name in MOTOR_KEYS})

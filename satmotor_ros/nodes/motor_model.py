@@ -5,13 +5,16 @@ The ``motor_model`` node: predicted shaft speed and volumetric-loss breakdown, l
 Subscribes ``flow_command``, ``inlet_pressure``, ``outlet_pressure`` and, when they are
 published, ``case_pressure``, ``fluid_temperature`` and ``joint_states``; publishes
 ``predicted_joint_state``, ``losses/<component>``, ``speed_residual`` and ``/diagnostics``
-(DESIGN.md). The node holds no physics: the combination rule and the model call are
+(DESIGN.md; names and types from :mod:`satmotor_ros.interface`). With ``losses_format``
+``array`` the breakdown goes out as one ``std_msgs/Float64MultiArray`` on ``losses``
+instead (its layout's one dimension is labelled with the component names, in order), and
+``losses_every`` thins it to every n-th prediction: what makes the node cheap at 1 kHz.
+The node holds no physics: the combination rule and the model call are
 :mod:`satmotor_ros.prediction`, shared with ``satmotor replay``.
 """
 
 from __future__ import annotations
 
-import dataclasses
 from typing import Any
 
 from builtin_interfaces.msg import Time as TimeMsg
@@ -23,85 +26,49 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import qos_profile_sensor_data, QoSProfile
 from rclpy.time import Time
-from satmotor_ros.model import (COMPONENTS, describe_status, load_motor, ModelError,
-                                MotorModel)
+from satmotor_ros.interface import (CHANNELS, JOINT_NAME, LOSS_COMPONENTS, LOSSES_ARRAY,
+                                    LOSSES_PREFIX, PREDICTED_JOINT_STATE, SPEED_RESIDUAL)
+from satmotor_ros.model import describe_status, ModelError, MotorModel
 from satmotor_ros.nodes import _diagnostics as diag
 from satmotor_ros.nodes import _parameters as params
 from satmotor_ros.nodes._parameters import ParamSpec
 from satmotor_ros.nodes._spin import spin
-from satmotor_ros.prediction import (Combiner, FIELDS, INPUTS, Level, MODES, predict_point,
+from satmotor_ros.prediction import (Combiner, FIELDS, INPUTS, Level, MODES, OUTPUTS, predict,
                                      Prediction, Progress, Rule, TOPICS, UNITS)
 from sensor_msgs.msg import FluidPressure, JointState, Temperature
-from std_msgs.msg import Float64
+from std_msgs.msg import Float64, Float64MultiArray, MultiArrayDimension
 
 
 def _joint_name_reason(value: Any) -> str | None:
     return None if str(value).strip() else f'joint_name = {value!r}: must not be empty'
 
 
+LOSSES_FORMATS = ('topics', 'array', 'both')
+"""How the loss breakdown goes out: DESIGN.md losses/<component>, one array, or both."""
+
 PARAMETERS = (
-    ParamSpec('liquid', 'oil', "coefficient set and its liquid: 'oil' or 'water' for the "
-              'packaged SM-0,75/25, or any set of motor_file'),
-    ParamSpec('viscosity', 0.0, 'kinematic viscosity of a user liquid run on the set; 0: the '
-              "set's own liquid", 'm^2/s', 0.0, 1.0e-2),
-    ParamSpec('density', 0.0, "density of a user liquid; 0: the set's own", 'kg/m^3', 0.0,
-              1.0e5),
-    ParamSpec('bulk_modulus', 0.0, "bulk modulus of a user liquid; 0: the set's own", 'Pa', 0.0,
-              1.0e12),
-    ParamSpec('motor_file', '', 'motor specification YAML (geometry, coefficient sets); '
-              'empty: the packaged SM-0,75/25'),
-    ParamSpec('displacement_law', 'eq33', 'change of displacement: physical eq. (33) or '
-              'empirical eq. (39)', choices=('eq33', 'eq39')),
+    *params.MOTOR_PARAMETERS,
     ParamSpec('publish_mode', 'on_flow', 'predict on every flow_command, or at publish_rate',
               choices=MODES),
     ParamSpec('publish_rate', 50.0, "prediction rate in publish_mode 'rate'", 'Hz', 0.1,
               1000.0),
     ParamSpec('input_timeout', 0.5, 'oldest input a prediction may use', 's', 0.001, 60.0),
-    ParamSpec('joint_name', 'motor_shaft', 'joint of predicted_joint_state, and of the '
+    ParamSpec('joint_name', JOINT_NAME, 'joint of predicted_joint_state, and of the '
               'measured speed taken from joint_states', check=_joint_name_reason),
+    ParamSpec('losses_format', 'topics', 'loss breakdown as the DESIGN.md topics '
+              'losses/<component> (topics), as one Float64MultiArray on losses whose layout '
+              'names the components (array, the cheapest per message), or both',
+              choices=LOSSES_FORMATS),
+    ParamSpec('losses_every', 1, 'publish the loss breakdown with every n-th prediction only '
+              '(1: with each)', '-', 1, 1000000),
     ParamSpec('qos_depth', 10, 'queue depth of every subscription and publisher (fixed at '
               'start)', '-', 1, 1000, read_only=True),
 )
 """The node's parameters: name, default, description, unit and accepted values."""
 
 _SPECS = {spec.name: spec for spec in PARAMETERS}
-_MODEL_KEYS = ('liquid', 'viscosity', 'density', 'bulk_modulus', 'motor_file',
-               'displacement_law')
-
-
-def model_from_parameters(values: dict[str, Any]) -> MotorModel:
-    """
-    Build the motor model the parameters describe.
-
-    Parameters
-    ----------
-    values : dict
-        Parameter name -> value (see :data:`PARAMETERS`), [SI]
-
-    Returns
-    -------
-    MotorModel
-        The model.
-
-    Raises
-    ------
-    ModelError
-        If the motor file, the set or the user liquid is invalid; the message names it.
-
-    """
-    spec = load_motor(values['motor_file'] or None)
-    name = values['liquid']
-    if name not in spec.sets:
-        raise ModelError(f'liquid = {name!r}: not a coefficient set of {spec.source} '
-                         f'(has: {", ".join(spec.sets)})')
-    overrides = {key: float(values[param]) for key, param in (
-        ('kinematic_viscosity', 'viscosity'), ('density', 'density'),
-        ('bulk_modulus', 'bulk_modulus')) if values[param] > 0.0}
-    liquid = None
-    if overrides:
-        liquid = dataclasses.replace(spec.sets[name].liquid, name=f'user liquid on {name}',
-                                     **overrides)
-    return MotorModel.from_spec(spec, name, liquid, values['displacement_law'])
+_SPEED = OUTPUTS.index('speed')
+_LOSSES = slice(_SPEED + 1, _SPEED + 1 + len(LOSS_COMPONENTS))
 
 
 def rule_from_parameters(values: dict[str, Any]) -> Rule:
@@ -157,20 +124,26 @@ class MotorModelNode(Node):
         sensor = QoSProfile(depth=depth, reliability=qos_profile_sensor_data.reliability,
                             durability=qos_profile_sensor_data.durability,
                             history=qos_profile_sensor_data.history)
-        self._pub_joint = self.create_publisher(JointState, 'predicted_joint_state', depth)
-        self._pub_losses = [self.create_publisher(Float64, f'losses/{c}', depth)
-                            for c in COMPONENTS]
-        self._pub_residual = self.create_publisher(Float64, 'speed_residual', depth)
+        self._pub_joint = self.create_publisher(JointState, PREDICTED_JOINT_STATE, depth)
+        self._pub_losses = [self.create_publisher(Float64, LOSSES_PREFIX + c, depth)
+                            for c in LOSS_COMPONENTS]
+        self._pub_losses_array = self.create_publisher(Float64MultiArray, LOSSES_ARRAY, depth)
+        self._pub_residual = self.create_publisher(Float64, SPEED_RESIDUAL, depth)
         self._pub_diag = self.create_publisher(DiagnosticArray, '/diagnostics', depth)
-        self.create_subscription(Float64, 'flow_command', self._on_flow, depth)
-        self.create_subscription(FluidPressure, 'inlet_pressure', self._pressure('p_in'),
-                                 sensor)
-        self.create_subscription(FluidPressure, 'outlet_pressure', self._pressure('p_out'),
-                                 sensor)
-        self.create_subscription(FluidPressure, 'case_pressure', self._pressure('p_case'),
-                                 sensor)
-        self.create_subscription(Temperature, 'fluid_temperature', self._on_temperature, sensor)
-        self.create_subscription(JointState, 'joint_states', self._on_joint_states, sensor)
+        self._joint_msg = JointState(name=[self._joint])  # refilled per prediction
+        self._losses_msg = Float64MultiArray()
+        self._losses_msg.layout.dim = [MultiArrayDimension(
+            label=','.join(LOSS_COMPONENTS), size=len(LOSS_COMPONENTS),
+            stride=len(LOSS_COMPONENTS))]
+        self._losses_format, self._losses_every = values['losses_format'], values['losses_every']
+        self.create_subscription(Float64, CHANNELS['flow'].topic, self._on_flow, depth)
+        for name in ('p_in', 'p_out', 'p_case'):
+            self.create_subscription(FluidPressure, CHANNELS[name].topic, self._pressure(name),
+                                     sensor)
+        self.create_subscription(Temperature, CHANNELS['temperature'].topic,
+                                 self._on_temperature, sensor)
+        self.create_subscription(JointState, CHANNELS['measured_speed'].topic,
+                                 self._on_joint_states, sensor)
         self._rate_timer = None
         self._apply_mode()
         self.create_timer(1.0, self._publish_diagnostics)
@@ -181,7 +154,8 @@ class MotorModelNode(Node):
 
     def _build_model(self, values: dict[str, Any]) -> None:
         try:
-            self._model, self._model_error = model_from_parameters(values), ''
+            self._model = params.motor_options(values).build_model()
+            self._model_error = ''
         except ModelError as err:
             self._model, self._model_error = None, str(err)
             self.get_logger().error(f'no model: {err}')
@@ -194,8 +168,8 @@ class MotorModelNode(Node):
         proposed.update({p.name: p.value for p in request if p.name in _SPECS})
         try:
             rule_from_parameters(proposed)
-            if any(p.name in _MODEL_KEYS for p in request):
-                model_from_parameters(proposed)
+            if any(p.name in params.MOTOR_KEYS for p in request):
+                params.motor_options(proposed).build_model()
         except (ModelError, ValueError) as err:
             return SetParametersResult(successful=False, reason=str(err))
         return SetParametersResult(successful=True)
@@ -205,13 +179,15 @@ class MotorModelNode(Node):
         for name in names:
             self._problems.pop(name, None)  # a start-up problem is over once it is set
         values = params.values(self, PARAMETERS)
-        if names & set(_MODEL_KEYS):
+        if names & set(params.MOTOR_KEYS):
             self._build_model(values)
             self.get_logger().info(f'model now {self._describe_model()}')
         if names & {'input_timeout', 'publish_mode', 'publish_rate'}:
             self._rule = self._combiner.rule = rule_from_parameters(values)
             self._apply_mode()
         self._joint = values['joint_name']
+        self._joint_msg.name = [self._joint]
+        self._losses_format, self._losses_every = values['losses_format'], values['losses_every']
 
     def _apply_mode(self) -> None:
         if self._rate_timer is not None:
@@ -267,8 +243,7 @@ class MotorModelNode(Node):
             pred = Prediction(t_ns, snap.values, (), 0, Level.ERROR,
                               f'no model: {self._model_error}')
         else:
-            pred = predict_point(self._model, snap, self._rule.timeout,
-                                 self._progress.advance(snap))
+            pred = predict(self._model, snap, self._rule.timeout, self._progress.advance(snap))
         if self._worst is None or pred.level >= self._worst.level:
             self._worst = pred
         if pred.level != self._last_level:
@@ -285,13 +260,22 @@ class MotorModelNode(Node):
             return
         self._published += 1
         out = pred.outputs
-        joint = JointState(name=[self._joint], velocity=[out[3]])
+        joint = self._joint_msg
+        joint.velocity = [out[_SPEED]]
         joint.header.stamp = TimeMsg(sec=t_ns // 1_000_000_000, nanosec=t_ns % 1_000_000_000)
         self._pub_joint.publish(joint)
-        for k, publisher in enumerate(self._pub_losses):
-            publisher.publish(Float64(data=out[4 + k]))
+        if self._published % self._losses_every == 0:
+            self._publish_losses(out[_LOSSES])
         if out[-1] == out[-1]:  # a measured speed was there: not NaN
             self._pub_residual.publish(Float64(data=out[-1]))
+
+    def _publish_losses(self, losses: tuple[float, ...]) -> None:
+        if self._losses_format != 'topics':
+            self._losses_msg.data = losses
+            self._pub_losses_array.publish(self._losses_msg)
+        if self._losses_format != 'array':
+            for publisher, value in zip(self._pub_losses, losses):
+                publisher.publish(Float64(data=value))
 
     # -- diagnostics ------------------------------------------------------------------------
 
@@ -303,10 +287,10 @@ class MotorModelNode(Node):
         for name, value, age in zip(INPUTS, pred.inputs, self._combiner.snapshot(now).ages):
             values[f'{FIELDS[name]} [{UNITS[name]}]'] = value
             values[f'{TOPICS[name]} age [s]'] = age
-        names = ('dp', 'dp_i', 'p_ex', 'speed', *COMPONENTS, 'residual')
-        units = ('Pa', 'Pa', 'Pa', 'rad/s', *(['m^3/s'] * len(COMPONENTS)), 'rad/s')
-        for name, unit, value in zip(names, units, pred.outputs or [float('nan')] * 13):
-            key = f'losses/{name}' if name in COMPONENTS else name
+        units = ('Pa', 'Pa', 'Pa', 'rad/s', *(['m^3/s'] * len(LOSS_COMPONENTS)), 'rad/s')
+        for name, unit, value in zip(OUTPUTS, units,
+                                     pred.outputs or [float('nan')] * len(OUTPUTS)):
+            key = LOSSES_PREFIX + name if name in LOSS_COMPONENTS else name
             values[f'{key} [{unit}]'] = value
         values.update({
             'model status': describe_status(pred.status), 'model': self._describe_model(),
@@ -330,7 +314,7 @@ class MotorModelNode(Node):
         if self._model is None:
             return Prediction(now, snap.values, (), 0, Level.ERROR,
                               f'no model: {self._model_error}')
-        pred = predict_point(self._model, snap, self._rule.timeout, self._progress.peek(now))
+        pred = predict(self._model, snap, self._rule.timeout, self._progress.peek(now))
         if pred.valid:  # inputs fresh, but no flow_command drove a prediction
             return pred._replace(level=Level.WARN, message='no prediction within '
                                  f'input_timeout {self._rule.timeout:g} s')

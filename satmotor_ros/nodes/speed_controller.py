@@ -22,7 +22,7 @@ from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import qos_profile_sensor_data
-from satmotor_ros.model import load_motor, MotorModel
+from satmotor_ros.interface import CHANNELS, JOINT_NAME
 from satmotor_ros.model.units import RPM
 from satmotor_ros.nodes import _diagnostics as diag
 from satmotor_ros.nodes import _parameters as params
@@ -51,9 +51,8 @@ PARAMETERS: tuple[ParamSpec, ...] = (
     ParamSpec('feedforward', _DEFAULTS.feedforward, 'feed-forward in front of the PI',
               choices=FEEDFORWARDS),
     ParamSpec('anti_windup', _DEFAULTS.anti_windup, 'back-calculation at the limits'),
-    ParamSpec('liquid', 'oil', 'coefficient set of the feed-forward model'),
-    ParamSpec('motor_file', '', 'motor YAML; empty: the packaged SM-0,75/25'),
-    ParamSpec('joint_name', 'motor_shaft', 'joint whose velocity is controlled'),
+    *params.MOTOR_PARAMETERS,
+    ParamSpec('joint_name', JOINT_NAME, 'joint whose velocity is controlled'),
     ParamSpec('measurement_timeout', 0.5, 'older speed: hold the command, warn', 's', 0.001,
               60.0),
     ParamSpec('diagnostics_period', 1.0, 'period of /diagnostics', 's', 0.01, 60.0),
@@ -96,22 +95,23 @@ class SpeedControllerNode(Node):
         self.last_rejection = ''
         self._rejected_since = 0
         self._next_diagnostics = 0.0
-        self._pub = self.create_publisher(Float64, 'flow_command', 10)
+        self._pub = self.create_publisher(Float64, CHANNELS['flow'].topic, 10)
         self._diag = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
         sensor = qos_profile_sensor_data
-        self.create_subscription(JointState, 'joint_states', self._on_joint, sensor)
-        self.create_subscription(FluidPressure, 'inlet_pressure', self._on_inlet, sensor)
-        self.create_subscription(FluidPressure, 'outlet_pressure', self._on_outlet, sensor)
+        self.create_subscription(JointState, CHANNELS['measured_speed'].topic, self._on_joint,
+                                 sensor)
+        self.create_subscription(FluidPressure, CHANNELS['p_in'].topic, self._on_inlet, sensor)
+        self.create_subscription(FluidPressure, CHANNELS['p_out'].topic, self._on_outlet,
+                                 sensor)
         self.create_subscription(Float64, 'speed_setpoint', self._on_setpoint, 10)
         self._timer = self.create_timer(1.0 / self.values['rate'], self._control)
 
     @staticmethod
     def _build(values: dict[str, Any]) -> SpeedController:
-        params = ControllerParams(**{k: values[k] for k in _LAW})
-        model = MotorModel.from_spec(load_motor(values['motor_file'] or None), values['liquid'])
+        model = params.motor_options(values).build_model()
         if not values['joint_name']:
             raise ValueError('joint_name is empty')
-        return SpeedController(params, model)
+        return SpeedController(ControllerParams(**{k: values[k] for k in _LAW}), model)
 
     def _validate(self, changes: list[Parameter]) -> SetParametersResult:
         result = params.check(self._specs, changes)

@@ -34,7 +34,8 @@ from rclpy.qos import qos_profile_sensor_data, QoSProfile
 from rclpy.time import Time as RosTime
 from rclpy.timer import Timer
 from rosgraph_msgs.msg import Clock as ClockMsg
-from satmotor_ros.model import describe_status, load_motor, MotorModel
+from satmotor_ros.interface import CHANNELS, JOINT_NAME, PRESSURE_TOPICS
+from satmotor_ros.model import describe_status
 from satmotor_ros.model.units import LPM
 from satmotor_ros.nodes import _diagnostics as diag
 from satmotor_ros.nodes import _parameters as params
@@ -47,10 +48,7 @@ from sensor_msgs.msg import FluidPressure, JointState, Temperature
 from std_msgs.msg import Float64
 
 NODE_PARAMETERS: tuple[ParamSpec, ...] = (
-    ParamSpec('liquid', 'oil', 'coefficient set and its liquid'),
-    ParamSpec('motor_file', '', 'motor YAML; empty: the packaged SM-0,75/25'),
-    ParamSpec('displacement_law', 'eq33', 'change of displacement law',
-              choices=('eq33', 'eq39')),
+    *params.MOTOR_PARAMETERS,
     ParamSpec('clock_mode', 'wall', "'wall' (real time) or 'sim' (fast, publishes /clock)",
               choices=('wall', 'sim')),
     ParamSpec('max_speedup', 0.0, 'sim mode: at most this many times real time; 0: as fast '
@@ -59,7 +57,7 @@ NODE_PARAMETERS: tuple[ParamSpec, ...] = (
     ParamSpec('diagnostics_period', 1.0, 'period of /diagnostics', 's', 0.01, 60.0),
     ParamSpec('max_flow_command', 100.0 * LPM, 'commands above are refused', 'm^3/s',
               1.0e-6, 1.0e-2),
-    ParamSpec('joint_name', 'motor_shaft', 'joint name in joint_states'),
+    ParamSpec('joint_name', JOINT_NAME, 'joint name in joint_states'),
     ParamSpec('frame_id', 'motor', 'frame_id of the sensor headers'),
     ParamSpec('load.kind', 'constant', 'load profile', choices=tuple(LOAD_KINDS)),
     ParamSpec('load.torque', 0.0, 'constant load torque', 'N*m', -1.0e4, 1.0e4),
@@ -81,9 +79,6 @@ _LOAD_FIELDS = {'constant': ('torque',), 'step': ('before', 'after', 'time'),
 MAX_LOAD_TORQUE = 1.0e4
 """Largest load torque accepted on the topic, [N*m]."""
 
-
-PRESSURE_TOPICS = ('inlet_pressure', 'outlet_pressure', 'case_pressure')
-"""The pressure topics, in the order of their readings."""
 
 _CHOICES = {'effects.leakage_driver': ('case', 'outlet')}
 
@@ -123,17 +118,13 @@ class Setup:
 
         """
         self.values = values
-        for name, allowed in (('clock_mode', ('wall', 'sim')),
-                              ('displacement_law', ('eq33', 'eq39')),
-                              ('load.kind', tuple(LOAD_KINDS))):
+        for name, allowed in (('clock_mode', ('wall', 'sim')), ('load.kind', tuple(LOAD_KINDS))):
             if values[name] not in allowed:
                 msg = f'{name} = {values[name]!r}: use one of {", ".join(allowed)}'
                 raise ValueError(msg)
         if not values['joint_name']:
             raise ValueError('joint_name is empty')
-        spec = load_motor(values['motor_file'] or None)
-        self.model = MotorModel.from_spec(spec, values['liquid'], None,
-                                          values['displacement_law'])
+        self.model = params.motor_options(values).build_model()
         plant_names = {s.name for s in parameter_specs()}
         self.params = params_from_flat({k: v for k, v in values.items() if k in plant_names})
         kind = values['load.kind']
@@ -176,11 +167,11 @@ class VirtualMotorNode(Node):
         self._pub = {name: self.create_publisher(FluidPressure, name, sensor,
                                                  event_callbacks=quiet)
                      for name in PRESSURE_TOPICS}
-        self._flow_pub = self.create_publisher(Float64, 'flow_measured', sensor,
+        self._flow_pub = self.create_publisher(Float64, CHANNELS['flow_measured'].topic, sensor,
                                                event_callbacks=quiet)
-        self._joint_pub = self.create_publisher(JointState, 'joint_states', sensor,
-                                                event_callbacks=quiet)
-        self._temp_pub = self.create_publisher(Temperature, 'fluid_temperature', sensor,
+        self._joint_pub = self.create_publisher(JointState, CHANNELS['measured_speed'].topic,
+                                                sensor, event_callbacks=quiet)
+        self._temp_pub = self.create_publisher(Temperature, CHANNELS['temperature'].topic, sensor,
                                                event_callbacks=quiet)
         self._diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10,
                                                event_callbacks=quiet)
@@ -189,8 +180,8 @@ class VirtualMotorNode(Node):
         self._pressure = {name: FluidPressure() for name in PRESSURE_TOPICS}
         self._flow, self._joint, self._temperature = Float64(), JointState(), Temperature()
         self._clock_msg = ClockMsg()
-        self.create_subscription(Float64, 'flow_command', self._on_command, 10)
-        self.create_subscription(Float64, 'load_torque', self._on_load, 10)
+        self.create_subscription(Float64, CHANNELS['flow'].topic, self._on_command, 10)
+        self.create_subscription(Float64, CHANNELS['torque'].topic, self._on_load, 10)
         self._steady = Clock(clock_type=ClockType.STEADY_TIME)
         self._driver: Timer | GuardCondition | None = None
         self._start_stepping()

@@ -2,36 +2,38 @@
 """
 The prediction: inputs -> model call -> speed, losses, residual and status.
 
-:func:`predict_point` serves the live node (one snapshot per message, the model's
-single-point path ``speed_point``, a few microseconds) and :func:`predict_batch` serves bag
-replay (every driving time at once, the array path ``speed``). Both apply the same checks
-and levels to the same model, so a bag replayed gives the levels, statuses and messages
-the node published, and its numbers to 1e-12 (the two model paths agree to that).
+:func:`predict` is the one path that the live node (a :class:`Snapshot` of floats per
+message, the model's single-point path ``speed_point``, a few microseconds) and bag replay
+(a :class:`SnapshotBatch` of arrays, every driving time at once, the array path ``speed``)
+both drive: its body is written once on values that may be floats or arrays
+(:func:`~satmotor_ros.prediction.rule.pick`). A bag replayed gives the levels, statuses and
+messages the node published, and its numbers to 1e-12 (the two model paths agree to that).
 """
 
 from __future__ import annotations
 
+import contextlib
 import math
-from typing import NamedTuple
+from typing import Any, NamedTuple, overload
 
 import numpy as np
 import numpy.typing as npt
 
 from satmotor_ros.model import COMPONENTS, describe_status, INVALID, MotorModel, PointStatus
-from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.units import ATMOSPHERE
 from satmotor_ros.prediction.rule import (describe_input, FIELDS, input_level, INPUTS,
-                                          InputState, Level, Snapshot, SnapshotBatch)
+                                          InputState, Level, pick, Snapshot, SnapshotBatch)
 
 OUTPUTS = ('dp', 'dp_i', 'p_ex', 'speed', *COMPONENTS, 'residual')
 """Computed fields of a prediction (SI: Pa, rad/s, m^3/s), after the inputs."""
 
-_NOTED = PointStatus.STALLED | PointStatus.CHANNEL_LIMITED | PointStatus.EXTRAPOLATED
-_I_OUT = INPUTS.index('p_out')
+_NOTED = int(PointStatus.STALLED | PointStatus.CHANNEL_LIMITED | PointStatus.EXTRAPOLATED)
+_INVALID = int(INVALID)
 _I_CASE = INPUTS.index('p_case')
 _I_SPEED = INPUTS.index('measured_speed')
-_GAUGED = {'p_case': _I_CASE, 'p_out': _I_OUT}
-_MEASURED = {**_GAUGED, 'temperature': INPUTS.index('temperature')}
+_GAUGED = ('p_case', 'p_out')
+_MEASURED = {'p_case': _I_CASE, 'p_out': INPUTS.index('p_out'),
+             'temperature': INPUTS.index('temperature')}
 CHANNELS = ('p_case', 'p_out', 'temperature', 'time', 'revolutions')
 """
 Channels a calibrated effect may read (``MotorModel.channels``): case and outlet pressure
@@ -41,14 +43,27 @@ and shaft revolutions [rev] since the first prediction (see :class:`Progress`), 
 """
 
 _TWO_PI = 2.0 * math.pi
+# plain ints: an enum member looked up on its class costs a microsecond per message
+_FRESH = int(InputState.FRESH)
+_OK, _WARN, _ERROR = int(Level.OK), int(Level.WARN), int(Level.ERROR)
+
+
+def _is_array(x: Any) -> bool:
+    return isinstance(x, np.ndarray)
+
+
+def _quiet(batch: bool) -> contextlib.AbstractContextManager[Any]:
+    """Silence numpy's NaN and inf warnings on arrays (floats never warn; errstate costs)."""
+    return np.errstate(invalid='ignore', over='ignore') if batch else contextlib.nullcontext()
 
 
 class Progress:
     """
-    Time and revolutions since the first prediction, advanced one prediction at a time.
+    Time and revolutions since the first prediction, advanced prediction by prediction.
 
     Revolutions add the measured speed (when fresh) times the time since the previous
-    prediction; :func:`predict_batch` sums the same terms in the same order.
+    prediction. :meth:`advance` takes one snapshot (the node) or a whole batch (replay)
+    and sums the same terms in the same order.
     """
 
     def __init__(self) -> None:
@@ -57,28 +72,36 @@ class Progress:
         self.last_ns = 0
         self.revolutions = 0.0
 
-    def advance(self, snap: Snapshot) -> tuple[float, float]:
+    def advance(self, snap: Snapshot | SnapshotBatch) -> tuple[Any, Any]:
         """
-        Count the snapshot in and return the time and revolutions at it.
+        Count the snapshot(s) in and return the time and revolutions at each.
 
         Parameters
         ----------
-        snap : Snapshot
-            The inputs of the prediction about to be made, [-]
+        snap : Snapshot or SnapshotBatch
+            The inputs of the prediction(s) about to be made, [-]
 
         Returns
         -------
-        tuple of float
-            Time since the first prediction [s] and revolutions [rev].
+        tuple
+            Time since the first prediction [s] and revolutions [rev]: floats for a
+            Snapshot, arrays for a batch.
 
         """
+        stamps = snap.stamp_ns
+        batch = _is_array(stamps)
+        if batch and not len(stamps):
+            return np.zeros(0), np.zeros(0)
         if self.origin_ns is None:
-            self.origin_ns = self.last_ns = snap.stamp_ns
-        if snap.states[_I_SPEED] == InputState.FRESH:
-            dt = (snap.stamp_ns - self.last_ns) * 1e-9
-            self.revolutions += snap.values[_I_SPEED] * dt / _TWO_PI
-        self.last_ns = snap.stamp_ns
-        return (snap.stamp_ns - self.origin_ns) * 1e-9, self.revolutions
+            self.origin_ns = self.last_ns = int(stamps[0] if batch else stamps)
+        dt = (np.diff(stamps, prepend=self.last_ns) if batch else stamps - self.last_ns) * 1e-9
+        fresh = snap.states[_I_SPEED] == _FRESH
+        with _quiet(batch):  # inf or NaN where not fresh
+            turns = pick(fresh, snap.values[_I_SPEED] * dt / _TWO_PI, 0.0)
+        revolutions = self.revolutions + (np.cumsum(turns) if batch else turns)
+        self.revolutions = float(revolutions[-1] if batch else revolutions)
+        self.last_ns = int(stamps[-1] if batch else stamps)
+        return (stamps - self.origin_ns) * 1e-9, revolutions
 
     def peek(self, stamp_ns: int) -> tuple[float, float]:
         """
@@ -104,28 +127,44 @@ def _leakage_channel(model: MotorModel) -> str | None:
     return next((e.regressor for e in model.effects if e.kind == 'external_leakage'), None)
 
 
-def _gauge(p: float) -> float:
-    return p - ATMOSPHERE if p > ATMOSPHERE else 0.0
+def _gauge(p: Any) -> Any:
+    """Absolute pressure made gauge, floored at 0 (float or array), [Pa]."""
+    return pick(p > ATMOSPHERE, p - ATMOSPHERE, 0.0)
 
 
-def _channels(needed: tuple[str, ...], snap: Snapshot,
-              progress: tuple[float, float]) -> tuple[dict[str, float] | None, str]:
-    """Return the channels the model's effects need, or None and why they are missing."""
-    channels: dict[str, float] = {}
+def _channels(needed: tuple[str, ...], snap: Snapshot | SnapshotBatch,
+              progress: tuple[Any, Any]) -> tuple[dict[str, Any], Any]:
+    """Return the channels the model's effects read and where one of them is missing."""
+    channels: dict[str, Any] = {}
+    missing: Any = False
     for name in needed:
         if name in ('time', 'revolutions'):
             channels[name] = progress[name == 'revolutions']
             continue
         i = _MEASURED.get(name)
-        if i is None:
-            return None, (f'the calibrated effect needs the channel {name!r}, which '
-                          f'motor_model does not measure (it has: {", ".join(CHANNELS)})')
-        if snap.states[i] != InputState.FRESH:
-            return None, (f'the calibrated effect needs {FIELDS[INPUTS[i]]}: '
-                          f'{InputState(snap.states[i]).name.lower()}')
+        if i is None:  # a channel motor_model does not measure: never usable
+            missing, channels[name] = True, 0.0
+            continue
+        fresh = snap.states[i] == _FRESH
+        missing = pick(fresh, missing, True)
         value = snap.values[i]
-        channels[name] = _gauge(value) if name in _GAUGED else value
-    return channels, ''
+        channels[name] = pick(fresh, _gauge(value) if name in _GAUGED else value, 0.0)
+    return channels, missing
+
+
+def _channel_problem(needed: tuple[str, ...], snap: Snapshot) -> str:
+    """Say why the channels the model's effects need are not there, or ''."""
+    for name in needed:
+        i = _MEASURED.get(name)
+        if name in ('time', 'revolutions'):
+            continue
+        if i is None:
+            return (f'the calibrated effect needs the channel {name!r}, which motor_model '
+                    f'does not measure (it has: {", ".join(CHANNELS)})')
+        if snap.states[i] != InputState.FRESH:
+            return (f'the calibrated effect needs {FIELDS[INPUTS[i]]}: '
+                    f'{InputState(snap.states[i]).name.lower()}')
+    return ''
 
 
 class Prediction(NamedTuple):
@@ -159,100 +198,6 @@ class Prediction(NamedTuple):
 
         """
         return self.outputs[OUTPUTS.index(name)]
-
-
-def _model_note(status: int, flow: float, dp: float) -> str:
-    return (f'model status {describe_status(status)} at flow_command.data = {flow!r} m^3/s, '
-            f'dp = {dp!r} Pa')
-
-
-def _messages(snap: Snapshot, timeout: float, status: int, dp: float) -> tuple[int, str]:
-    """Return the level and the message of a snapshot and its model status."""
-    level, notes = Level.OK, []
-    p_in = snap.values[INPUTS.index('p_in')]
-    for name, value, age, state in zip(INPUTS, snap.values, snap.ages, snap.states):
-        rated = input_level(name, state)
-        if rated:
-            level = max(level, rated)
-            notes.append(describe_input(name, state, value, age, timeout, p_in))
-    if level < Level.ERROR and status & int(_NOTED | INVALID):
-        level = max(level, Level.ERROR if status & INVALID else Level.WARN)
-        notes.append(_model_note(status, snap.values[0], dp))
-    return int(level), '; '.join(notes) if notes else 'OK'
-
-
-def _level_table() -> npt.NDArray[np.uint8]:
-    table = np.zeros((len(INPUTS), max(InputState) + 1), dtype=np.uint8)
-    for i, name in enumerate(INPUTS):
-        for state in InputState:
-            table[i, state] = input_level(name, state)
-    return table
-
-
-_LEVELS = _level_table()
-_LEVEL_ROWS = [tuple(int(x) for x in row) for row in _LEVELS]
-_NOTED_OR_INVALID = int(_NOTED | INVALID)
-
-
-def _input_level(states: tuple[int, ...]) -> int:
-    """Return the worst level of the inputs' states (a table look-up per input)."""
-    return max(row[state] for row, state in zip(_LEVEL_ROWS, states))
-
-
-def predict_point(model: MotorModel, snap: Snapshot, timeout: float,
-                  progress: tuple[float, float] = (0.0, 0.0)) -> Prediction:
-    """
-    Predict from one snapshot of the inputs (the live node's path).
-
-    Parameters
-    ----------
-    model : MotorModel
-        The motor model, [-]
-    snap : Snapshot
-        The inputs at the driving time, [-]
-    timeout : float
-        The input timeout, quoted in messages, [s]
-    progress : tuple of float
-        Time since the first prediction [s] and revolutions [rev] (:class:`Progress`),
-        for effects that read them, [-]
-
-    Returns
-    -------
-    Prediction
-        Outputs and status; NaN outputs and level ERROR when no prediction may be made.
-
-    """
-    inputs_level = _input_level(snap.states)
-    channels, why = None, ''
-    if inputs_level < Level.ERROR and model.channels:
-        channels, why = _channels(model.channels, snap, progress)
-    if inputs_level >= Level.ERROR or why:
-        level, message = _messages(snap, timeout, 0, math.nan)
-        if why:
-            level, message = Level.ERROR, why if message == 'OK' else f'{message}; {why}'
-        return Prediction(snap.stamp_ns, snap.values, (math.nan,) * len(OUTPUTS), 0, level,
-                          message)
-    flow, p_in, p_out = snap.values[0], snap.values[1], snap.values[2]
-    p_ex = _gauge(snap.values[_I_CASE]) if snap.states[_I_CASE] == InputState.FRESH else 0.0
-    dp = p_in - p_out
-    point = model.speed_point(flow, dp, p_ex=p_ex, channels=channels)
-    leak = _leakage_channel(model)
-    if leak is not None and channels is not None:
-        p_ex = channels[leak]  # the pressure the effect drove eq. (24) with
-    status = point.status
-    speed = point.speed
-    residual = (model.true_speed(snap.values[_I_SPEED]) - speed
-                if snap.states[_I_SPEED] == InputState.FRESH else math.nan)
-    if inputs_level == Level.OK and not status & _NOTED_OR_INVALID:
-        level, message = Level.OK, 'OK'  # the usual case, without building any text
-    else:
-        level, message = _messages(snap, timeout, status, dp)
-    if level >= Level.ERROR:
-        return Prediction(snap.stamp_ns, snap.values, (math.nan,) * len(OUTPUTS), status,
-                          level, message)
-    outputs = (dp, point.dp_i, p_ex, speed, *(getattr(point, c) for c in COMPONENTS),
-               residual)
-    return Prediction(snap.stamp_ns, snap.values, outputs, status, level, message)
 
 
 class PredictionBatch(NamedTuple):
@@ -313,7 +258,7 @@ class PredictionBatch(NamedTuple):
 
     def message(self, i: int) -> str:
         """
-        Spell out prediction `i`'s problems, as :func:`predict_point` does.
+        Spell out prediction `i`'s problems, as the node's :class:`Prediction` does.
 
         Parameters
         ----------
@@ -326,98 +271,159 @@ class PredictionBatch(NamedTuple):
             ``'OK'`` or the problems.
 
         """
-        snap = self.snapshot(i)
-        dp = float(snap.values[1] - snap.values[2])
-        message = _messages(snap, self.timeout, int(self.status[i]), dp)[1]
-        if self.channels and _input_level(snap.states) < Level.ERROR:
-            why = _channels(self.channels, snap, (0.0, 0.0))[1]
-            if why:
-                message = why if message == 'OK' else f'{message}; {why}'
-        return message
+        return describe(self.snapshot(i), self.timeout, int(self.status[i]), self.channels)[1]
 
 
-def predict_batch(model: MotorModel, snaps: SnapshotBatch, timeout: float) -> PredictionBatch:
+def _model_note(status: int, flow: float, dp: float) -> str:
+    return (f'model status {describe_status(status)} at flow_command.data = {flow!r} m^3/s, '
+            f'dp = {dp!r} Pa')
+
+
+def _level_table() -> npt.NDArray[np.uint8]:
+    table = np.zeros((len(INPUTS), max(InputState) + 1), dtype=np.uint8)
+    for i, name in enumerate(INPUTS):
+        for state in InputState:
+            table[i, state] = input_level(name, state)
+    return table
+
+
+_LEVELS = _level_table()
+
+
+def _worst(levels: list[Any]) -> Any:
+    """Return the worst of some levels, element by element (floats or arrays)."""
+    return np.maximum.reduce(levels) if _is_array(levels[-1]) else max(levels)
+
+
+def _masked(keep: Any, values: list[Any], fill: float) -> list[Any]:
+    """Return `values` where `keep`, `fill` elsewhere (one test for floats)."""
+    if _is_array(keep):
+        return [np.where(keep, value, fill) for value in values]
+    return values if keep else [fill] * len(values)
+
+
+def describe(snap: Snapshot, timeout: float, status: int, channels: tuple[str, ...] = ()
+             ) -> tuple[int, str]:
     """
-    Predict from many snapshots at once (bag replay's path), as :func:`predict_point` would.
+    Rate one prediction and spell out its problems, each naming the field and the value.
+
+    Parameters
+    ----------
+    snap : Snapshot
+        Its inputs, [-]
+    timeout : float
+        The input timeout, quoted in messages, [s]
+    status : int
+        The model's :class:`PointStatus`; 0 when the model was not run, [-]
+    channels : tuple of str
+        Channels the model's effects read (``MotorModel.channels``), [-]
+
+    Returns
+    -------
+    tuple
+        The :class:`Level` and ``'OK'`` or the problems.
+
+    """
+    level, notes = Level.OK, []
+    p_in = snap.values[INPUTS.index('p_in')]
+    for name, value, age, state in zip(INPUTS, snap.values, snap.ages, snap.states):
+        rated = input_level(name, state)
+        if rated:
+            level = max(level, rated)
+            notes.append(describe_input(name, state, value, age, timeout, p_in))
+    why = _channel_problem(channels, snap) if level < Level.ERROR else ''
+    if why:
+        level = Level.ERROR
+        notes.append(why)
+    if level < Level.ERROR and status & (_NOTED | _INVALID):
+        level = max(level, Level.ERROR if status & _INVALID else Level.WARN)
+        notes.append(_model_note(status, snap.values[0], snap.values[1] - snap.values[2]))
+    return int(level), '; '.join(notes) if notes else 'OK'
+
+
+def _model_call(model: MotorModel, flow: Any, dp: Any, p_ex: Any,
+                channels: dict[str, Any] | None) -> tuple[Any, Any, Any, list[Any]]:
+    """Run the model's point path on floats, its array path on arrays."""
+    if _is_array(flow):
+        op = model.speed(flow, dp, p_ex=p_ex, errors='mask', channels=channels)
+        return op.speed, op.dp_i, op.status, list(op.losses.as_dict().values())
+    point = model.speed_point(flow, dp, p_ex=p_ex, channels=channels)
+    return point.speed, point.dp_i, point.status, [getattr(point, c) for c in COMPONENTS]
+
+
+@overload
+def predict(model: MotorModel, snap: Snapshot, timeout: float,
+            progress: tuple[Any, Any] = ...) -> Prediction: ...
+
+
+@overload
+def predict(model: MotorModel, snap: SnapshotBatch, timeout: float,
+            progress: tuple[Any, Any] = ...) -> PredictionBatch: ...
+
+
+def predict(model: MotorModel, snap: Snapshot | SnapshotBatch, timeout: float,
+            progress: tuple[Any, Any] = (0.0, 0.0)) -> Prediction | PredictionBatch:
+    """
+    Predict from one snapshot of the inputs (the node) or from many at once (replay).
 
     Parameters
     ----------
     model : MotorModel
         The motor model, [-]
-    snaps : SnapshotBatch
-        The inputs at every driving time, [-]
+    snap : Snapshot or SnapshotBatch
+        The inputs at the driving time(s), [-]
     timeout : float
         The input timeout, quoted in messages, [s]
+    progress : tuple
+        Time since the first prediction [s] and revolutions [rev] at the driving time(s)
+        (:meth:`Progress.advance`), for effects that read them, [-]
 
     Returns
     -------
-    PredictionBatch
-        Outputs, status and level per driving time.
+    Prediction or PredictionBatch
+        Outputs and status; NaN outputs and level ERROR where no prediction may be made.
 
     """
-    values, states = snaps.values, snaps.states
-    n = values.shape[1]
-    level = np.zeros(n, dtype=np.uint8)
-    for i in range(len(INPUTS)):
-        np.maximum(level, _LEVELS[i][states[i]], out=level)
+    values, states = snap.values, snap.states
+    level = _worst([row[state] for row, state in zip(_LEVELS, states)])
     channels = None
     if model.channels:
-        level, channels = _batch_channels(model, snaps, level)
-    usable = level < Level.ERROR
-    flow = np.where(usable, values[0], 0.0)
-    dp = np.where(usable, values[1] - values[2], 0.0)
-    p_ex = np.where(usable & (states[_I_CASE] == InputState.FRESH),
-                    np.maximum(values[_I_CASE] - ATMOSPHERE, 0.0), 0.0)
-    op = model.speed(flow, dp, p_ex=p_ex, errors='mask', channels=channels)
+        channels, missing = _channels(model.channels, snap, progress)
+        level = pick(missing, _ERROR, level)
+    usable = level < _ERROR
+    if not (usable.any() if _is_array(usable) else usable):
+        return _result(model, snap, timeout, [math.nan] * len(OUTPUTS), 0, level)
+    p_ex = pick(states[_I_CASE] == _FRESH, _gauge(values[_I_CASE]), 0.0)
+    flow, dp, p_ex = _masked(usable, [values[0], values[1] - values[2], p_ex], 0.0)
+    if channels is not None:
+        channels = dict(zip(channels, _masked(usable, list(channels.values()), 0.0)))
+    speed, dp_i, status, losses = _model_call(model, flow, dp, p_ex, channels)
     leak = _leakage_channel(model)
     if leak is not None and channels is not None:
         p_ex = channels[leak]  # the pressure the effect drove eq. (24) with
-    status = np.where(usable, op.status, 0).astype(np.uint8)
-    model_level = np.where(status & int(INVALID), np.uint8(Level.ERROR),
-                           np.where(status & int(_NOTED), np.uint8(Level.WARN), np.uint8(0)))
-    np.maximum(level, model_level, out=level)
-    speed = op.speed
-    residual = np.where(states[_I_SPEED] == InputState.FRESH,
-                        model.true_speed(values[_I_SPEED]) - speed, np.nan)
-    columns = [dp, op.dp_i, p_ex, speed, *op.losses.as_dict().values(), residual]
-    outputs = np.empty((len(OUTPUTS), n))
-    for row, column in zip(outputs, columns):
-        row[:] = column
-    outputs[:, level >= Level.ERROR] = np.nan
-    return PredictionBatch(snaps, outputs, status, level, timeout, model.channels)
+    status = pick(usable, status, 0)
+    level = _worst([level, pick(status & _INVALID, _ERROR, pick(status & _NOTED, _WARN, _OK))])
+    with _quiet(_is_array(speed)):  # NaN where the speed is not measured
+        residual = pick(states[_I_SPEED] == _FRESH,
+                        model.true_speed(values[_I_SPEED]) - speed, math.nan)
+    outputs = _masked(level < _ERROR, [dp, dp_i, p_ex, speed, *losses, residual], math.nan)
+    return _result(model, snap, timeout, outputs, status, level)
 
 
-def _batch_progress(snaps: SnapshotBatch) -> tuple[FloatArray, FloatArray]:
-    """Return time [s] and revolutions [rev] at each prediction, as :class:`Progress`."""
-    stamps = snaps.stamp_ns
-    if not len(stamps):
-        return np.zeros(0), np.zeros(0)
-    dt = np.diff(stamps, prepend=stamps[0]) * 1e-9
-    fresh = snaps.states[_I_SPEED] == InputState.FRESH
-    with np.errstate(invalid='ignore', over='ignore'):  # inf or NaN where not fresh
-        turns = np.where(fresh, snaps.values[_I_SPEED] * dt / _TWO_PI, 0.0)
-    return (stamps - stamps[0]) * 1e-9, np.cumsum(turns)
-
-
-def _batch_channels(model: MotorModel, snaps: SnapshotBatch, level: npt.NDArray[np.uint8]
-                    ) -> tuple[npt.NDArray[np.uint8], dict[str, FloatArray]]:
-    """Return the levels with missing channels made ERROR, and the channels (0 there)."""
-    channels: dict[str, FloatArray] = {}
-    level = level.copy()
-    progress = _batch_progress(snaps)
-    for name in model.channels:
-        if name in ('time', 'revolutions'):
-            channels[name] = progress[name == 'revolutions']
-            continue
-        i = _MEASURED.get(name)
-        if i is None:
-            level[:] = Level.ERROR
-            channels[name] = np.zeros(len(level))
-            continue
-        fresh = snaps.states[i] == InputState.FRESH
-        level[~fresh] = Level.ERROR
-        value = snaps.values[i]
-        if name in _GAUGED:
-            value = np.maximum(value - ATMOSPHERE, 0.0)
-        channels[name] = np.where(fresh & (level < Level.ERROR), value, 0.0)
-    return level, channels
+def _result(model: MotorModel, snap: Snapshot | SnapshotBatch, timeout: float,
+            outputs: list[Any], status: Any, level: Any) -> Prediction | PredictionBatch:
+    """Pack the outputs as the node's Prediction or replay's PredictionBatch."""
+    if isinstance(snap, SnapshotBatch):
+        n = len(snap.stamp_ns)
+        table = np.empty((len(OUTPUTS), n))
+        for row, column in zip(table, outputs):
+            row[:] = column
+        return PredictionBatch(snap, table, np.broadcast_to(status, n).astype(np.uint8),
+                               np.broadcast_to(level, n).astype(np.uint8), timeout,
+                               model.channels)
+    if level == _OK and not status & (_NOTED | _INVALID):
+        message = 'OK'  # the usual case, without building any text
+    else:
+        level, message = describe(snap, timeout, int(status), model.channels)
+    return Prediction(snap.stamp_ns, snap.values, tuple(outputs), int(status), int(level),
+                      message)

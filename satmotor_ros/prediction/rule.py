@@ -7,37 +7,34 @@ driving time (every ``flow_command`` by default, or the ticks of a fixed rate) f
 latest value of each input, provided it arrived no longer than the input timeout before
 the driving time and its value is valid. The live node (:class:`Combiner`, one message
 at a time) and bag replay (:func:`combine_batch`, whole arrays at once) apply the same
-rule; the tests check that they agree element by element.
+rule: both hold the latest value and age of each input and rate them with
+:func:`input_states`, one body of code for floats and arrays (:func:`pick`).
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 import enum
 import math
-from typing import NamedTuple
+import sys
+from typing import Any, NamedTuple
 
 import numpy as np
 import numpy.typing as npt
 
-INPUTS = ('flow', 'p_in', 'p_out', 'p_case', 'temperature', 'measured_speed')
+from satmotor_ros.interface import CHANNELS, PREDICTION_INPUTS
+
+INPUTS = PREDICTION_INPUTS
 """The inputs of a prediction, in the order of every per-input tuple and array."""
 
-TOPICS = {
-    'flow': 'flow_command', 'p_in': 'inlet_pressure', 'p_out': 'outlet_pressure',
-    'p_case': 'case_pressure', 'temperature': 'fluid_temperature',
-    'measured_speed': 'joint_states',
-}
+TOPICS = {name: CHANNELS[name].topic for name in INPUTS}
 """The topic (relative name, DESIGN.md) that carries each input."""
 
-UNITS = {'flow': 'm^3/s', 'p_in': 'Pa', 'p_out': 'Pa', 'p_case': 'Pa', 'temperature': 'degC',
-         'measured_speed': 'rad/s'}
+UNITS = {name: CHANNELS[name].unit for name in INPUTS}
 """The SI unit of each input, as on its topic."""
 
-FIELDS = {'flow': 'flow_command.data', 'p_in': 'inlet_pressure.fluid_pressure',
-          'p_out': 'outlet_pressure.fluid_pressure', 'p_case': 'case_pressure.fluid_pressure',
-          'temperature': 'fluid_temperature.temperature',
-          'measured_speed': 'joint_states.velocity'}
+FIELDS = {name: f'{CHANNELS[name].topic}.{CHANNELS[name].field}' for name in INPUTS}
 """The message field each input is read from, as named in diagnostics."""
 
 REQUIRED = ('flow', 'p_in', 'p_out')
@@ -109,51 +106,91 @@ class Rule:
         return int(round(1e9 / self.rate))
 
 
-def check_value(name: str, value: float) -> InputState:
+_FLOAT_MAX = sys.float_info.max
+# plain ints: an enum member looked up on its class costs a microsecond per message
+_FRESH, _MISSING, _STALE, _NOT_FINITE, _NEGATIVE, _REVERSED = (int(s) for s in InputState)
+_I_IN, _I_OUT = INPUTS.index('p_in'), INPUTS.index('p_out')
+
+
+def pick(condition: Any, if_true: Any, if_false: Any) -> Any:
     """
-    Check one input value (scalar form of :func:`check_values`).
+    Choose element by element: a conditional expression on scalars, ``np.where`` on arrays.
+
+    What lets one body of code serve one message (floats, the node) and a whole
+    recording (arrays, replay).
+
+    Parameters
+    ----------
+    condition : bool or ndarray of bool
+        Where to take `if_true`, [-]
+    if_true, if_false : float, int or ndarray
+        The choices, [any]
+
+    Returns
+    -------
+    float, int or ndarray
+        The choice; an array when `condition` is one.
+
+    """
+    if isinstance(condition, np.ndarray):
+        return np.where(condition, if_true, if_false)
+    return if_true if condition else if_false
+
+
+def input_state(name: str, value: Any, age_ns: Any, timeout_ns: int) -> Any:
+    """
+    Rate an input at a driving time: one value (float) or many (array) alike.
 
     Parameters
     ----------
     name : str
         Input name, one of :data:`INPUTS`, [-]
-    value : float
-        Its value, [unit of the input]
+    value : float or ndarray
+        Its latest value, [unit of the input]
+    age_ns : float or ndarray
+        Driving time minus its arrival; NaN when it never arrived, [ns]
+    timeout_ns : int
+        The rule's timeout, [ns]
 
     Returns
     -------
-    InputState
-        FRESH, NOT_FINITE or NEGATIVE.
+    int or ndarray of int
+        An :class:`InputState`: FRESH, MISSING, STALE, NOT_FINITE or NEGATIVE (REVERSED
+        needs both pressures, see :func:`input_states`).
 
     """
-    if not math.isfinite(value):
-        return InputState.NOT_FINITE
-    if value < 0.0 and name in NON_NEGATIVE:
-        return InputState.NEGATIVE
-    return InputState.FRESH
-
-
-def check_values(name: str, values: npt.NDArray[np.float64]) -> npt.NDArray[np.uint8]:
-    """
-    Check input values element by element (array form of :func:`check_value`).
-
-    Parameters
-    ----------
-    name : str
-        Input name, one of :data:`INPUTS`, [-]
-    values : ndarray
-        Its values, [unit of the input]
-
-    Returns
-    -------
-    ndarray of uint8
-        An :class:`InputState` per element.
-
-    """
-    states = np.where(np.isfinite(values), np.uint8(InputState.FRESH),
-                      np.uint8(InputState.NOT_FINITE)).astype(np.uint8)
+    state = pick(abs(value) <= _FLOAT_MAX, _FRESH, _NOT_FINITE)
     if name in NON_NEGATIVE:
-        states[(values < 0.0) & (states == InputState.FRESH)] = InputState.NEGATIVE
+        state = pick((value < 0.0) & (state == _FRESH), _NEGATIVE, state)
+    state = pick(age_ns > timeout_ns, _STALE, state)
+    return pick(age_ns != age_ns, _MISSING, state)  # NaN age: never arrived
+
+
+def input_states(values: Sequence[Any], ages_ns: Sequence[Any], timeout_ns: int) -> list[Any]:
+    """
+    Rate every input at a driving time (floats) or at many (rows of arrays).
+
+    Parameters
+    ----------
+    values : sequence
+        Per input of :data:`INPUTS`: its latest value(s), [unit of the input]
+    ages_ns : sequence
+        Per input: driving time(s) minus arrival; NaN where it never arrived, [ns]
+    timeout_ns : int
+        The rule's timeout, [ns]
+
+    Returns
+    -------
+    list
+        Per input: an :class:`InputState` value (or an array of them); the outlet pressure is
+        REVERSED where both pressures are fresh and it is above the inlet pressure.
+
+    """
+    states = [input_state(name, value, age, timeout_ns)
+              for name, value, age in zip(INPUTS, values, ages_ns)]
+    reversed_ = (states[_I_IN] == _FRESH) & (states[_I_OUT] == _FRESH) \
+        & (values[_I_OUT] > values[_I_IN])
+    states[_I_OUT] = pick(reversed_, _REVERSED, states[_I_OUT])
     return states
 
 
@@ -164,13 +201,6 @@ class Snapshot(NamedTuple):
     values: tuple[float, ...]  # per input of INPUTS; NaN when missing [unit of the input]
     ages: tuple[float, ...]  # per input: driving time minus arrival; NaN when missing [s]
     states: tuple[int, ...]  # per input: an InputState
-
-
-def _pressure_order(states: list[int], values: tuple[float, ...] | list[float]) -> None:
-    i_in, i_out = INPUTS.index('p_in'), INPUTS.index('p_out')
-    if states[i_in] == InputState.FRESH and states[i_out] == InputState.FRESH \
-            and values[i_out] > values[i_in]:
-        states[i_out] = InputState.REVERSED
 
 
 class Combiner:
@@ -223,18 +253,10 @@ class Combiner:
             Values, ages and states of every input.
 
         """
-        timeout_ns = self.rule.timeout_ns
-        states, ages = [], []
-        for name, value, t in zip(INPUTS, self._values, self._times):
-            if t is None:
-                states.append(InputState.MISSING)
-                ages.append(math.nan)
-                continue
-            age = t_ns - t
-            ages.append(age * 1e-9)
-            states.append(InputState.STALE if age > timeout_ns else check_value(name, value))
-        _pressure_order(states, self._values)
-        return Snapshot(int(t_ns), tuple(self._values), tuple(ages), tuple(states))
+        ages_ns = [math.nan if t is None else float(t_ns - t) for t in self._times]
+        states = input_states(self._values, ages_ns, self.rule.timeout_ns)
+        return Snapshot(int(t_ns), tuple(self._values), tuple(a * 1e-9 for a in ages_ns),
+                        tuple(states))
 
 
 class SnapshotBatch(NamedTuple):
@@ -298,10 +320,9 @@ def combine_batch(rule: Rule, stamps_ns: npt.NDArray[np.int64],
         Values, ages and states per input and driving time.
 
     """
-    n = len(stamps_ns)
-    values = np.full((len(INPUTS), n), np.nan)
-    ages = np.full((len(INPUTS), n), np.nan)
-    states = np.full((len(INPUTS), n), InputState.MISSING, dtype=np.uint8)
+    stamps_ns = np.asarray(stamps_ns, dtype=np.int64)
+    values = np.full((len(INPUTS), len(stamps_ns)), np.nan)
+    ages_ns = np.full((len(INPUTS), len(stamps_ns)), np.nan)
     for i, name in enumerate(INPUTS):
         if name not in inputs or len(inputs[name][0]) == 0:
             continue
@@ -309,18 +330,10 @@ def combine_batch(rule: Rule, stamps_ns: npt.NDArray[np.int64],
         idx = np.searchsorted(t, stamps_ns, side='right') - 1
         seen = idx >= 0
         at = np.where(seen, idx, 0)
-        age_ns = stamps_ns - t[at]
         values[i] = np.where(seen, v[at], np.nan)
-        ages[i] = np.where(seen, age_ns * 1e-9, np.nan)
-        state = check_values(name, values[i])
-        state[age_ns > rule.timeout_ns] = InputState.STALE
-        state[~seen] = InputState.MISSING
-        states[i] = state
-    i_in, i_out = INPUTS.index('p_in'), INPUTS.index('p_out')
-    reversed_ = (states[i_in] == InputState.FRESH) & (states[i_out] == InputState.FRESH) \
-        & (values[i_out] > values[i_in])
-    states[i_out][reversed_] = InputState.REVERSED
-    return SnapshotBatch(np.asarray(stamps_ns, dtype=np.int64), values, ages, states)
+        ages_ns[i] = np.where(seen, stamps_ns - t[at], np.nan)
+    states = np.array(input_states(values, ages_ns, rule.timeout_ns), dtype=np.uint8)
+    return SnapshotBatch(stamps_ns, values, ages_ns * 1e-9, states)
 
 
 def input_level(name: str, state: int) -> Level:

@@ -1,0 +1,212 @@
+# SPDX-License-Identifier: Apache-2.0
+"""
+The DESIGN.md interface contract in one place: topics, message types, fields, options.
+
+Nodes, ``satmotor replay`` and ``calibrate``, the bag code and the tests import their topic
+names, message types, message fields, loss components, default joint name and the motor
+and liquid options from here. No ROS: message types are named by their type strings
+(``'sensor_msgs/msg/FluidPressure'``); the nodes map them to classes.
+
+Beyond DESIGN.md (documented here and in doc/interface.md): ``motor_model`` may also
+publish the loss breakdown as one ``std_msgs/Float64MultiArray`` on ``losses``
+(:data:`LOSSES_ARRAY`), its layout naming the components (:data:`LOSS_COMPONENTS` order),
+and every node accepts the same motor and liquid parameters (:class:`MotorOptions`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+import math
+from typing import NamedTuple
+
+from satmotor_ros.model import load_motor, ModelError, MotorModel
+from satmotor_ros.model.config import MotorSpec
+from satmotor_ros.model.results import COMPONENTS
+
+FLOAT64 = 'std_msgs/msg/Float64'
+FLOAT64_ARRAY = 'std_msgs/msg/Float64MultiArray'
+FLUID_PRESSURE = 'sensor_msgs/msg/FluidPressure'
+TEMPERATURE = 'sensor_msgs/msg/Temperature'
+JOINT_STATE = 'sensor_msgs/msg/JointState'
+DIAGNOSTIC_ARRAY = 'diagnostic_msgs/msg/DiagnosticArray'
+CLOCK = 'rosgraph_msgs/msg/Clock'
+
+LOSS_COMPONENTS = COMPONENTS
+"""The ``<component>`` of ``losses/<component>``: the model's loss breakdown fields."""
+
+JOINT_NAME = 'motor_shaft'
+"""Default joint name of every JointState the nodes read or write."""
+
+PREDICTED_JOINT_STATE = 'predicted_joint_state'
+SPEED_RESIDUAL = 'speed_residual'
+LOSSES_PREFIX = 'losses/'
+LOSSES_ARRAY = 'losses'
+"""One Float64MultiArray with every component (an addition to DESIGN.md, optional)."""
+
+TOPIC_TYPES = {
+    'flow_command': FLOAT64, 'inlet_pressure': FLUID_PRESSURE,
+    'outlet_pressure': FLUID_PRESSURE, 'case_pressure': FLUID_PRESSURE,
+    'fluid_temperature': TEMPERATURE, 'flow_measured': FLOAT64, 'joint_states': JOINT_STATE,
+    'load_torque': FLOAT64, PREDICTED_JOINT_STATE: JOINT_STATE, SPEED_RESIDUAL: FLOAT64,
+    **{LOSSES_PREFIX + c: FLOAT64 for c in LOSS_COMPONENTS},
+}
+"""Each DESIGN.md topic (relative name) and its message type."""
+
+MODEL_OUTPUTS = (PREDICTED_JOINT_STATE, SPEED_RESIDUAL, LOSSES_PREFIX, LOSSES_ARRAY)
+"""What ``motor_model`` publishes (``losses/`` as a prefix): predictions, not measurements."""
+
+
+class Channel(NamedTuple):
+    """Where a measured quantity travels: topic, message field and unit."""
+
+    topic: str  # relative topic name
+    field: str  # message field (JointState: of the joint named by the joint parameter)
+    unit: str  # SI unit on the topic
+
+
+CHANNELS = {
+    'flow': Channel('flow_command', 'data', 'm^3/s'),
+    'p_in': Channel('inlet_pressure', 'fluid_pressure', 'Pa'),
+    'p_out': Channel('outlet_pressure', 'fluid_pressure', 'Pa'),
+    'p_case': Channel('case_pressure', 'fluid_pressure', 'Pa'),
+    'temperature': Channel('fluid_temperature', 'temperature', 'degC'),
+    'measured_speed': Channel('joint_states', 'velocity', 'rad/s'),
+    'flow_measured': Channel('flow_measured', 'data', 'm^3/s'),
+    'torque': Channel('load_torque', 'data', 'N*m'),
+}
+"""Each measured quantity by its short name (the bench-table column where there is one)."""
+
+PREDICTION_INPUTS = ('flow', 'p_in', 'p_out', 'p_case', 'temperature', 'measured_speed')
+"""The :data:`CHANNELS` a ``motor_model`` prediction reads, in its order."""
+
+PRESSURE_TOPICS = ('inlet_pressure', 'outlet_pressure', 'case_pressure')
+"""The FluidPressure topics, in the order the plant reads them."""
+
+DISPLACEMENT_LAWS = ('eq33', 'eq39')
+"""Laws of the change of displacement: physical eq. (33) or empirical eq. (39)."""
+
+LIQUID_PROPERTIES = {'viscosity': 'kinematic_viscosity', 'density': 'density',
+                     'bulk_modulus': 'bulk_modulus'}
+"""User-liquid option -> :class:`~satmotor_ros.model.Liquid` field it overrides."""
+
+
+class OptionError(ModelError):
+    """
+    A motor or liquid option is not acceptable; names the option and the value.
+
+    Parameters
+    ----------
+    option : str
+        Field of :class:`MotorOptions`, [-]
+    value : object
+        Its value, [-]
+    reason : str
+        What is wrong, [-]
+
+    """
+
+    def __init__(self, option: str, value: object, reason: str) -> None:
+        """Keep the parts, so that each front end can spell the option its own way."""
+        super().__init__(f'{option} = {value!r}: {reason}')
+        self.option, self.value, self.reason = option, value, reason
+
+
+@dataclass(frozen=True)
+class MotorOptions:
+    """
+    Which motor, coefficient set, liquid and Delta q law a model is built from.
+
+    The same options are node parameters (same names) and ``satmotor`` options
+    (``--liquid``, ``--motor``, ``--law``, ``--viscosity``, ``--density``,
+    ``--bulk-modulus``).
+
+    Parameters
+    ----------
+    liquid : str
+        Coefficient set and its liquid: ``'oil'`` or ``'water'`` for the packaged
+        SM-0,75/25, or any set of `motor_file`, [-]
+    motor_file : str
+        Motor specification or calibrated coefficients YAML; empty: the packaged
+        SM-0,75/25, [-]
+    displacement_law : {'eq33', 'eq39'}
+        Change of displacement law, [-]
+    viscosity : float
+        Kinematic viscosity of a user liquid run on the set; 0: the set's own, [m^2/s]
+    density : float
+        Density of a user liquid; 0: the set's own, [kg/m^3]
+    bulk_modulus : float
+        Bulk modulus of a user liquid; 0: the set's own, [Pa]
+
+    """
+
+    liquid: str = 'oil'
+    motor_file: str = ''
+    displacement_law: str = 'eq33'
+    viscosity: float = 0.0  # [m^2/s]; 0: the set's own
+    density: float = 0.0  # [kg/m^3]; 0: the set's own
+    bulk_modulus: float = 0.0  # [Pa]; 0: the set's own
+
+    def __post_init__(self) -> None:
+        """Reject a law or a liquid property that cannot be, naming the option."""
+        if self.displacement_law not in DISPLACEMENT_LAWS:
+            raise OptionError('displacement_law', self.displacement_law,
+                              f'use one of {", ".join(DISPLACEMENT_LAWS)}')
+        for name in LIQUID_PROPERTIES:
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value >= 0.0):
+                raise OptionError(name, value, "must be a finite value > 0 (0: the set's own)")
+
+    def spec(self) -> MotorSpec:
+        """
+        Load the motor file and check that it has the coefficient set.
+
+        Returns
+        -------
+        MotorSpec
+            The motor.
+
+        Raises
+        ------
+        ModelError
+            If the file cannot be read (the message names it) or lacks the set
+            (:class:`OptionError` on ``liquid``).
+
+        """
+        spec = load_motor(self.motor_file or None)
+        if self.liquid not in spec.sets:
+            raise OptionError('liquid', self.liquid, f'not a coefficient set of {spec.name} '
+                              f'(has: {", ".join(spec.sets)})')
+        return spec
+
+    def build_model(self) -> MotorModel:
+        """
+        Build the motor model the options describe.
+
+        Returns
+        -------
+        MotorModel
+            The model, with the user liquid when a property is overridden.
+
+        Raises
+        ------
+        ModelError
+            If the motor file, the set or the user liquid is invalid; the message names it.
+
+        """
+        spec = self.spec()
+        overrides = {field: float(getattr(self, option))
+                     for option, field in LIQUID_PROPERTIES.items() if getattr(self, option)}
+        liquid = None
+        if overrides:
+            liquid = replace(spec.sets[self.liquid].liquid,
+                             name=f'user liquid on the {self.liquid} set', **overrides)
+        return MotorModel.from_spec(spec, self.liquid, liquid, self.displacement_law)
+
+
+__all__ = [
+    'CHANNELS', 'CLOCK', 'Channel', 'DIAGNOSTIC_ARRAY', 'DISPLACEMENT_LAWS', 'FLOAT64',
+    'FLOAT64_ARRAY', 'FLUID_PRESSURE', 'JOINT_NAME', 'JOINT_STATE', 'LIQUID_PROPERTIES',
+    'LOSSES_ARRAY', 'LOSSES_PREFIX', 'LOSS_COMPONENTS', 'MODEL_OUTPUTS', 'MotorOptions',
+    'OptionError', 'PREDICTED_JOINT_STATE', 'PREDICTION_INPUTS', 'PRESSURE_TOPICS',
+    'SPEED_RESIDUAL', 'TEMPERATURE', 'TOPIC_TYPES',
+]
