@@ -13,7 +13,8 @@ flows are all distinct and the predicted speed grows with the flow, so a lost me
 is a drop, not a shifted pairing. Reported: p50/p99 latency, the ratio to the relay,
 drops, and the node process's CPU time per input message (/proc).
 
-Run: ``ROS_DOMAIN_ID=.. python bench/bench_node.py [--seconds 30] [--rate 1000]``.
+Run: ``ROS_DOMAIN_ID=.. python bench/bench_node.py [--seconds 30] [--rate 1000]
+[--losses-format topics|array|both]``.
 """
 
 from __future__ import annotations
@@ -72,7 +73,8 @@ def _cpu_seconds(pid: int) -> float:
     return (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK')
 
 
-def measure(kind: str, seconds: float, rate: float, namespace: str) -> dict[str, float]:
+def measure(kind: str, seconds: float, rate: float, namespace: str,
+            parameters: tuple[str, ...] = ()) -> dict[str, float]:
     """
     Start one node process, feed it, and measure its latency.
 
@@ -86,6 +88,8 @@ def measure(kind: str, seconds: float, rate: float, namespace: str) -> dict[str,
         flow_command rate, [Hz]
     namespace : str
         Namespace of the node, [-]
+    parameters : tuple of str
+        ``name:=value`` parameters of the node, [-]
 
     Returns
     -------
@@ -97,8 +101,9 @@ def measure(kind: str, seconds: float, rate: float, namespace: str) -> dict[str,
     code = ('import sys; sys.path.insert(0, %r); import bench_node; bench_node.run_relay()'
             % str(ROOT / 'bench')) if kind == 'relay' else \
         'from satmotor_ros.nodes.motor_model import main; main()'
+    extra = [arg for p in parameters for arg in ('-p', p)]
     proc = subprocess.Popen([sys.executable, '-c', code, '--ros-args', '-r',
-                             f'__ns:={namespace}'], env=env)
+                             f'__ns:={namespace}', *extra], env=env)
     context = Context()
     context.init()
     node = Node(f'bench_{uuid.uuid4().hex[:8]}', context=context)
@@ -176,11 +181,15 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--seconds', type=float, default=30.0)
     parser.add_argument('--rate', type=float, default=1000.0)
+    parser.add_argument('--losses-format', choices=('topics', 'array', 'both'),
+                        default='topics', help="motor_model's losses_format parameter")
     args = parser.parse_args()
     ns = f'/bench_{uuid.uuid4().hex[:8]}'
     relay = measure('relay', args.seconds, args.rate, ns + '/relay')
-    model = measure('motor_model', args.seconds, args.rate, ns + '/motor')
-    print(f'{args.rate:g} Hz for {args.seconds:g} s, ROS_DOMAIN_ID '
+    model = measure('motor_model', args.seconds, args.rate, ns + '/motor',
+                    (f'losses_format:={args.losses_format}',))
+    print(f'{args.rate:g} Hz for {args.seconds:g} s, losses_format {args.losses_format}, '
+          f'ROS_DOMAIN_ID '
           f'{os.environ.get("ROS_DOMAIN_ID", "0")}, load {os.getloadavg()[0]:.1f}')
     print(f'{"node":12s} {"p50 [ms]":>9s} {"p99 [ms]":>9s} {"sent":>7s} {"drops":>6s} '
           f'{"CPU/msg [us]":>13s}')

@@ -16,7 +16,6 @@ from sensor_msgs.msg import FluidPressure, JointState
 from std_msgs.msg import Float64
 
 
-
 class Recorder:
     """Record serialised messages with their receive time, as ``ros2 bag record`` does."""
 

@@ -20,15 +20,13 @@ from satmotor_ros.bags.decode import decode, FIELDS, FLOAT64, FLUID_PRESSURE, JO
     TEMPERATURE
 from satmotor_ros.bags.encode import encode_many, encode_message
 from satmotor_ros.bags.errors import BagError
-from satmotor_ros.bags.series import (describe_topics, DESIGN_TYPES, list_topics,
-                                      LOSS_COMPONENTS, match_topics, missing_topics,
-                                      parse_topic_map, read_series, Series)
+from satmotor_ros.bags.series import (describe_topics, list_topics, match_topics,
+                                      missing_topics, parse_topic_map, read_series, Series)
 from satmotor_ros.bags.storage import open_bag, TopicInfo
 from satmotor_ros.bags.writer import OutTopic, write_bag
 
 __all__ = [
-    'BagError', 'DESIGN_TYPES', 'FIELDS', 'FLOAT64', 'FLUID_PRESSURE', 'JOINT_STATE',
-    'LOSS_COMPONENTS', 'OutTopic', 'Series', 'TEMPERATURE', 'TopicInfo', 'decode',
+    'BagError', 'FIELDS', 'FLOAT64', 'FLUID_PRESSURE', 'JOINT_STATE', 'OutTopic', 'Series', 'TEMPERATURE', 'TopicInfo', 'decode',
     'describe_topics', 'encode_many', 'encode_message', 'list_topics', 'match_topics',
     'missing_topics', 'open_bag', 'parse_topic_map', 'read_series', 'write_bag',
 ]

@@ -17,23 +17,10 @@ from pathlib import Path
 import numpy as np
 import numpy.typing as npt
 
-from satmotor_ros.bags.decode import decode_packed, FIELDS, FLOAT64, FLUID_PRESSURE, \
-    JOINT_STATE, TEMPERATURE
+from satmotor_ros.bags.decode import decode_packed, FIELDS
 from satmotor_ros.bags.errors import BagError
 from satmotor_ros.bags.storage import open_bag, TopicInfo
-
-LOSS_COMPONENTS = ('flat_clearance', 'commutation', 'compressibility', 'deformation',
-                   'backlash', 'inertia', 'external', 'total')
-"""The ``losses/<component>`` topics of DESIGN.md."""
-
-DESIGN_TYPES = {
-    'flow_command': FLOAT64, 'inlet_pressure': FLUID_PRESSURE,
-    'outlet_pressure': FLUID_PRESSURE, 'case_pressure': FLUID_PRESSURE,
-    'fluid_temperature': TEMPERATURE, 'flow_measured': FLOAT64, 'joint_states': JOINT_STATE,
-    'load_torque': FLOAT64, 'predicted_joint_state': JOINT_STATE, 'speed_residual': FLOAT64,
-    **{f'losses/{c}': FLOAT64 for c in LOSS_COMPONENTS},
-}
-"""Each DESIGN.md topic (relative name) and its message type."""
+from satmotor_ros.interface import TOPIC_TYPES
 
 
 @dataclass(frozen=True)
@@ -209,7 +196,7 @@ def read_series(path: str | Path, topics: Iterable[str],
     for want, name in found.items():
         info = available[name]
         base = want.rsplit('/', 1)[-1] if want.startswith('/') else want
-        expected = DESIGN_TYPES.get(base) or DESIGN_TYPES.get(want.lstrip('/'))
+        expected = TOPIC_TYPES.get(base) or TOPIC_TYPES.get(want.lstrip('/'))
         if expected is not None and info.msgtype != expected:
             raise BagError(f'{want} ({name} in the bag) is {info.msgtype}; '
                            f'expected {expected}')

@@ -16,6 +16,8 @@ from rclpy.parameter import Parameter
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock
 from satmotor_ros.cli._demo_report import RunResult, write_run_bag
+from satmotor_ros.interface import (CLOCK, DIAGNOSTIC_ARRAY, FLOAT64, MODEL_OUTPUTS,
+                                    TOPIC_TYPES)
 from satmotor_ros.nodes.motor_model import MotorModelNode
 from satmotor_ros.nodes.speed_controller import SpeedControllerNode
 from satmotor_ros.nodes.virtual_motor import VirtualMotorNode
@@ -31,23 +33,12 @@ _TYPES = {'std_msgs/msg/Float64': Float64, 'sensor_msgs/msg/FluidPressure': Flui
 CONTROL_RATE = 100.0
 """Rate of the controller and of the set-point script, [Hz]."""
 
+_RELIABLE = {'flow_command', 'load_torque',
+             *(t for t in TOPIC_TYPES if t.startswith(MODEL_OUTPUTS))}
 RECORDED = (  # topic relative to the run's namespace, type, reliable publisher?
-    ('flow_command', 'std_msgs/msg/Float64', True),
-    ('load_torque', 'std_msgs/msg/Float64', True),
-    ('speed_setpoint', 'std_msgs/msg/Float64', True),
-    ('inlet_pressure', 'sensor_msgs/msg/FluidPressure', False),
-    ('outlet_pressure', 'sensor_msgs/msg/FluidPressure', False),
-    ('case_pressure', 'sensor_msgs/msg/FluidPressure', False),
-    ('flow_measured', 'std_msgs/msg/Float64', False),
-    ('joint_states', 'sensor_msgs/msg/JointState', False),
-    ('fluid_temperature', 'sensor_msgs/msg/Temperature', False),
-    ('/diagnostics', 'diagnostic_msgs/msg/DiagnosticArray', True),
-    ('/clock', 'rosgraph_msgs/msg/Clock', True),
-    ('predicted_joint_state', 'sensor_msgs/msg/JointState', True),
-    ('speed_residual', 'std_msgs/msg/Float64', True),
-    *((f'losses/{c}', 'std_msgs/msg/Float64', True) for c in (
-        'flat_clearance', 'commutation', 'compressibility', 'deformation', 'backlash',
-        'inertia', 'external', 'total')),
+    *((topic, msgtype, topic in _RELIABLE) for topic, msgtype in TOPIC_TYPES.items()),
+    ('speed_setpoint', FLOAT64, True), ('/diagnostics', DIAGNOSTIC_ARRAY, True),
+    ('/clock', CLOCK, True),
 )
 """Every topic of a run, relative to its namespace (DESIGN.md names and types)."""
 

@@ -24,22 +24,20 @@ from satmotor_ros.bags import (BagError, describe_topics, FIELDS, list_topics, r
                                Series)
 from satmotor_ros.identify.errors import DataError
 from satmotor_ros.identify.table import BenchTable, table_from_columns
+from satmotor_ros.interface import CHANNELS, MODEL_OUTPUTS
 from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.units import ATMOSPHERE
 
 
-COLUMNS = {'inlet_pressure': ('p_in', 'fluid_pressure'),
-           'outlet_pressure': ('p_out', 'fluid_pressure'),
-           'case_pressure': ('p_case', 'fluid_pressure'),
-           'fluid_temperature': ('temperature', 'temperature'),
-           'load_torque': ('torque', 'data')}
+COLUMNS = {CHANNELS[c].topic: (c, CHANNELS[c].field)
+           for c in ('p_in', 'p_out', 'p_case', 'temperature', 'torque')}
 """DESIGN.md topic -> (bench column, message field)."""
 
-REQUIRED_TOPICS = ('inlet_pressure', 'outlet_pressure', 'joint_states')
-"""Topics a calibration bag must have, besides flow_measured or flow_command."""
+_FLOWS = (CHANNELS['flow_measured'].topic, CHANNELS['flow'].topic)  # flowmeter first
+_SHAFT = CHANNELS['measured_speed']
 
-MODEL_OUTPUTS = ('predicted_joint_state', 'speed_residual', 'losses/')
-"""Topics the motor_model node publishes: predictions, not measurements."""
+REQUIRED_TOPICS = tuple(CHANNELS[c].topic for c in ('p_in', 'p_out', 'measured_speed'))
+"""Topics a calibration bag must have, besides flow_measured or flow_command."""
 
 
 def _on(series: Series, field: str, t: FloatArray, t0: int) -> FloatArray:
@@ -59,7 +57,7 @@ def _on(series: Series, field: str, t: FloatArray, t0: int) -> FloatArray:
 def _extra_topics(path: Path) -> dict[str, str]:
     infos = list_topics(path)
     out = {}
-    known = set(COLUMNS) | {'flow_measured', 'flow_command', 'joint_states'}
+    known = set(COLUMNS) | {*_FLOWS, _SHAFT.topic}
     for name, info in infos.items():
         base = name.rstrip('/').rsplit('/', 1)[-1]
         if (base in known or info.msgtype not in FIELDS or info.count == 0
@@ -97,13 +95,13 @@ def read_bag(path: str | Path, joint: str | None = 'motor_shaft',
 
     """
     path = Path(path)
-    wanted = ['flow_measured', 'flow_command', 'joint_states', *COLUMNS]
+    wanted = [*_FLOWS, _SHAFT.topic, *COLUMNS]
     try:
         series = read_series(path, wanted, topic_map, joint)
     except BagError as err:
         msg = f'bag {str(path)!r}: {err}'
         raise DataError(msg) from None
-    flow_topic = next((n for n in ('flow_measured', 'flow_command')
+    flow_topic = next((n for n in _FLOWS
                        if n in series and len(series[n])), None)
     missing = [n for n in REQUIRED_TOPICS if n not in series or not len(series[n])]
     if flow_topic is None:
@@ -122,11 +120,11 @@ def read_bag(path: str | Path, joint: str | None = 'motor_shaft',
     except BagError as err:
         msg = f'bag {str(path)!r}: {err}'
         raise DataError(msg) from None
-    shaft = series['joint_states']
+    shaft = series[_SHAFT.topic]
     t0 = int(shaft.t_ns[0])
     t = (shaft.t_ns - t0) * 1.0e-9
     columns: dict[str, tuple[str, np.ndarray]] = {
-        'time': ('s', t), 'speed': ('rad/s', shaft.fields['velocity']),
+        'time': ('s', t), 'speed': ('rad/s', shaft.fields[_SHAFT.field]),
         'flow': ('m^3/s', _on(series[flow_topic], 'data', t, t0))}
     for topic, (column, field) in COLUMNS.items():
         if topic in series and len(series[topic]):
