@@ -26,7 +26,8 @@ from satmotor_ros.bags.storage import open_bag, TopicInfo
 from satmotor_ros.bags.writer import OutTopic, write_bag
 
 __all__ = [
-    'BagError', 'FIELDS', 'FLOAT64', 'FLUID_PRESSURE', 'JOINT_STATE', 'OutTopic', 'Series', 'TEMPERATURE', 'TopicInfo', 'decode',
+    'BagError', 'FIELDS', 'FLOAT64', 'FLUID_PRESSURE', 'JOINT_STATE', 'OutTopic', 'Series',
+    'TEMPERATURE', 'TopicInfo', 'decode',
     'describe_topics', 'encode_many', 'encode_message', 'list_topics', 'match_topics',
     'missing_topics', 'open_bag', 'parse_topic_map', 'read_series', 'write_bag',
 ]
