@@ -21,6 +21,7 @@ from typing import NamedTuple
 
 from satmotor_ros.model import load_motor, ModelError, MotorModel
 from satmotor_ros.model.config import MotorSpec
+from satmotor_ros.model.motor import DisplacementLaw
 from satmotor_ros.model.results import COMPONENTS
 
 FLOAT64 = 'std_msgs/msg/Float64'
@@ -141,7 +142,7 @@ class MotorOptions:
 
     liquid: str = 'oil'
     motor_file: str = ''
-    displacement_law: str = 'eq33'
+    displacement_law: DisplacementLaw = 'eq33'
     viscosity: float = 0.0  # [m^2/s]; 0: the set's own
     density: float = 0.0  # [kg/m^3]; 0: the set's own
     bulk_modulus: float = 0.0  # [Pa]; 0: the set's own

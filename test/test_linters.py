@@ -1,16 +1,18 @@
 # SPDX-License-Identifier: Apache-2.0
 """
-ament's Python linters, run as tests the way ``colcon test`` runs them.
+ament's Python linters, run as tests the way ``colcon test`` runs them, and mypy.
 
-Both check the package from the repository root.  Directories whose names start with
-``.`` or ``_`` (``.venv``, ``.git``, ``__pycache__``) are skipped by the linters
-themselves; the build and output trees are excluded here.
+Both ament linters check the package from the repository root.  Directories whose names
+start with ``.`` or ``_`` (``.venv``, ``.git``, ``__pycache__``) are skipped by the linters
+themselves; the build and output trees are excluded here.  mypy checks satmotor_ros/ as
+mypy.ini says (strict).
 """
 
 from pathlib import Path
 
 from ament_flake8.main import main_with_errors
 from ament_pep257.main import main as pep257_main
+from mypy import api as mypy_api
 import pytest
 
 REPO_ROOT = Path(__file__).resolve().parent.parent
@@ -35,3 +37,12 @@ def test_pep257(monkeypatch):
     excludes = [str(REPO_ROOT / name) for name in EXCLUDED_DIRS]
     rc = pep257_main(argv=['.', '--exclude', *excludes])
     assert rc == 0, 'Found code style errors / warnings'
+
+
+@pytest.mark.linter
+def test_mypy(monkeypatch):
+    """The package type-checks under mypy.ini (strict): no error, no unused ignore."""
+    monkeypatch.chdir(REPO_ROOT)
+    stdout, stderr, rc = mypy_api.run(['--config-file', str(REPO_ROOT / 'mypy.ini')])
+    assert rc == 0, f'mypy found errors:\n{stdout}{stderr}'
+    assert 'Success: no issues found' in stdout, stdout

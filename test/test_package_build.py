@@ -49,7 +49,8 @@ ROSDEP_KEYS = {'numpy': 'python3-numpy', 'scipy': 'python3-scipy', 'pyyaml': 'py
                'matplotlib': 'python3-matplotlib'}
 
 # Top-level entries of a checkout that are not package source.
-NOT_SOURCE = {'.git', '.venv', '.pytest_cache', '.hypothesis', 'build', 'install', 'log', 'out'}
+NOT_SOURCE = {'.git', '.venv', '.pytest_cache', '.hypothesis', '.mypy_cache', 'build', 'install',
+              'log', 'out'}
 
 
 def _ignore_non_source(directory, names):
@@ -431,11 +432,23 @@ def test_pip_wheel_ships_config_as_package_data(wheel):
     assert f'{PACKAGE}/py.typed' in names
 
 
+def _runtime_nodes(tree):
+    """Yield the nodes of a module except those under ``if TYPE_CHECKING:`` (never run)."""
+    todo = [tree]
+    while todo:
+        node = todo.pop()
+        yield node
+        if isinstance(node, ast.If) and 'TYPE_CHECKING' in ast.unparse(node.test):
+            todo.extend(node.orelse)
+        else:
+            todo.extend(ast.iter_child_nodes(node))
+
+
 def _third_party_imports():
-    """Map each module imported by satmotor_ros from outside it and the stdlib to a file."""
+    """Map each module imported at run time by satmotor_ros from outside it and the stdlib."""
     found = {}
     for path in sorted((REPO_ROOT / PACKAGE).rglob('*.py')):
-        for node in ast.walk(ast.parse(path.read_text(), str(path))):
+        for node in _runtime_nodes(ast.parse(path.read_text(), str(path))):
             if isinstance(node, ast.Import):
                 names = [alias.name for alias in node.names]
             elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:

@@ -69,7 +69,7 @@ class _Cursor:
         return at, value
 
     def string(self, structural: bool = False) -> str:
-        _, n = self.number('I', 4, structural=True)
+        n = int(self.number('I', 4, structural=True)[1])
         at = self.pos
         self.pos += n
         if self.pos > len(self.data):
@@ -79,7 +79,7 @@ class _Cursor:
         return bytes(self.data[at:at + n]).rstrip(b'\0').decode('utf-8', 'replace')
 
     def doubles(self) -> list[int]:
-        _, n = self.number('I', 4, structural=True)
+        n = int(self.number('I', 4, structural=True)[1])
         if n:
             self.align(8)
         at = self.pos
@@ -138,7 +138,7 @@ def parse_layout(msgtype: str, data: bytes, joint: str | None = None) -> Layout:
 
 
 def _joint_layout(cur: _Cursor, stamp: int, joint: str | None) -> Layout:
-    _, count = cur.number('I', 4, structural=True)
+    count = int(cur.number('I', 4, structural=True)[1])
     names = [cur.string(structural=True) for _ in range(count)]
     sequences = [cur.doubles() for _ in range(3)]
     if joint is None:

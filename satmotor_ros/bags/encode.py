@@ -80,8 +80,7 @@ def encode_message(msgtype: str, values: Mapping[str, float], stamp_ns: int = 0,
         for joint in joints:
             out.string(joint)
         for name in FIELDS[JOINT_STATE]:
-            value = values.get(name, ())
-            out.doubles([float(value)] if np.ndim(value) == 0 else [float(v) for v in value])
+            out.doubles([float(v) for v in np.atleast_1d(values.get(name, np.empty(0)))])
     else:
         raise BagError(f'{msgtype} has no encoder (supported: {", ".join(FIELDS)})')
     return bytes(out.buf)

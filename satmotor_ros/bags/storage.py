@@ -13,6 +13,7 @@ directory) are read.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 import re
@@ -41,7 +42,11 @@ class TopicInfo(NamedTuple):
     name: str
     msgtype: str  # normalised: 'pkg/msg/Type'
     serialization: str  # 'cdr' for ROS 2
-    count: int  # messages in the storage
+    count: int  # type: ignore[assignment]  # messages in the storage (not tuple.count)
+
+
+Found = Iterator[tuple[TopicInfo, list[tuple[np.ndarray, ...]]]]
+"""What a storage file holds: each topic with its message parts (times, buffer, ...)."""
 
 
 class RawTopic(NamedTuple):
@@ -177,8 +182,8 @@ class Bag:
 
         """
         if self.storage == 'mcap':
-            summaries = [read_summary(path) for path in self.files]
-            if all(s is not None for s in summaries):
+            summaries = [s for s in map(read_summary, self.files) if s is not None]
+            if len(summaries) == len(self.files):
                 infos: dict[str, TopicInfo] = {}
                 for summary in summaries:
                     for info, _ in _mcap_topics(summary):
@@ -232,7 +237,7 @@ class Bag:
         return infos, {name: _compact(parts[name]) for name in wanted & set(infos)}
 
     def _read_sqlite_file(self, path: Path, wanted: set[str],
-                          count: bool):  # noqa: ANN202 (generator)
+                          count: bool) -> Found:
         if path.suffix == '.zstd':
             path = self._decompress_file(path)
         uri = f'{path.resolve().as_uri()}?mode=ro&immutable=1'
@@ -298,11 +303,11 @@ class Bag:
                                f'messages in metadata.yaml and {found.count} in {where}')
 
 
-def _read_mcap_file(path: Path, wanted: set[str], count: bool):  # noqa: ANN202, ARG001
+def _read_mcap_file(path: Path, wanted: set[str], count: bool) -> Found:  # noqa: ARG001
     return _mcap_topics(read_mcap(path, wanted))
 
 
-def _mcap_topics(content: McapContent):  # noqa: ANN202 (generator)
+def _mcap_topics(content: McapContent) -> Found:
     for channel_id, channel in content.channels.items():
         info = TopicInfo(channel.topic, normalize_type(channel.msgtype), channel.encoding,
                          content.counts.get(channel_id, 0))

@@ -10,7 +10,8 @@ import sys
 from typing import Any
 
 from satmotor_ros.interface import DISPLACEMENT_LAWS, MotorOptions, OptionError
-from satmotor_ros.model.units import parse_quantity, UnitError
+from satmotor_ros.model.errors import UnitError
+from satmotor_ros.model.units import parse_quantity
 
 
 class CliError(Exception):
@@ -27,8 +28,9 @@ _USER_LIQUID = {'viscosity': ('viscosity', 'cSt'), 'density': ('density', 'kg/m^
 _PREFIX = 'motor_options.'  # the argparse dest of a motor option: prefix + field
 
 
-def subcommand(sub: argparse._SubParsersAction, name: str, command: Callable[..., int],
-               help_text: str, description: str) -> argparse.ArgumentParser:
+def subcommand(sub: argparse._SubParsersAction[argparse.ArgumentParser], name: str,
+               command: Callable[..., int], help_text: str,
+               description: str) -> argparse.ArgumentParser:
     """
     Add a subcommand whose parsed options are passed to `command` as keywords.
 
@@ -161,14 +163,15 @@ def quantity(flag: str, text: str, kind: str, default_unit: str, *,
     return value
 
 
-def fail(err: Exception) -> int:
+def fail(err: Exception | str) -> int:
     """
     Print one error line to stderr.
 
     Parameters
     ----------
-    err : Exception
-        The error to report; an :class:`OptionError` names the ``satmotor`` option, [-]
+    err : Exception or str
+        The error (or its message) to report; an :class:`OptionError` names the
+        ``satmotor`` option, [-]
 
     Returns
     -------

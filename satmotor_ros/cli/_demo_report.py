@@ -330,11 +330,11 @@ def write_report(out: Path, runs: list[RunResult], cycle: Cycle,
     for liquid in dict.fromkeys(r.liquid for r in runs):
         tracks = {r.feedforward: Tracking(r) for r in runs if r.liquid == liquid}
         for ff, tr in tracks.items():
-            s = summary(tr.metrics())
+            stats = summary(tr.metrics())
             table.append(f'| {liquid} | {"model" if ff == "model" else "none (PI alone)"} | '
-                         f'{s["rise"] * 1e3:.0f} | {s["overshoot"]:.1f} | '
-                         f'{s["sse"] / RPM:.3f} | {s["iae_steps"]:.2f} | '
-                         f'{s["iae_loads"]:.2f} | {s["iae"]:.2f} |')
+                         f'{stats["rise"] * 1e3:.0f} | {stats["overshoot"]:.1f} | '
+                         f'{stats["sse"] / RPM:.3f} | {stats["iae_steps"]:.2f} | '
+                         f'{stats["iae_loads"]:.2f} | {stats["iae"]:.2f} |')
         tracking = _plot_tracking(out, liquid, tracks)
         main = tracks.get('model') or next(iter(tracks.values()))
         after = min(1.0, 0.5 * min(s.duration for s in cycle.segments))

@@ -10,12 +10,13 @@ from satmotor_ros.cli._common import add_motor_options, fail, subcommand
 from satmotor_ros.identify import BenchTable, calibrate, DataError, IdentificationError, Options
 from satmotor_ros.identify import read_csv
 from satmotor_ros.identify.output import write_json, write_yaml
+from satmotor_ros.identify.pipeline import Mode
 from satmotor_ros.identify.report import write_report
 from satmotor_ros.interface import MotorOptions
 from satmotor_ros.model import ModelError
 
 
-def add_parser(sub: argparse._SubParsersAction) -> None:
+def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Register ``satmotor calibrate`` and its options."""
     parser = subcommand(
         sub, 'calibrate', command, 'fit the model to bench data and find the effect it lacks',
@@ -65,7 +66,7 @@ def load_data(data: str) -> BenchTable:
     return read_csv(path)
 
 
-def command(data: str, out: str, mode: str, alpha: float, folds: int,
+def command(data: str, out: str, mode: Mode, alpha: float, folds: int,
             options: MotorOptions) -> int:
     """
     Calibrate and write the three outputs.

@@ -36,7 +36,7 @@ class Figure:
     plotted: tuple[str, ...]  # which columns are drawn; line styles in order
 
 
-def add_parser(sub: argparse._SubParsersAction) -> None:
+def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Register ``satmotor characteristics`` and its options."""
     parser = subcommand(
         sub, 'characteristics', command, 'write characteristic plots (PNG) and their data (CSV)',

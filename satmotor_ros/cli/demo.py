@@ -27,7 +27,7 @@ LIQUIDS = ('water', 'oil')
 FEEDFORWARDS = ('model', 'none')
 
 
-def add_parser(sub: argparse._SubParsersAction) -> None:
+def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Register ``satmotor demo`` and its options."""
     parser = subcommand(
         sub, 'demo', command, 'run virtual motor, model and controller over ROS; bag + report',

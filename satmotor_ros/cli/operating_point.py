@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import json
+from typing import TypedDict
 
 from satmotor_ros.cli._common import add_motor_options, CliError, fail, quantity, subcommand
 from satmotor_ros.interface import MotorOptions
@@ -24,7 +25,25 @@ _LABELS = {
 }
 
 
-def add_parser(sub: argparse._SubParsersAction) -> None:
+class PointReport(TypedDict):
+    """The operating point as ``--json`` prints it, in hydraulic units."""
+
+    motor: str
+    coefficients: str
+    liquid: str
+    displacement_law: str
+    flow_lpm: float
+    dp_MPa: float
+    dp_i_MPa: float
+    speed_rpm: float
+    speed_rad_s: float
+    speed_loss_rpm: float
+    losses_lpm: dict[str, float]
+    status: str
+    warnings: list[str]
+
+
+def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Register ``satmotor operating-point`` and its options."""
     parser = subcommand(
         sub, 'operating-point', command, 'speed and losses at one flow and pressure drop',
@@ -74,8 +93,10 @@ def command(flow: str, dp: str | None, dp_i: str | None, p_ex: str, as_json: boo
         pex = quantity('--p-ex', p_ex, 'pressure', 'MPa')
         if dp is not None:
             op = model.speed(q, quantity('--dp', dp, 'pressure', 'MPa'), p_ex=pex)
-        else:
+        elif dp_i is not None:
             op = model.speed(q, dp_i=quantity('--dp-i', dp_i, 'pressure', 'MPa'), p_ex=pex)
+        else:
+            raise CliError('give --dp or --dp-i')
     except (CliError, ModelError) as err:
         return fail(err)
     result = _result(model, op)
@@ -83,7 +104,7 @@ def command(flow: str, dp: str | None, dp_i: str | None, p_ex: str, as_json: boo
     return 0
 
 
-def _result(model: MotorModel, op: OperatingPoints) -> dict:
+def _result(model: MotorModel, op: OperatingPoints) -> PointReport:
     status = int(op.status)
     return {
         'motor': model.name,
@@ -113,7 +134,7 @@ def _warnings(status: int) -> list[str]:
     return notes
 
 
-def _table(r: dict) -> str:
+def _table(r: PointReport) -> str:
     lines = [
         f'{r["motor"]} on {r["liquid"]} ({r["coefficients"]} coefficients), '
         f'displacement law {r["displacement_law"]}',

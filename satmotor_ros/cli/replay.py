@@ -23,7 +23,7 @@ from satmotor_ros.cli import _fastcsv as fastcsv
 from satmotor_ros.cli._common import add_motor_options, CliError, fail, subcommand
 from satmotor_ros.interface import (CHANNELS, JOINT_NAME, LOSS_COMPONENTS, LOSSES_PREFIX,
                                     MotorOptions, PREDICTED_JOINT_STATE, SPEED_RESIDUAL)
-from satmotor_ros.model import describe_status, ModelError
+from satmotor_ros.model import describe_status, ModelError, MotorModel
 from satmotor_ros.model.units import LPM, MPA, RPM
 from satmotor_ros.prediction import (combine_batch, driving_times, INPUTS, InputState, Level,
                                      MODES, predict, PredictionBatch, Progress, REQUIRED, Rule,
@@ -41,7 +41,7 @@ _OUTPUT_COLUMNS = (('dp', 'dp [MPa]', MPA, 9), ('dp_i', 'dp_i [MPa]', MPA, 9),
                    ('residual', 'residual [rpm]', RPM, 9))
 
 
-def add_parser(sub: argparse._SubParsersAction) -> None:
+def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Register ``satmotor replay`` and its options."""
     parser = subcommand(
         sub, 'replay', command, "run the motor_model node's prediction over a recorded bag",
@@ -180,7 +180,7 @@ def inputs_of(series: dict[str, Series]) -> dict[str, tuple[np.ndarray, np.ndarr
     return inputs
 
 
-def _predict(model, rule: Rule, series: dict[str, Series]) -> PredictionBatch:  # noqa: ANN001
+def _predict(model: MotorModel, rule: Rule, series: dict[str, Series]) -> PredictionBatch:
     inputs = inputs_of(series)
     first = min(int(t[0]) for t, _ in inputs.values())
     last = max(int(t[-1]) for t, _ in inputs.values())
@@ -332,7 +332,7 @@ def _write_bag(path: Path, series: dict[str, Series], batch: PredictionBatch,
     prefix = flow_topic[:-len('flow_command')] if flow_topic.endswith('flow_command') else '/'
     prefix = prefix if prefix.startswith('/') else '/' + prefix
     topics = [OutTopic(s.topic if s.topic.startswith('/') else '/' + s.topic, s.msgtype,
-                       s.t_ns, s.raw) for s in series.values() if len(s)]
+                       s.t_ns, s.raw) for s in series.values() if len(s) and s.raw is not None]
     valid = batch.valid
     t_ns = batch.snapshots.stamp_ns[valid]
     topics.append(OutTopic(prefix + PREDICTED_JOINT_STATE, JOINT_STATE, t_ns, encode_many(

@@ -11,7 +11,7 @@ selector, and :mod:`.pipeline` composes them; :mod:`.output` and
 :mod:`.report` write the results, :mod:`.synthetic` makes test data.
 """
 
-from satmotor_ros.identify.candidates import build_library, Candidate, TERMS
+from satmotor_ros.identify.candidates import build_library, Candidate
 from satmotor_ros.identify.errors import DataError, IdentificationError
 from satmotor_ros.identify.fit import check_identifiable, FitReport, LossFit
 from satmotor_ros.identify.parts import loss_parts, LossParts, Modifier, predict_flow
@@ -20,6 +20,7 @@ from satmotor_ros.identify.selection import CrossValidatedSelector, Errors, Sele
 from satmotor_ros.identify.steady import extract_steady, SteadyTolerance
 from satmotor_ros.identify.table import BenchTable, read_csv, REQUIRED, write_csv
 from satmotor_ros.identify.viscosity import standard_law, ViscosityLaw
+from satmotor_ros.model.effects import TERMS
 
 __all__ = [
     'BenchTable', 'Calibration', 'Candidate', 'CrossValidatedSelector', 'DataError', 'Errors',

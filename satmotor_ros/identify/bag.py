@@ -106,7 +106,7 @@ def read_bag(path: str | Path, joint: str | None = 'motor_shaft',
     missing = [n for n in REQUIRED_TOPICS if n not in series or not len(series[n])]
     if flow_topic is None:
         missing.insert(0, 'flow_measured (or flow_command)')
-    if missing:
+    if missing or flow_topic is None:
         try:
             has = describe_topics(list_topics(path), limit=5)
         except BagError:
@@ -122,7 +122,7 @@ def read_bag(path: str | Path, joint: str | None = 'motor_shaft',
         raise DataError(msg) from None
     shaft = series[_SHAFT.topic]
     t0 = int(shaft.t_ns[0])
-    t = (shaft.t_ns - t0) * 1.0e-9
+    t = (shaft.t_ns - t0).astype(np.float64) * 1.0e-9
     columns: dict[str, tuple[str, np.ndarray]] = {
         'time': ('s', t), 'speed': ('rad/s', shaft.fields[_SHAFT.field]),
         'flow': ('m^3/s', _on(series[flow_topic], 'data', t, t0))}

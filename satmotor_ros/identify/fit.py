@@ -23,7 +23,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 import math
-from typing import Self
+from typing import TYPE_CHECKING
 
 import numpy as np
 from satmotor_ros.identify.candidates import Candidate
@@ -32,6 +32,9 @@ from satmotor_ros.identify.parts import LossParts, NO_EFFECT, predict_flow, SCAL
 from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.units import LPM, MPA, RPM
 from scipy import optimize, special
+
+if TYPE_CHECKING:  # typing.Self is Python 3.11+
+    from typing_extensions import Self
 
 MIN_POINTS = 8
 """Fewest points for 3 coefficients, one effect and a residual estimate."""
@@ -173,7 +176,7 @@ class LossFit:
             msg = 'the fit produced non-finite residuals: the data are outside the model'
             raise IdentificationError(msg)
         self.u_ = result.x
-        self.jac_ = result.jac
+        self.jac_ = np.asarray(result.jac, dtype=float)
         self.rss_ = float(np.sum(result.fun[:n_data] ** 2)) * LPM ** 2
         self.n_ = int(index.size)
         return self

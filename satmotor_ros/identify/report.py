@@ -6,22 +6,24 @@ from __future__ import annotations
 from dataclasses import replace
 import json
 from pathlib import Path
+from types import ModuleType
 
 import numpy as np
 
-from satmotor_ros.identify.candidates import describe, TERMS
+from satmotor_ros.identify.candidates import describe
 from satmotor_ros.identify.output import effect_block, fitted_coefficients
 from satmotor_ros.identify.parts import SCALES
 from satmotor_ros.identify.pipeline import Calibration
 from satmotor_ros.model import MotorModel
 from satmotor_ros.model._typing import FloatArray
+from satmotor_ros.model.effects import TERMS
 from satmotor_ros.model.units import LPM, MPA, RPM
 
 _UNITS = {'time': ('s', 1.0), 'revolutions': ('rev', 1.0), 'temperature': ('degC', 1.0),
           'p_case': ('MPa', MPA), 'p_out': ('MPa', MPA), 'p_in': ('MPa', MPA)}
 
 
-def _pyplot():
+def _pyplot() -> ModuleType:
     import matplotlib
     matplotlib.use('Agg')
     from matplotlib import pyplot
@@ -51,11 +53,12 @@ def _plot_residuals(cal: Calibration, path: Path) -> None:
     rows = int(np.ceil(len(regs) / cols))
     fig, axes = plt.subplots(rows, cols, figsize=(12, 3.0 * rows), squeeze=False)
     before = cal.selection.baseline.cv_error / LPM
-    after = cal.selection.chosen.cv_error / LPM if cal.selection.chosen else None
+    chosen = cal.selection.chosen
     for ax, (label, x) in zip(axes.flat, regs.items()):
         ax.plot(x, before, 'o', ms=3, alpha=0.6, label='before (no effect)')
-        if after is not None:
-            ax.plot(x, after, 'o', ms=3, alpha=0.6, label=f'after ({cal.chosen.label})')
+        if chosen is not None:
+            ax.plot(x, chosen.cv_error / LPM, 'o', ms=3, alpha=0.6,
+                    label=f'after ({chosen.label})')
         ax.axhline(0.0, color='k', lw=0.8)
         ax.set_xlabel(label)
         ax.set_ylabel('residual of Q_vl [l/min]')
@@ -107,7 +110,8 @@ def _plot_characteristics(cal: Calibration, path: Path) -> None:
     right.plot(measured, before, 'o', ms=3, alpha=0.6, label='before (no effect)')
     if cal.selection.chosen is not None:
         after = measured - cal.selection.chosen.cv_error / LPM
-        right.plot(measured, after, 'o', ms=3, alpha=0.6, label=f'after ({cal.chosen.label})')
+        right.plot(measured, after, 'o', ms=3, alpha=0.6,
+                   label=f'after ({cal.selection.chosen.label})')
     lim = [min(measured.min(), before.min()), max(measured.max(), before.max())]
     right.plot(lim, lim, 'k-', lw=0.8)
     right.set_xlabel('measured Q_vl [l/min]')
@@ -152,7 +156,7 @@ def _table(rows: list[list[str]], header: list[str]) -> str:
     return '\n'.join(lines)
 
 
-def write_report(cal: Calibration, out: Path, summary: dict) -> Path:
+def write_report(cal: Calibration, out: Path, summary: dict[str, object]) -> Path:
     """
     Write ``report.md`` and its three PNG plots into `out`.
 
@@ -204,7 +208,8 @@ def write_report(cal: Calibration, out: Path, summary: dict) -> Path:
               'identifiable from Q, n and dp and keep their packaged values.', '']
     lines += ['## Candidates', '', _table(
         [[f'`{s.label}`', f'{s.cv_rmse / LPM:.4g}', f'{s.p_value:.2g}',
-          f'{s.fit.effect_coefficient:.4g} {s.candidate.unit}'] for s in sel.ranking],
+          f'{s.fit.effect_coefficient:.4g} {s.candidate.unit if s.candidate else ""}']
+         for s in sel.ranking],
         ['candidate', 'CV RMSE [l/min]', 'p (F-test)', 'coefficient']), '',
         f'No effect: CV RMSE {sel.baseline.cv_rmse / LPM:.4g} l/min. An effect is accepted '
         f'when p < {sel.alpha:g}/{len(sel.ranking)} (Bonferroni) and it cuts the CV error by '

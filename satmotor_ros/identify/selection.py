@@ -82,6 +82,11 @@ class Score:
         """Return the candidate's label, or ``'none'`` for the baseline."""
         return self.candidate.label if self.candidate is not None else 'none'
 
+    @property
+    def effect(self) -> str:
+        """Return the candidate's effect, or ``'none'`` for the baseline."""
+        return self.candidate.effect if self.candidate is not None else 'none'
+
 
 @dataclass(frozen=True)
 class Selection:
@@ -95,14 +100,14 @@ class Selection:
     alpha: float  # family-wise significance level [-]
 
 
-def priority(candidate: Candidate) -> int:
+def priority(effect: str) -> int:
     """
     Rank a candidate's kind for near ties: named effects, then channels, then terms.
 
     Parameters
     ----------
-    candidate : Candidate
-        The candidate, [-]
+    effect : str
+        The candidate's effect, [-]
 
     Returns
     -------
@@ -110,8 +115,7 @@ def priority(candidate: Candidate) -> int:
         0 for a named physical effect, 1 for ``channel:``, 2 for ``term:``.
 
     """
-    return 2 if candidate.effect.startswith('term:') else int(
-        candidate.effect.startswith('channel:'))
+    return 2 if effect.startswith('term:') else int(effect.startswith('channel:'))
 
 
 def folds(n: int, k: int, time_ordered: bool, seed: int = 0) -> list[np.ndarray]:
@@ -260,11 +264,11 @@ class CrossValidatedSelector:
             s.cv_rmse <= (1.0 + self.tie) * top.cv_rmse
             or s.cv_rmse - top.cv_rmse <= self.tie * removed)]
         contenders = [s for s in close if s.cv_rmse <= (1.0 + self.tie) * top.cv_rmse]
-        best = min(contenders, key=lambda s: (priority(s.candidate), s.cv_rmse))
+        best = min(contenders, key=lambda s: (priority(s.effect), s.cv_rmse))
         # a runner-up also when it removes nearly all the error the winner removes: on data
         # with little noise the two errors left are both tiny and far apart in ratio
-        others = [s for s in close if s.candidate.effect != best.candidate.effect]
-        others.sort(key=lambda s: priority(s.candidate) != priority(best.candidate))
+        others = [s for s in close if s.effect != best.effect]
+        others.sort(key=lambda s: priority(s.effect) != priority(best.effect))
         runner = others[0] if others else None
         gain = 1.0 - best.cv_rmse / baseline.cv_rmse
         verdict = (f'{best.label}: cuts the cross-validated error by {100 * gain:.1f} %, '
@@ -274,6 +278,6 @@ class CrossValidatedSelector:
             verdict += (f'; near tie with {runner.label} (cross-validated error '
                         f'{100 * (runner.cv_rmse / best.cv_rmse - 1):+.1f} %, it cuts the '
                         f'error by {100 * runner_gain:.1f} %): the data barely tell them apart')
-            if priority(runner.candidate) > priority(best.candidate):
+            if priority(runner.effect) > priority(best.effect):
                 verdict += ', and a named physical effect goes before a generic term'
         return Selection(baseline, ranking, best, runner, verdict, self.alpha)

@@ -166,8 +166,8 @@ def steady_runs(table: BenchTable, time: FloatArray,
     channels = _channels(table, tol)
     mask = _steady_mask(channels, time, tol.window)
     edges = np.flatnonzero(np.diff(np.concatenate(([0], mask.astype(np.int8), [0]))))
-    runs = []
-    stack = []
+    runs: list[tuple[int, int]] = []
+    stack: list[tuple[int, int]] = []
     for a, b in zip(edges[::2], edges[1::2]):
         a = int(np.searchsorted(time, time[a] + tol.settle)) if tol.settle else int(a)
         stack.append((a, int(b)))

@@ -59,7 +59,7 @@ def run_case(case: Case) -> tuple[str, str, str, float, float, float]:
     # a steady point's noise; a time series' windows average many samples (not counted)
     noise = float('nan') if series else float(
         np.sqrt(np.mean(plan.noise_lpm(table.flow, cal.model) ** 2)))
-    return (chosen, runner.candidate.effect if runner else '', effect,
+    return (chosen, runner.effect if runner else '', effect,
             cal.error_before.rmse_lpm, cal.error_after.rmse_lpm, noise)
 
 
@@ -101,7 +101,7 @@ def main(argv: Sequence[str] | None = None) -> int:
           'median error cut | cut >= 3x or within 1.5x noise |')
     print('| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: |')
     keys = sorted({c[:3] for c in cases}, key=lambda k: (k[0], args.effects.index(k[1]), k[2]))
-    totals = {'hit': [], 'fp': []}
+    totals: dict[str, list[float]] = {'hit': [], 'fp': []}
     for key in keys:
         rows = [r for c, r in zip(cases, results) if c[:3] == key]
         chosen = np.array([r[0] for r in rows])

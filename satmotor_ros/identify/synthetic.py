@@ -19,10 +19,10 @@ import re
 
 import numpy as np
 
-from satmotor_ros.identify.candidates import TERMS
 from satmotor_ros.identify.table import BenchTable
 from satmotor_ros.model import load_motor, MotorModel
 from satmotor_ros.model._typing import FloatArray
+from satmotor_ros.model.effects import TERMS
 from satmotor_ros.model.units import LPM, MPA, RPM
 
 WATER_TABLE = ((10.0, 1.3059e-3), (20.0, 1.0016e-3), (30.0, 0.7972e-3), (40.0, 0.6527e-3),

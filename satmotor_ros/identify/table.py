@@ -14,7 +14,8 @@ import numpy as np
 
 from satmotor_ros.identify.errors import DataError
 from satmotor_ros.model._typing import FloatArray
-from satmotor_ros.model.units import kinds, RPM, to_si, UnitError, units_of
+from satmotor_ros.model.errors import UnitError
+from satmotor_ros.model.units import kinds, RPM, to_si, units_of
 
 REQUIRED = ('speed', 'flow', 'p_in', 'p_out')
 """Columns every bench table must have (DESIGN.md, "Bench tables")."""
@@ -256,8 +257,8 @@ def table_from_columns(columns: Mapping[str, tuple[str, np.ndarray]], source: st
                  f'{", ".join(REQUIRED)}',)
     units = {name: unit for name, (unit, _) in columns.items()}
     extra = {name: values[good].copy() for name, values in si.items() if name not in REQUIRED}
-    return BenchTable(*(si[name][good].copy() for name in REQUIRED), extra, units, source,
-                      time_series, notes)
+    speed, flow, p_in, p_out = (si[name][good].copy() for name in REQUIRED)
+    return BenchTable(speed, flow, p_in, p_out, extra, units, source, time_series, notes)
 
 
 def read_csv(path: str | Path) -> BenchTable:

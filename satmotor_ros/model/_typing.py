@@ -9,4 +9,4 @@ import numpy as np
 import numpy.typing as npt
 
 FloatArray: TypeAlias = npt.NDArray[np.float64]
-ArrayLike: TypeAlias = Union[float, npt.ArrayLike]
+ArrayLike: TypeAlias = Union[float, FloatArray]

@@ -3,7 +3,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 import numpy as np
 
@@ -21,12 +21,12 @@ its own elements converge: 3-4x faster than solving a whole batch at once. A
 closed-form evaluation is a single pass, where chunking would only add a copy.
 """
 
-Chunk = dict[str, np.ndarray]
-"""Results of one chunk by field name: OperatingPoints fields and COMPONENTS."""
+Chunk = dict[str, 'np.ndarray | float']
+"""Results of one chunk by field name: OperatingPoints fields and COMPONENTS (0.0: none)."""
 
 
-def _join(parts: list[Chunk], shape: tuple[int, ...]) -> Chunk:
-    joined = {}
+def _join(parts: list[Chunk], shape: tuple[int, ...]) -> dict[str, np.ndarray]:
+    joined: dict[str, np.ndarray] = {}
     for key in parts[0]:
         values = [p[key] for p in parts]
         scalar = [np.ndim(v) == 0 for v in values]
@@ -34,8 +34,9 @@ def _join(parts: list[Chunk], shape: tuple[int, ...]) -> Chunk:
             joined[key] = np.zeros(shape)  # calloc'd: no pages written
             continue
         if any(scalar):  # 0 in some chunks, masked to NaN in others
-            values = [np.broadcast_to(v, p['status'].shape) for v, p in zip(values, parts)]
-        joined[key] = (np.concatenate(values) if len(values) > 1 else values[0]).reshape(shape)
+            values = [np.broadcast_to(v, np.shape(p['status'])) for v, p in zip(values, parts)]
+        joined[key] = (np.concatenate(values) if len(values) > 1
+                       else np.asarray(values[0])).reshape(shape)
     return joined
 
 
@@ -64,7 +65,7 @@ def mask_invalid(chunk: Chunk, status: Status) -> Chunk:
     return chunk
 
 
-def run(core: Callable[..., Chunk], arrays: list[FloatArray], status: Status,
+def run(core: Callable[..., Chunk], arrays: Sequence[FloatArray], status: Status,
         given: dict[str, FloatArray], iterative: bool,
         geometry: MotorGeometry) -> OperatingPoints:
     """
@@ -74,7 +75,7 @@ def run(core: Callable[..., Chunk], arrays: list[FloatArray], status: Status,
     ----------
     core : callable
         ``core(*arrays, status, at) -> Chunk`` for one chunk of flat arrays, [-]
-    arrays : list of ndarray
+    arrays : sequence of ndarray
         The screened arguments, broadcast to one shape, [SI]
     status : ndarray of uint8
         Flags from screening, [-]

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from satmotor_ros.model import losses as eq
-from satmotor_ros.model._typing import FloatArray
+from satmotor_ros.model._typing import ArrayLike, FloatArray
 from satmotor_ros.model.coefficients import Liquid, LossCoefficients, MotorGeometry
 from satmotor_ros.model.derived import DerivedCoefficients
 from satmotor_ros.model.laws import DisplacementLaw
@@ -61,7 +61,7 @@ class Equations:
 
     def breakdown(self, speed: FloatArray, dp_i: FloatArray, q_lfg: FloatArray,
                   q_c: FloatArray, q_ex: FloatArray | float,
-                  leak: FloatArray) -> dict[str, FloatArray]:
+                  leak: FloatArray) -> dict[str, ArrayLike]:
         """Return the components of eq. (31) by name; `leak` is Q_Lfg + Q_C + Q_ex."""
         g, d = self.geometry, self.derived
         parts = self.law.share([eq.compressibility_loss(dp_i, speed, d.c_fc_beta, g),

@@ -10,6 +10,8 @@ float-specialised single-point path (:mod:`.point`) inlines both.
 
 from __future__ import annotations
 
+from abc import ABC, abstractmethod
+
 import numpy as np
 
 from satmotor_ros.model import losses as eq
@@ -20,7 +22,7 @@ from satmotor_ros.model.errors import ModelError
 from satmotor_ros.model.units import MPA, RPM
 
 
-class DisplacementLaw:
+class DisplacementLaw(ABC):
     """
     What a law of Delta q holds: the model's constants, geometry and coefficients.
 
@@ -43,6 +45,24 @@ class DisplacementLaw:
                  coef: LossCoefficients) -> None:
         """Keep the constants."""
         self.derived, self.geometry, self.coef = derived, geometry, coef
+
+    @abstractmethod
+    def loss(self, speed: FloatArray, dp_i: FloatArray) -> FloatArray:
+        """Return Delta Q_vl = Delta q n, [m^3/s]."""
+
+    @abstractmethod
+    def slopes(self, speed: FloatArray, dp_i: FloatArray,
+               loss: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """Return d(Delta Q_vl)/dn [m^3/rad] and d(Delta Q_vl)/d(dp_i) [m^3/(s*Pa)]."""
+
+    @abstractmethod
+    def floor(self, dp_i: FloatArray) -> FloatArray:
+        """Return the lowest speed the law is used at, [rad/s]."""
+
+    @abstractmethod
+    def share(self, parts: list[FloatArray], speed: FloatArray,
+              dp_i: FloatArray) -> list[FloatArray]:
+        """Return the components of eqs. (11)-(14) that add up to this law's loss, [m^3/s]."""
 
 
 class PhysicalLaw(DisplacementLaw):

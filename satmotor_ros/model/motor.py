@@ -257,9 +257,11 @@ class MotorModel:
 
     @staticmethod
     def _which_dp(dp: ArrayLike | None, dp_i: ArrayLike | None) -> tuple[str, ArrayLike]:
-        if (dp is None) == (dp_i is None):
-            raise ModelError('give exactly one of dp (between the ports) and dp_i (chambers)')
-        return ('dp', dp) if dp is not None else ('dp_i', dp_i)
+        if dp is not None and dp_i is None:
+            return 'dp', dp
+        if dp_i is not None and dp is None:
+            return 'dp_i', dp_i
+        raise ModelError('give exactly one of dp (between the ports) and dp_i (chambers)')
 
     def breakdown(self, speed: ArrayLike, dp_i: ArrayLike, p_ex: ArrayLike = 0.0,
                   errors: Errors = 'raise',

@@ -15,7 +15,7 @@ from typing import Literal
 import numpy as np
 import numpy.typing as npt
 
-from satmotor_ros.model._typing import ArrayLike, FloatArray
+from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.derived import DerivedCoefficients
 from satmotor_ros.model.errors import InvalidInputError, ModelError
 from satmotor_ros.model.laws import DisplacementLaw
@@ -38,7 +38,7 @@ FLOW_ATOL = 1e-20
 """Absolute resolution of flows in the solves and their check, [m^3/s] (6e-16 l/min)."""
 
 
-def numbers(name: str, value: ArrayLike) -> FloatArray:
+def numbers(name: str, value: object) -> FloatArray:
     """
     Return one argument as a float array, refusing what is not real numbers.
 
@@ -116,8 +116,8 @@ def _screen(name: str, unit: str, value: FloatArray, errors: Errors) -> Status |
             | negative * np.uint8(PointStatus.NEGATIVE)).astype(np.uint8)
 
 
-def prepare(named: dict[str, tuple[ArrayLike, str]],
-            errors: Errors) -> tuple[list[FloatArray], Status]:
+def prepare(named: dict[str, tuple[object, str]],
+            errors: Errors) -> tuple[tuple[FloatArray, ...], Status]:
     """
     Convert, screen and broadcast the arguments of a map.
 
@@ -130,7 +130,7 @@ def prepare(named: dict[str, tuple[ArrayLike, str]],
 
     Returns
     -------
-    arrays : list of ndarray
+    arrays : tuple of ndarray
         The arguments, broadcast to one shape (views, possibly of the caller's arrays).
     status : ndarray of uint8
         NOT_FINITE / NEGATIVE flags per element.
@@ -148,7 +148,7 @@ def prepare(named: dict[str, tuple[ArrayLike, str]],
         shapes = ', '.join(f'{name} {value.shape}' for name, value in zip(named, values))
         msg = f'the shapes of the arguments do not broadcast together: {shapes}'
         raise InvalidInputError(msg) from None
-    status = np.zeros(arrays[0].shape, dtype=np.uint8)
+    status: Status = np.zeros(arrays[0].shape, dtype=np.uint8)
     for flag in flags:
         if flag is not None:
             status |= flag

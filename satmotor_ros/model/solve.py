@@ -7,12 +7,12 @@ from collections.abc import Callable
 
 import numpy as np
 
-from satmotor_ros.model._typing import FloatArray
+from satmotor_ros.model._typing import ArrayLike, FloatArray
 
 
 def solve_increasing(func: Callable[[FloatArray], tuple[FloatArray, FloatArray]],
-                     lo: FloatArray, hi: FloatArray, x0: FloatArray, xtol: FloatArray,
-                     ftol: FloatArray = 0.0, maxiter: int = 60,
+                     lo: FloatArray, hi: FloatArray, x0: FloatArray, xtol: ArrayLike,
+                     ftol: ArrayLike = 0.0, maxiter: int = 60,
                      rtol: float = 0.0) -> tuple[FloatArray, FloatArray]:
     """
     Find x in [lo, hi] with f(x) = 0 for an increasing f, element by element.

@@ -5,19 +5,18 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
 import math
-from typing import Any
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from rclpy.time import Time
 
 
-def format_value(value: Any) -> str:
+def format_value(value: object) -> str:
     """
     Format a key-value's value: floats with 9 significant digits, NaN as 'nan'.
 
     Parameters
     ----------
-    value : Any
+    value : object
         Number, string or flag, [-]
 
     Returns
@@ -32,7 +31,7 @@ def format_value(value: Any) -> str:
 
 
 def status(name: str, hardware_id: str, level: int, message: str,
-           values: Mapping[str, Any]) -> DiagnosticStatus:
+           values: Mapping[str, object]) -> DiagnosticStatus:
     """
     Build one DiagnosticStatus.
 

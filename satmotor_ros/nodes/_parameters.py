@@ -15,14 +15,17 @@ from __future__ import annotations
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 import math
-from typing import Any
+from typing import Any, TypeAlias
 
 from rcl_interfaces.msg import (FloatingPointRange, IntegerRange, ParameterDescriptor,
                                 SetParametersResult)
 from rclpy.exceptions import InvalidParameterTypeException, InvalidParameterValueException
 from rclpy.node import Node
-from rclpy.parameter import Parameter
+from rclpy.parameter import AllowableParameterValue, Parameter
 from satmotor_ros.interface import DISPLACEMENT_LAWS, MotorOptions
+
+RosParameter: TypeAlias = Parameter[AllowableParameterValue]
+"""A parameter as rclpy hands it to the set-parameter callbacks."""
 
 
 @dataclass(frozen=True)
@@ -54,11 +57,11 @@ class ParamSpec:
         # dynamic typing: a value of the wrong type reaches reason(), which names it
         desc = ParameterDescriptor(description=text, additional_constraints=extra,
                                    read_only=self.read_only, dynamic_typing=True)
-        if isinstance(self.default, float) and self.low is not None:
+        if isinstance(self.default, float) and self.low is not None and self.high is not None:
             desc.floating_point_range = [FloatingPointRange(
                 from_value=float(self.low), to_value=float(self.high), step=0.0)]
         elif isinstance(self.default, int) and not isinstance(self.default, bool) \
-                and self.low is not None:
+                and self.low is not None and self.high is not None:
             desc.integer_range = [IntegerRange(from_value=int(self.low),
                                                to_value=int(self.high), step=1)]
         return desc
@@ -126,7 +129,7 @@ def declare(node: Node, specs: Iterable[ParamSpec]) -> dict[str, str]:
     return problems
 
 
-def check(specs: Mapping[str, ParamSpec], params: Iterable[Parameter]) -> SetParametersResult:
+def check(specs: Mapping[str, ParamSpec], params: Iterable[RosParameter]) -> SetParametersResult:
     """
     Check a set request against the table (for an on-set callback).
 

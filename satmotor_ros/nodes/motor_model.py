@@ -15,6 +15,7 @@ The node holds no physics: the combination rule and the model call are
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 from builtin_interfaces.msg import Time as TimeMsg
@@ -23,15 +24,15 @@ from rcl_interfaces.msg import SetParametersResult
 import rclpy
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
-from rclpy.parameter import Parameter
 from rclpy.qos import qos_profile_sensor_data, QoSProfile
 from rclpy.time import Time
+from rclpy.timer import Timer
 from satmotor_ros.interface import (CHANNELS, JOINT_NAME, LOSS_COMPONENTS, LOSSES_ARRAY,
                                     LOSSES_PREFIX, PREDICTED_JOINT_STATE, SPEED_RESIDUAL)
 from satmotor_ros.model import describe_status, ModelError, MotorModel
 from satmotor_ros.nodes import _diagnostics as diag
 from satmotor_ros.nodes import _parameters as params
-from satmotor_ros.nodes._parameters import ParamSpec
+from satmotor_ros.nodes._parameters import ParamSpec, RosParameter
 from satmotor_ros.nodes._spin import spin
 from satmotor_ros.prediction import (Combiner, FIELDS, INPUTS, Level, MODES, OUTPUTS, predict,
                                      Prediction, Progress, Rule, TOPICS, UNITS)
@@ -144,7 +145,7 @@ class MotorModelNode(Node):
                                  self._on_temperature, sensor)
         self.create_subscription(JointState, CHANNELS['measured_speed'].topic,
                                  self._on_joint_states, sensor)
-        self._rate_timer = None
+        self._rate_timer: Timer | None = None
         self._apply_mode()
         self.create_timer(1.0, self._publish_diagnostics)
         self.add_on_set_parameters_callback(self._check_parameters)
@@ -160,7 +161,7 @@ class MotorModelNode(Node):
             self._model, self._model_error = None, str(err)
             self.get_logger().error(f'no model: {err}')
 
-    def _check_parameters(self, request: list[Parameter]) -> SetParametersResult:
+    def _check_parameters(self, request: list[RosParameter]) -> SetParametersResult:
         result = params.check(_SPECS, request)
         if not result.successful:
             return result
@@ -174,7 +175,7 @@ class MotorModelNode(Node):
             return SetParametersResult(successful=False, reason=str(err))
         return SetParametersResult(successful=True)
 
-    def _apply_parameters(self, changed: list[Parameter]) -> None:
+    def _apply_parameters(self, changed: list[RosParameter]) -> None:
         names = {p.name for p in changed}
         for name in names:
             self._problems.pop(name, None)  # a start-up problem is over once it is set
@@ -215,7 +216,7 @@ class MotorModelNode(Node):
         if self._rule.mode == 'on_flow':
             self._predict(t)
 
-    def _pressure(self, name: str):  # noqa: ANN202 (callback factory)
+    def _pressure(self, name: str) -> Callable[[FluidPressure], None]:
         def on_pressure(msg: FluidPressure) -> None:
             self._combiner.update(name, msg.fluid_pressure, self._now_ns())
         return on_pressure

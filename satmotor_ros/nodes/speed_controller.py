@@ -20,13 +20,13 @@ from rcl_interfaces.msg import SetParametersResult
 import rclpy
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
-from rclpy.parameter import Parameter
 from rclpy.qos import qos_profile_sensor_data
+from rclpy.time import Time
 from satmotor_ros.interface import CHANNELS, JOINT_NAME
 from satmotor_ros.model.units import RPM
 from satmotor_ros.nodes import _diagnostics as diag
 from satmotor_ros.nodes import _parameters as params
-from satmotor_ros.nodes._parameters import ParamSpec
+from satmotor_ros.nodes._parameters import ParamSpec, RosParameter
 from satmotor_ros.nodes._spin import spin
 from satmotor_ros.plant.controller import ControllerParams, FEEDFORWARDS, SpeedController
 from satmotor_ros.plant.errors import PlantError
@@ -87,9 +87,9 @@ class SpeedControllerNode(Node):
         self.add_post_set_parameters_callback(self._apply)
         self.setpoint = self.values['setpoint']
         self.speed: float | None = None
-        self._speed_time = None
+        self._speed_time: Time | None = None
         self._p_in = self._p_out = math.nan
-        self._last_time = None
+        self._last_time: Time | None = None
         self.command = 0.0
         self.rejected = 0
         self.last_rejection = ''
@@ -113,7 +113,7 @@ class SpeedControllerNode(Node):
             raise ValueError('joint_name is empty')
         return SpeedController(ControllerParams(**{k: values[k] for k in _LAW}), model)
 
-    def _validate(self, changes: list[Parameter]) -> SetParametersResult:
+    def _validate(self, changes: list[RosParameter]) -> SetParametersResult:
         result = params.check(self._specs, changes)
         if not result.successful:
             self.get_logger().warning(f'parameter change refused: {result.reason}')
@@ -127,7 +127,7 @@ class SpeedControllerNode(Node):
             return SetParametersResult(successful=False, reason=str(err))
         return SetParametersResult(successful=True)
 
-    def _apply(self, changes: list[Parameter]) -> None:
+    def _apply(self, changes: list[RosParameter]) -> None:
         values, law = self._pending
         law.integral = self.law.integral  # bumpless: keep the integrator
         self.law = law
@@ -175,7 +175,7 @@ class SpeedControllerNode(Node):
     def _control(self) -> None:
         now = self.get_clock().now()
         last, self._last_time = self._last_time, now
-        if last is None or self.speed is None:
+        if last is None or self.speed is None or self._speed_time is None:
             return
         dt = (now - last).nanoseconds * 1e-9
         stale = (now - self._speed_time).nanoseconds * 1e-9 > self.values['measurement_timeout']
@@ -191,7 +191,7 @@ class SpeedControllerNode(Node):
         self._pub.publish(Float64(data=self.command))
         self._diagnose(now, stale)
 
-    def _diagnose(self, now: Any, stale: bool) -> None:
+    def _diagnose(self, now: Time, stale: bool) -> None:
         t = now.nanoseconds * 1e-9
         if t < self._next_diagnostics:
             return

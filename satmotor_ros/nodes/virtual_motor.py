@@ -24,12 +24,12 @@ from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticArray
 from rcl_interfaces.msg import SetParametersResult
 import rclpy
-from rclpy.clock import Clock, ClockType
+from rclpy.clock import Clock
+from rclpy.clock_type import ClockType
 from rclpy.event_handler import PublisherEventCallbacks
 from rclpy.executors import ExternalShutdownException
 from rclpy.guard_condition import GuardCondition
 from rclpy.node import Node
-from rclpy.parameter import Parameter
 from rclpy.qos import qos_profile_sensor_data, QoSProfile
 from rclpy.time import Time as RosTime
 from rclpy.timer import Timer
@@ -39,7 +39,7 @@ from satmotor_ros.model import describe_status
 from satmotor_ros.model.units import LPM
 from satmotor_ros.nodes import _diagnostics as diag
 from satmotor_ros.nodes import _parameters as params
-from satmotor_ros.nodes._parameters import ParamSpec
+from satmotor_ros.nodes._parameters import ParamSpec, RosParameter
 from satmotor_ros.nodes._spin import spin
 from satmotor_ros.plant import make_load, Plant
 from satmotor_ros.plant.config import parameter_specs, params_from_flat
@@ -188,13 +188,13 @@ class VirtualMotorNode(Node):
 
     # -- parameters --------------------------------------------------------------------
 
-    def _values(self, changes: list[Parameter] | None = None) -> dict[str, Any]:
+    def _values(self, changes: list[RosParameter] | None = None) -> dict[str, Any]:
         values = params.values(self, self._specs.values())
         for p in changes or []:
             values[p.name] = p.value
         return values
 
-    def _validate(self, changes: list[Parameter]) -> SetParametersResult:
+    def _validate(self, changes: list[RosParameter]) -> SetParametersResult:
         result = params.check(self._specs, changes)
         if not result.successful:
             self.get_logger().warning(f'parameter change refused: {result.reason}')
@@ -207,7 +207,7 @@ class VirtualMotorNode(Node):
             return SetParametersResult(successful=False, reason=reason)
         return SetParametersResult(successful=True)
 
-    def _apply(self, changes: list[Parameter]) -> None:
+    def _apply(self, changes: list[RosParameter]) -> None:
         setup, old = self._pending, self._setup
         model_changed = any(setup.values[k] != old.values[k]
                             for k in ('liquid', 'motor_file', 'displacement_law'))

@@ -11,19 +11,25 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field, fields
 import math
-from typing import ClassVar
+from typing import ClassVar, Protocol
 
 from satmotor_ros.model.units import ATMOSPHERE, LPM, MPA
 from satmotor_ros.plant.errors import PlantError
 
 
-def check_bounds(record: object) -> None:
+class Bounded(Protocol):
+    """A parameter record: its class maps numeric field names to closed ranges."""
+
+    bounds: ClassVar[dict[str, tuple[float, float]]]
+
+
+def check_bounds(record: Bounded) -> None:
     """
     Check every numeric field of a record against its class's ``bounds`` (closed ranges).
 
     Parameters
     ----------
-    record : object
+    record : Bounded
         A parameter record with a ``bounds`` mapping field -> (low, high), [-]
 
     Raises

@@ -88,7 +88,7 @@ class Progress:
             Snapshot, arrays for a batch.
 
         """
-        stamps = snap.stamp_ns
+        stamps: Any = snap.stamp_ns  # an int, or an array for a batch: one body for both
         batch = _is_array(stamps)
         if batch and not len(stamps):
             return np.zeros(0), np.zeros(0)

@@ -166,7 +166,9 @@ def input_state(name: str, value: Any, age_ns: Any, timeout_ns: int) -> Any:
     return pick(age_ns != age_ns, _MISSING, state)  # NaN age: never arrived
 
 
-def input_states(values: Sequence[Any], ages_ns: Sequence[Any], timeout_ns: int) -> list[Any]:
+def input_states(values: Sequence[float] | npt.NDArray[np.float64],
+                 ages_ns: Sequence[float] | npt.NDArray[np.float64],
+                 timeout_ns: int) -> list[Any]:
     """
     Rate every input at a driving time (floats) or at many (rows of arrays).
 
