@@ -64,7 +64,7 @@ def command(out: str, points: int, options: MotorOptions) -> int:
     Returns
     -------
     int
-        0 on success, 1 on an error (one line on stderr).
+        0 once every figure is written (PNG and CSV), 1 on an error (one line on stderr).
 
     """
     try:

@@ -84,7 +84,7 @@ def command(flow: str, dp: str | None, dp_i: str | None, p_ex: str, as_json: boo
     Returns
     -------
     int
-        0 on success, 1 on an error (one line on stderr).
+        0 once the point is printed, flagged or not; 1 on an error (one line on stderr).
 
     """
     try:
