@@ -3,6 +3,7 @@
 
 from pathlib import Path
 import shutil
+import sys
 
 import numpy as np
 import pytest
@@ -14,6 +15,11 @@ from satmotor_ros.bags import (BagError, decode, encode_many, encode_message, FL
                                missing_topics, OutTopic, parse_topic_map, read_series,
                                TEMPERATURE, write_bag)
 import yaml
+
+if sys.version_info >= (3, 14):
+    from compression import zstd
+else:
+    from backports import zstd
 
 TYPESTORE = get_typestore(Stores.ROS2_KILTED)
 N = 200
@@ -170,9 +176,10 @@ def _rosbags_bag(path, mode=None, storage=StoragePlugin.SQLITE3):
             writer.write(conn, 100 + i, encode_message(FLOAT64, {'data': float(i)}))
 
 
+@pytest.mark.parametrize('storage', [StoragePlugin.SQLITE3, StoragePlugin.MCAP])
 @pytest.mark.parametrize('mode', [None, CompressionMode.FILE, CompressionMode.MESSAGE])
-def test_compressed_bags_read(tmp_path, mode):
-    _rosbags_bag(tmp_path / 'bag', mode)
+def test_compressed_bags_read(tmp_path, mode, storage):
+    _rosbags_bag(tmp_path / 'bag', mode, storage)
     series = read_series(tmp_path / 'bag', ['flow_command'])
     assert series['flow_command'].fields['data'].tolist() == list(map(float, range(10)))
 
@@ -219,7 +226,7 @@ def test_truncated_mcap_and_missing_bag_are_errors(tmp_path):
     cut = tmp_path / 'cut'
     cut.mkdir()
     (cut / 'x.mcap').write_bytes(mcap.read_bytes()[:3000])
-    with pytest.raises(BagError, match='x.mcap: truncated'):
+    with pytest.raises(BagError, match=r'x.mcap: damaged or truncated \(.+\)$'):
         list_topics(cut)
     with pytest.raises(BagError, match='no such bag'):
         list_topics(tmp_path / 'nothing')
@@ -238,3 +245,110 @@ def test_messages_stored_out_of_order_come_back_in_log_time_order(tmp_path, stor
     series = read_series(tmp_path / 'bag', ['inlet_pressure'])['inlet_pressure']
     assert series.t_ns.tolist() == [10, 10, 20, 30]
     assert series.fields['fluid_pressure'].tolist() == [10.0, 10.0, 20.0, 30.0]
+
+
+def _zstd_file_compressed(bag):
+    """Compress a bag's storage files with zstd and edit metadata.yaml as rosbag2 does."""
+    for file in [*bag.glob('*.mcap'), *bag.glob('*.db3')]:
+        file.with_name(file.name + '.zstd').write_bytes(zstd.compress(file.read_bytes()))
+        file.unlink()
+
+    def edit(doc):
+        doc.update(compression_format='zstd', compression_mode='FILE',
+                   relative_file_paths=[f + '.zstd' for f in doc['relative_file_paths']])
+        for entry in doc.get('files') or ():
+            entry['path'] += '.zstd'
+    _edit_metadata(bag, edit)
+
+
+@pytest.mark.parametrize('storage', ['mcap', 'sqlite3'])
+def test_zstd_file_compressed_bag_of_our_writer_reads_as_the_plain_one(tmp_path, storage):
+    data = _inputs(np.random.default_rng(5))
+    write_bag(tmp_path / 'bag', data['topics'], storage=storage)
+    names = ['flow_command', 'inlet_pressure', 'joint_states']
+    plain = read_series(tmp_path / 'bag', names)
+    _zstd_file_compressed(tmp_path / 'bag')
+    assert [p.suffixes[-2:] for p in (tmp_path / 'bag').glob('*.zstd')] == [
+        ['.mcap' if storage == 'mcap' else '.db3', '.zstd']]
+    packed = read_series(tmp_path / 'bag', names)
+    for name in names:
+        np.testing.assert_array_equal(packed[name].t_ns, plain[name].t_ns)
+        for field, values in plain[name].fields.items():
+            np.testing.assert_array_equal(packed[name].fields[field], values)
+    np.testing.assert_array_equal(packed['flow_command'].fields['data'], data['flow'])
+    zst = next((tmp_path / 'bag').glob('*.zstd'))
+    assert len(read_series(zst, ['flow_command'])['flow_command']) == N  # the file alone
+    zst.write_bytes(zst.read_bytes()[:-100])
+    with pytest.raises(BagError, match=f'{zst.name}: not a complete zstd file'):
+        read_series(tmp_path / 'bag', names)
+
+
+def _chunks(mcap):
+    """Return the chunk records of an MCAP file."""
+    from mcap.records import Chunk
+    from mcap.stream_reader import StreamReader
+    with mcap.open('rb') as stream:
+        return [r for r in StreamReader(stream, emit_chunks=True).records
+                if isinstance(r, Chunk)]
+
+
+def _flip(path, at, count=16):
+    data = bytearray(path.read_bytes())
+    data[at:at + count] = bytes(b ^ 0xFF for b in data[at:at + count])
+    path.write_bytes(bytes(data))
+
+
+@pytest.mark.parametrize('where', [0.1, 0.5, 0.9])
+def test_mcap_bag_with_16_flipped_bytes_in_a_chunk_is_refused_with_one_line(tmp_path, where):
+    """Our writer puts CRCs on its chunks; a damaged chunk never gives altered numbers."""
+    write_bag(tmp_path / 'bag', _inputs(np.random.default_rng(6))['topics'])
+    mcap = next((tmp_path / 'bag').glob('*.mcap'))
+    chunks = _chunks(mcap)
+    assert chunks and all(c.uncompressed_crc for c in chunks) and \
+        {c.compression for c in chunks} == {'zstd'}
+    start = mcap.read_bytes().index(chunks[0].data)
+    _flip(mcap, start + int(where * len(chunks[0].data)))
+    with pytest.raises(BagError, match=rf'^{mcap.name}: damaged or truncated \(.+\)$') as err:
+        read_series(tmp_path / 'bag', ['flow_command', 'inlet_pressure', 'joint_states'])
+    assert '\n' not in str(err.value)
+
+
+def test_uncompressed_mcap_chunk_with_flipped_bytes_is_a_crc_mismatch(tmp_path):
+    """In a chunk that is not compressed, only the CRC can tell: it must."""
+    bag = _mcap_by_the_mcap_library(tmp_path / 'bag', schema_encoding='ros2msg')
+    assert list_topics(bag)['/flow_command'].count == 10
+    mcap = next(bag.glob('*.mcap'))
+    (chunk,) = _chunks(mcap)
+    payload = encode_message(FLOAT64, {'data': 5.0})
+    _flip(mcap, mcap.read_bytes().index(payload) + 4, count=8)  # the number itself
+    with pytest.raises(BagError, match=f'{mcap.name}: damaged or truncated .*checksum'):
+        read_series(bag, ['flow_command'])
+
+
+def _mcap_by_the_mcap_library(bag, schema_encoding):
+    """Write a 10-message MCAP bag (no metadata.yaml) with the mcap library, chunks plain."""
+    from mcap.writer import CompressionType, Writer as McapWriter
+    bag.mkdir()
+    with (bag / 'x_0.mcap').open('wb') as stream:
+        writer = McapWriter(stream, compression=CompressionType.NONE)
+        writer.start(profile='ros2')
+        schema = writer.register_schema(FLOAT64, schema_encoding, b'')
+        channel = writer.register_channel('/flow_command', 'cdr', schema)
+        for i in range(10):
+            writer.add_message(channel, 100 + i, encode_message(FLOAT64, {'data': float(i)}),
+                               100 + i)
+        writer.finish()
+    return bag
+
+
+def test_mcap_with_a_schema_encoding_rosbags_does_not_know_reads(tmp_path):
+    """rosbag2 writes schema encoding 'unknown' for types it has no definition of."""
+    bag = _mcap_by_the_mcap_library(tmp_path / 'bag', schema_encoding='unknown')
+    series = read_series(bag, ['flow_command'])['flow_command']
+    assert series.fields['data'].tolist() == list(map(float, range(10)))
+    assert series.t_ns.tolist() == list(range(100, 110))
+    mcap = next(bag.glob('*.mcap'))
+    _flip(mcap, mcap.read_bytes().index(encode_message(FLOAT64, {'data': 5.0})) + 4, 8)
+    with pytest.raises(BagError, match=f'{mcap.name}: damaged or truncated .*crc validation failed'):
+        read_series(bag, ['flow_command'])
+

@@ -1,18 +1,13 @@
 # SPDX-License-Identifier: Apache-2.0
 """The 24 foreign bags of shared/data/foreign_bags: every one read, or one clear error."""
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 from rosbags.highlevel import AnyReader
 from rosbags.typesys import get_typestore, Stores
 
 from satmotor_ros.bags import BagError, list_topics, open_bag, read_series
-
-FOREIGN = Path('/work/shared/data/foreign_bags')
-if not FOREIGN.is_dir():
-    FOREIGN = Path(__file__).resolve().parent / 'data' / 'foreign_bags'
+from shared_data import foreign_bag, FOREIGN_BAGS, shared_path
 
 # Messages in the storage, counted independently of any bag library (the bags' README).
 STORAGE_COUNTS = {
@@ -28,19 +23,19 @@ STORAGE_COUNTS = {
 DISAGREEING = {'v3_cdr_test_type_mismatch': '/test_topic is test_msgs/msg/BasicTypes in '
                                             'metadata.yaml and test_msgs/msg/Primitives in'}
 
-pytestmark = pytest.mark.skipif(not FOREIGN.is_dir(), reason='foreign bags not available')
 
 
 def test_the_table_covers_all_24_bags():
-    bags = sorted(p.name for p in FOREIGN.iterdir() if p.is_dir())
-    assert bags == sorted([*STORAGE_COUNTS, *DISAGREEING]) and len(bags) == 24
+    bags = sorted(p.name for p in shared_path('data', 'foreign_bags').iterdir() if p.is_dir())
+    assert bags == sorted([*STORAGE_COUNTS, *DISAGREEING]) == sorted(FOREIGN_BAGS)
+    assert len(bags) == 24
 
 
 @pytest.mark.parametrize('name', sorted(STORAGE_COUNTS))
 def test_foreign_bag_reads_every_message_of_its_storage(name):
-    topics = list_topics(FOREIGN / name)
+    topics = list_topics(foreign_bag(name))
     assert sum(t.count for t in topics.values()) == STORAGE_COUNTS[name]
-    infos, raw = open_bag(FOREIGN / name).read(set(topics))  # every message, walked
+    infos, raw = open_bag(foreign_bag(name)).read(set(topics))  # every message, walked
     assert {n: len(r.t_ns) for n, r in raw.items()} == {n: t.count for n, t in infos.items()}
     assert {n: t for n, t in infos.items() if t.count} == \
         {n: t for n, t in topics.items() if t.count}  # the summary may list empty channels
@@ -53,27 +48,28 @@ def test_foreign_bag_reads_every_message_of_its_storage(name):
 @pytest.mark.parametrize('name', sorted(DISAGREEING))
 def test_foreign_bag_whose_metadata_disagrees_is_one_clear_error(name):
     with pytest.raises(BagError, match=DISAGREEING[name]) as err:
-        list_topics(FOREIGN / name)
+        list_topics(foreign_bag(name))
     assert '\n' not in str(err.value)
 
 
 def _rosbags_messages(bag):
-    with AnyReader([bag], default_typestore=get_typestore(Stores.ROS2_HUMBLE)) as reader:
+    typestore = get_typestore(Stores.ROS2_HUMBLE)
+    with AnyReader([foreign_bag(bag)], default_typestore=typestore) as reader:
         return [(t, reader.deserialize(raw, c.msgtype)) for c, t, raw in reader.messages()
                 if c.msgtype in ('sensor_msgs/msg/JointState', 'sensor_msgs/msg/Temperature')]
 
 
 def test_foreign_joint_state_and_temperature_decode_as_rosbags_decodes_them():
-    joint = read_series(FOREIGN / 'v5_humble_sensor_mcap', ['joint_states'],
+    joint = read_series(foreign_bag('v5_humble_sensor_mcap'), ['joint_states'],
                         {'/one_shot/joint_state': 'joint_states'}, joint='joint2')
-    ((t, msg),) = _rosbags_messages(FOREIGN / 'v5_humble_sensor_mcap')
+    ((t, msg),) = _rosbags_messages('v5_humble_sensor_mcap')
     series = joint['joint_states']
     assert series.t_ns.tolist() == [t]
     assert [series.fields[k][0] for k in ('position', 'velocity', 'effort')] == [
         msg.position[1], msg.velocity[1], msg.effort[1]]
-    temp = read_series(FOREIGN / 'v5_humble_sensor_sqlite3', ['fluid_temperature'],
+    temp = read_series(foreign_bag('v5_humble_sensor_sqlite3'), ['fluid_temperature'],
                        {'/my_temperature': 'fluid_temperature'})['fluid_temperature']
-    expected = _rosbags_messages(FOREIGN / 'v5_humble_sensor_sqlite3')
+    expected = _rosbags_messages('v5_humble_sensor_sqlite3')
     np.testing.assert_array_equal(temp.fields['temperature'], [m.temperature
                                                                for _, m in expected])
     np.testing.assert_array_equal(temp.t_ns, [t for t, _ in expected])
@@ -81,4 +77,4 @@ def test_foreign_joint_state_and_temperature_decode_as_rosbags_decodes_them():
 
 def test_foreign_wrong_serialization_format_is_named():
     with pytest.raises(BagError, match="serialization format 'wrong_format' is not supported"):
-        read_series(FOREIGN / 'v6_wrong_format_mcap', ['x'], {'/test_topic': 'x'})
+        read_series(foreign_bag('v6_wrong_format_mcap'), ['x'], {'/test_topic': 'x'})

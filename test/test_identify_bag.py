@@ -11,10 +11,8 @@ from satmotor_ros.cli import main
 from satmotor_ros.identify import calibrate, DataError
 from satmotor_ros.identify.bag import read_bag
 from satmotor_ros.identify.synthetic import generate_series, Injection, Plan, write_bag_of
+from shared_data import foreign_bag, FOREIGN_BAGS
 
-FOREIGN = Path('/work/shared/data/foreign_bags')
-if not FOREIGN.is_dir():
-    FOREIGN = Path(__file__).resolve().parents[2] / 'shared' / 'data' / 'foreign_bags'
 
 
 @pytest.fixture(scope='module')
@@ -61,16 +59,14 @@ def test_bag_with_flow_command_only_is_used(tmp_path):
     assert calibrate(table, 'oil').chosen is None
 
 
-@pytest.mark.skipif(not FOREIGN.is_dir(), reason='shared foreign bags not present')
-@pytest.mark.parametrize('bag', sorted(p.name for p in FOREIGN.iterdir() if p.is_dir())
-                         if FOREIGN.is_dir() else [])
+@pytest.mark.parametrize('bag', FOREIGN_BAGS)
 def test_foreign_bag_gives_one_clear_line(tmp_path, bag, capsys):
     with pytest.raises(DataError) as info:
-        read_bag(FOREIGN / bag)
+        read_bag(foreign_bag(bag))
     text = str(info.value)
     assert '\n' not in text and bag in text
     assert 'lacks the calibration topic' in text or 'metadata' in text
-    code = main(['calibrate', str(FOREIGN / bag), '--liquid', 'oil', '--out',
+    code = main(['calibrate', str(foreign_bag(bag)), '--liquid', 'oil', '--out',
                  str(tmp_path / 'o')])
     err = capsys.readouterr().err
     assert code == 1 and err.count('\n') == 1

@@ -11,8 +11,8 @@ from satmotor_ros.bags import (encode_many, FLOAT64, FLUID_PRESSURE, JOINT_STATE
 from satmotor_ros.cli.main import main
 from satmotor_ros.model import MotorModel
 from satmotor_ros.model.units import LPM, MPA, RPM
+from shared_data import foreign_bag, FOREIGN_BAGS
 
-FOREIGN = Path('/work/shared/data/foreign_bags')
 OIL = MotorModel.default('oil')
 
 
@@ -147,12 +147,10 @@ def test_replay_rate_mode_predicts_on_ticks(tmp_path, capsys):
     assert all(r['level'] == 'OK' for r in rows[1:])
 
 
-@pytest.mark.skipif(not FOREIGN.is_dir(), reason='foreign bags not available')
-@pytest.mark.parametrize('name', sorted(p.name for p in FOREIGN.iterdir() if p.is_dir())
-                         if FOREIGN.is_dir() else [])
+@pytest.mark.parametrize('name', FOREIGN_BAGS)
 def test_replay_of_every_foreign_bag_fails_cleanly_with_one_line(name, capsys):
     """None of them holds the motor's topics: exit 1, one line naming what is missing."""
-    assert main(['replay', str(FOREIGN / name), '--no-plot']) == 1
+    assert main(['replay', str(foreign_bag(name)), '--no-plot']) == 1
     captured = capsys.readouterr()
     assert captured.out == '' and captured.err.count('\n') == 1
     assert 'Traceback' not in captured.err

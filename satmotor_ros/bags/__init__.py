@@ -3,10 +3,13 @@
 rosbag2 bags in and out, without ROS: topics as numpy time series, fast.
 
 Reading (:func:`read_series`, :func:`list_topics`) takes sqlite3 and MCAP bags of every
-metadata version, split or zstd-compressed, with or without metadata.yaml, checks
-metadata.yaml against the storage, and decodes Float64, FluidPressure, Temperature and
-JointState messages with a vectorised CDR decoder. Writing (:func:`write_bag`) uses
-rosbags' writer. Every failure is a :class:`BagError` with a one-line message.
+metadata version, split or zstd-compressed (FILE or MESSAGE), with or without
+metadata.yaml: rosbags reads the storage files (the ``mcap`` library the MCAP files rosbags
+cannot open), metadata.yaml is checked against the storage, and Float64, FluidPressure,
+Temperature and JointState messages are decoded with a vectorised CDR decoder. Writing
+(:func:`write_bag`) uses rosbags' writer, with MCAP chunks written by the ``mcap``
+library so that they carry CRCs. Every failure, a damaged or truncated file too, is a
+:class:`BagError` with a one-line message naming the file.
 
 Example::
 

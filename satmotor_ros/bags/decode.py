@@ -178,11 +178,30 @@ def decode(msgtype: str, payloads: Sequence[bytes], joint: str | None = None) ->
         Which messages hold values, their header stamps and their fields.
 
     """
+    return decode_packed(msgtype, *pack_payloads(payloads), joint)
+
+
+def pack_payloads(payloads: Sequence[bytes]) -> tuple[npt.NDArray[np.uint8],
+                                                      npt.NDArray[np.int64],
+                                                      npt.NDArray[np.int64]]:
+    """
+    Pack serialised messages back to back into one buffer.
+
+    Parameters
+    ----------
+    payloads : sequence of bytes
+        The serialised messages, [-]
+
+    Returns
+    -------
+    tuple of ndarray
+        The buffer (uint8), the offset and the length of each message (int64), [bytes]
+
+    """
     lengths = np.fromiter(map(len, payloads), dtype=np.int64, count=len(payloads))
     offsets = np.zeros(len(payloads), dtype=np.int64)
     np.cumsum(lengths[:-1], out=offsets[1:])
-    buf = np.frombuffer(b''.join(payloads), dtype=np.uint8)
-    return decode_packed(msgtype, buf, offsets, lengths, joint)
+    return np.frombuffer(b''.join(payloads), dtype=np.uint8), offsets, lengths
 
 
 def decode_packed(msgtype: str, buf: npt.NDArray[np.uint8], offsets: npt.NDArray[np.int64],

@@ -191,7 +191,7 @@ def read_series(path: str | Path, topics: Iterable[str],
     """
     bag = open_bag(path)
     requested = list(dict.fromkeys(topics))
-    available = bag.topics(count=False)
+    available = bag.topics()
     found = match_topics(available, requested, topic_map)
     for want, name in found.items():
         info = available[name]

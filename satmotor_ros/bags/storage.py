@@ -1,39 +1,49 @@
 # SPDX-License-Identifier: Apache-2.0
 """
-rosbag2 storage: metadata, sqlite3 and MCAP files, raw messages by topic.
+rosbag2 storage: metadata, storage files and raw messages by topic, read with rosbags.
 
-The storage files are read directly (sqlite3 queries, an MCAP record walk), for speed and
-so that nothing is dropped silently: rosbags' reader matches metadata.yaml to storage on
-type and QoS and returns no messages where they differ. Here the storage is the truth and
-metadata.yaml is checked against it: a topic whose type or message count differs is an
-error naming both. Bags of any metadata version (1-9), split into several files, with
-zstd FILE or MESSAGE compression, or without metadata.yaml (storage files found in the
-directory) are read.
+Every storage file (``.db3`` or ``.mcap``, or either zstd FILE-compressed as ``.zstd``) is
+read on its own with rosbags' Reader, which checks MCAP chunk CRCs; the few MCAP files it
+cannot open (schema encodings it does not know) are read with the ``mcap`` library, which
+checks them too. metadata.yaml is read here and checked against the storage rather than
+used to select from it: rosbags' directory reader silently returns no messages for a topic
+whose type or QoS differ between the two. Here the storage is the truth, and a topic whose
+type or message count differs is an error naming both. Bags of any metadata version (1-9),
+split into several files, with zstd FILE or MESSAGE compression, or without metadata.yaml
+(storage files found in the directory) are read. A damaged or truncated file is a
+:class:`BagError` naming the file, never altered numbers.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 import re
+import shutil
 import sqlite3
+import struct
+import sys
 import tempfile
 from typing import Any, NamedTuple
 
 import numpy as np
 import numpy.typing as npt
 
-from satmotor_ros.bags.decode import gather_rows
+from satmotor_ros.bags.decode import pack_payloads
 from satmotor_ros.bags.errors import BagError
-from satmotor_ros.bags.mcap import McapContent, read_mcap, read_summary
 import yaml
+
+if sys.version_info >= (3, 14):
+    from compression import zstd
+else:
+    from backports import zstd
 
 STORAGES = ('sqlite3', 'mcap')
 """Storage plugins that can be read."""
 
 _ZSTD_MAGIC = b'\x28\xb5\x2f\xfd'
 _SPLIT_INDEX = re.compile(r'_(\d+)\.(?:db3|mcap)(?:\.zstd)?$')
+_SUFFIXES = ('.db3', '.db3.zstd', '.mcap', '.mcap.zstd')
 
 
 class TopicInfo(NamedTuple):
@@ -42,11 +52,7 @@ class TopicInfo(NamedTuple):
     name: str
     msgtype: str  # normalised: 'pkg/msg/Type'
     serialization: str  # 'cdr' for ROS 2
-    count: int  # type: ignore[assignment]  # messages in the storage (not tuple.count)
-
-
-Found = Iterator[tuple[TopicInfo, list[tuple[np.ndarray, ...]]]]
-"""What a storage file holds: each topic with its message parts (times, buffer, ...)."""
+    count: int  # messages in the storage
 
 
 class RawTopic(NamedTuple):
@@ -76,53 +82,12 @@ class RawTopic(NamedTuple):
         return self.buf[start:start + int(self.lengths[i])].tobytes()
 
 
-def pack_payloads(payloads: list[bytes]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """
-    Pack payloads back to back into one buffer.
-
-    Parameters
-    ----------
-    payloads : list of bytes
-        The serialised messages, [-]
-
-    Returns
-    -------
-    tuple of ndarray
-        The buffer (uint8), the offsets and the lengths (int64), [bytes]
-
-    """
-    lengths = np.fromiter(map(len, payloads), dtype=np.int64, count=len(payloads))
-    offsets = np.zeros(len(payloads), dtype=np.int64)
-    np.cumsum(lengths[:-1], out=offsets[1:])
-    return np.frombuffer(b''.join(payloads), dtype=np.uint8), offsets, lengths
-
-
-def _compact(parts: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]) -> RawTopic:
-    """Join message parts (times, buffer, offsets, lengths) into one packed RawTopic."""
-    if not parts:
-        empty = np.zeros(0, dtype=np.int64)
-        return RawTopic(empty, np.zeros(0, dtype=np.uint8), empty, empty)
-    if len(parts) == 1 and parts[0][1].size == parts[0][3].sum():
-        packed = RawTopic(*parts[0])  # already back to back (sqlite3)
-        return _in_time_order(packed)
-    t_ns = np.concatenate([p[0] for p in parts])
-    lengths = np.concatenate([p[3] for p in parts])
-    offsets = np.zeros(len(lengths), dtype=np.int64)
-    np.cumsum(lengths[:-1], out=offsets[1:])
-    chunks = []
-    for _, buf, starts, sizes in parts:
-        if len(sizes) and (sizes == sizes[0]).all():
-            chunks.append(gather_rows(buf, starts, int(sizes[0])).reshape(-1))
-        else:
-            chunks.extend(buf[a:a + n] for a, n in zip(starts.tolist(), sizes.tolist()))
-    return _in_time_order(RawTopic(t_ns, np.concatenate(chunks), offsets, lengths))
-
-
-def _in_time_order(raw: RawTopic) -> RawTopic:
-    t_ns = raw.t_ns
-    if len(t_ns) > 1 and np.any(np.diff(t_ns) < 0):
-        order = np.argsort(t_ns, kind='stable')
-        return raw._replace(t_ns=t_ns[order], offsets=raw.offsets[order],
+def _packed(t_ns: list[int], payloads: list[bytes]) -> RawTopic:
+    """Pack one topic's messages into a RawTopic, in log-time order."""
+    raw = RawTopic(np.array(t_ns, dtype=np.int64), *pack_payloads(payloads))
+    if len(t_ns) > 1 and np.any(np.diff(raw.t_ns) < 0):
+        order = np.argsort(raw.t_ns, kind='stable')
+        return raw._replace(t_ns=raw.t_ns[order], offsets=raw.offsets[order],
                             lengths=raw.lengths[order])
     return raw
 
@@ -146,6 +111,14 @@ def normalize_type(msgtype: str) -> str:
     return f'{parts[0]}/msg/{parts[1]}' if len(parts) == 2 else msgtype.strip()
 
 
+class FileTopic(NamedTuple):
+    """One topic of one storage file: what it is, and its messages when they were asked for."""
+
+    info: TopicInfo
+    t_ns: list[int]  # log times [ns]
+    payloads: list[bytes]  # serialised messages, as stored
+
+
 @dataclass
 class Bag:
     """
@@ -160,20 +133,14 @@ class Bag:
     metadata: dict[str, TopicInfo] | None  # from metadata.yaml; None when absent
     _tmp: Any = field(default=None, repr=False)
 
-    def topics(self, count: bool = True) -> dict[str, TopicInfo]:
+    def topics(self) -> dict[str, TopicInfo]:
         """
         List the topics of the storage, checked against metadata.yaml.
-
-        Parameters
-        ----------
-        count : bool
-            Count the messages of every topic; without, sqlite3 counts are -1 (not
-            counted), which saves a pass over the messages table, [-]
 
         Returns
         -------
         dict
-            Topic name -> :class:`TopicInfo`.
+            Topic name -> :class:`TopicInfo`, with the message count of the storage.
 
         Raises
         ------
@@ -181,20 +148,9 @@ class Bag:
             If a storage file cannot be read or metadata.yaml disagrees with the storage.
 
         """
-        if self.storage == 'mcap':
-            summaries = [s for s in map(read_summary, self.files) if s is not None]
-            if len(summaries) == len(self.files):
-                infos: dict[str, TopicInfo] = {}
-                for summary in summaries:
-                    for info, _ in _mcap_topics(summary):
-                        seen = infos.get(info.name)
-                        infos[info.name] = info._replace(
-                            count=info.count + (seen.count if seen else 0))
-                self._check_metadata(infos)
-                return infos
-        return self.read((), count)[0]
+        return self.read(())[0]
 
-    def read(self, names: tuple[str, ...] | list[str] | set[str], count: bool = False,
+    def read(self, names: tuple[str, ...] | list[str] | set[str],
              ) -> tuple[dict[str, TopicInfo], dict[str, RawTopic]]:
         """
         Read the raw messages of some topics.
@@ -203,14 +159,13 @@ class Bag:
         ----------
         names : collection of str
             Full topic names as in the bag, [-]
-        count : bool
-            Also count the messages of the other topics (sqlite3: one more pass), [-]
 
         Returns
         -------
         tuple
             The storage's topics (name -> :class:`TopicInfo`) and the messages of the
-            requested ones (name -> :class:`RawTopic`, log-time order).
+            requested ones (name -> :class:`RawTopic`, log-time order, MESSAGE
+            compression undone).
 
         Raises
         ------
@@ -220,67 +175,36 @@ class Bag:
         """
         wanted = set(names)
         infos: dict[str, TopicInfo] = {}
-        parts: dict[str, list[Any]] = {n: [] for n in wanted}
+        messages: dict[str, tuple[list[int], list[bytes]]] = {}
         for path in self.files:
-            reader = _read_mcap_file if self.storage == 'mcap' else self._read_sqlite_file
-            for info, pieces in reader(path, wanted, count):
-                seen = infos.get(info.name)
+            for topic in _read_file(self._uncompressed(path), wanted, path.name):
+                info, seen = topic.info, infos.get(topic.info.name)
                 if seen is not None and seen.msgtype != info.msgtype:
                     raise BagError(f'{info.name} is {seen.msgtype} in one storage file and '
                                    f'{info.msgtype} in {path.name}')
-                if seen is not None and min(seen.count, info.count) >= 0:
-                    info = info._replace(count=info.count + seen.count)
-                infos[info.name] = info
+                infos[info.name] = info._replace(count=info.count + (seen.count if seen else 0))
                 if info.name in wanted:
-                    parts[info.name].extend(pieces)
+                    t_ns, payloads = messages.setdefault(info.name, ([], []))
+                    t_ns.extend(topic.t_ns)
+                    payloads.extend(topic.payloads)
         self._check_metadata(infos)
-        return infos, {name: _compact(parts[name]) for name in wanted & set(infos)}
+        return infos, {name: _packed(t_ns, _decompressed(payloads, name))
+                       for name, (t_ns, payloads) in messages.items()}
 
-    def _read_sqlite_file(self, path: Path, wanted: set[str],
-                          count: bool) -> Found:
-        if path.suffix == '.zstd':
-            path = self._decompress_file(path)
-        uri = f'{path.resolve().as_uri()}?mode=ro&immutable=1'
-        try:
-            db = sqlite3.connect(uri, uri=True)
-        except sqlite3.Error as err:
-            raise BagError(f'{path.name}: cannot open as sqlite3 ({err})') from None
-        try:
-            topics = db.execute('SELECT id, name, type, serialization_format FROM topics')\
-                .fetchall()
-            counts = dict(db.execute('SELECT topic_id, COUNT(*) FROM messages '
-                                     'GROUP BY topic_id').fetchall()) if count else {}
-            ids = {topic_id: name for topic_id, name, _, _ in topics if name in wanted}
-            rows = db.execute(f'SELECT topic_id, timestamp, data FROM messages WHERE topic_id '
-                              f'IN ({",".join(map(str, ids))})').fetchall() if ids else []
-            which = np.fromiter((r[0] for r in rows), dtype=np.int64, count=len(rows))
-            for topic_id, name, msgtype, fmt in topics:
-                info = TopicInfo(name, normalize_type(msgtype), fmt,
-                                 counts.get(topic_id, 0 if count else -1))
-                if topic_id not in ids:
-                    yield (info if count else info._replace(count=-1)), []
-                    continue
-                mine = np.flatnonzero(which == topic_id).tolist() if len(ids) > 1 \
-                    else range(len(rows))
-                t = np.fromiter((rows[i][1] for i in mine), dtype=np.int64, count=len(mine))
-                payloads = _decompressed([rows[i][2] for i in mine], name)
-                yield info._replace(count=len(mine)), ([(t, *pack_payloads(payloads))]
-                                                       if len(mine) else [])
-        except sqlite3.DatabaseError as err:
-            raise BagError(f'{path.name}: not a rosbag2 sqlite3 file ({err})') from None
-        finally:
-            db.close()
-
-    def _decompress_file(self, path: Path) -> Path:
-        from backports import zstd
+    def _uncompressed(self, path: Path) -> Path:
+        """Undo zstd FILE compression into a temporary file that lives as long as the bag."""
+        if path.suffix != '.zstd':
+            return path
         if self._tmp is None:
             self._tmp = tempfile.TemporaryDirectory(prefix='satmotor_bag_')
         target = Path(self._tmp.name) / path.name.removesuffix('.zstd')
         if not target.exists():
             try:
-                target.write_bytes(zstd.decompress(path.read_bytes()))
-            except zstd.ZstdError as err:
-                raise BagError(f'{path.name}: not a zstd file ({err})') from None
+                with zstd.open(path, 'rb') as source, target.open('wb') as sink:
+                    shutil.copyfileobj(source, sink)
+            except (zstd.ZstdError, EOFError) as err:
+                target.unlink(missing_ok=True)
+                raise BagError(f'{path.name}: not a complete zstd file ({err})') from None
         return target
 
     def _check_metadata(self, infos: dict[str, TopicInfo]) -> None:
@@ -298,37 +222,119 @@ class Bag:
             if found.msgtype != meta.msgtype:
                 raise BagError(f'metadata.yaml and storage disagree: {name} is {meta.msgtype} '
                                f'in metadata.yaml and {found.msgtype} in {where}')
-            if found.count >= 0 and found.count != meta.count:
+            if found.count != meta.count:
                 raise BagError(f'metadata.yaml and storage disagree: {name} has {meta.count} '
                                f'messages in metadata.yaml and {found.count} in {where}')
 
 
-def _read_mcap_file(path: Path, wanted: set[str], count: bool) -> Found:  # noqa: ARG001
-    return _mcap_topics(read_mcap(path, wanted))
+def _read_file(path: Path, wanted: set[str], name: str) -> list[FileTopic]:
+    """
+    Read one (uncompressed) storage file: all its topics, the messages of the wanted ones.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The ``.db3`` or ``.mcap`` file, [-]
+    wanted : set of str
+        Topics whose messages to read, [-]
+    name : str
+        The file's name in the bag, for messages, [-]
+
+    Returns
+    -------
+    list of FileTopic
+        One per topic of the file (its channels or connections joined).
+
+    Raises
+    ------
+    BagError
+        If the file is damaged, truncated or not a storage file.
+
+    """
+    from mcap.exceptions import McapError
+    from rosbags.rosbag2 import ReaderError
+
+    try:
+        channels = _read_with_rosbags(path, wanted)
+        if channels is None:
+            channels = _read_with_mcap(path, wanted)
+    except (ReaderError, McapError, sqlite3.Error, zstd.ZstdError, struct.error, EOFError,
+            ValueError, TypeError, IndexError, RuntimeError) as err:
+        detail = (str(err).splitlines() or [type(err).__name__])[0]
+        raise BagError(f'{name}: damaged or truncated ({detail})') from None
+    topics: dict[str, FileTopic] = {}
+    for channel in channels:
+        info = channel.info
+        if info.name in wanted and len(channel.t_ns) != info.count:
+            raise BagError(f'{name}: damaged or truncated ({info.name}: its index counts '
+                           f'{info.count} messages, {len(channel.t_ns)} were found)')
+        seen = topics.get(info.name)
+        if seen is None:
+            topics[info.name] = channel
+            continue
+        if seen.info.msgtype != info.msgtype:
+            raise BagError(f'{name}: {info.name} is both {seen.info.msgtype} and '
+                           f'{info.msgtype}')
+        topics[info.name] = FileTopic(seen.info._replace(count=seen.info.count + info.count),
+                                      seen.t_ns + channel.t_ns,
+                                      seen.payloads + channel.payloads)
+    return list(topics.values())
 
 
-def _mcap_topics(content: McapContent) -> Found:
-    for channel_id, channel in content.channels.items():
-        info = TopicInfo(channel.topic, normalize_type(channel.msgtype), channel.encoding,
-                         content.counts.get(channel_id, 0))
-        yield info, [_uncompressed_part(p, channel.topic)
-                     for p in content.parts.get(channel_id, ())]
+def _read_with_rosbags(path: Path, wanted: set[str]) -> list[FileTopic] | None:
+    """Read a file's channels with rosbags' Reader; None for an MCAP file it cannot open."""
+    from rosbags.rosbag2 import Reader
+
+    reader = Reader(path)
+    try:
+        reader.open()
+    except KeyError:  # rosbags 0.11.9 knows no MCAP schema encoding 'unknown' (rosbag2's)
+        return None
+    try:
+        channels = {conn.id: FileTopic(TopicInfo(conn.topic, normalize_type(conn.msgtype),
+                                                 conn.ext.serialization_format,
+                                                 conn.msgcount), [], [])
+                    for conn in reader.connections}
+        picked = [conn for conn in reader.connections if conn.topic in wanted]
+        for conn, t_ns, data in reader.messages(picked) if picked else ():
+            channel = channels[conn.id]
+            channel.t_ns.append(t_ns)
+            channel.payloads.append(data)
+    finally:
+        reader.close()
+    return list(channels.values())
 
 
-def _uncompressed_part(part: Any, name: str) -> tuple[np.ndarray, ...]:
-    """Return an MCAP part as (times, buffer, offsets, lengths), undoing MESSAGE zstd."""
-    t_ns, buf, offsets, lengths = part
-    if len(offsets) and buf[offsets[0]:offsets[0] + 4].tobytes() == _ZSTD_MAGIC:
-        payloads = [buf[a:a + n].tobytes() for a, n in zip(offsets.tolist(), lengths.tolist())]
-        return (t_ns, *pack_payloads(_decompressed(payloads, name)))
-    return t_ns, buf, offsets, lengths
+def _read_with_mcap(path: Path, wanted: set[str]) -> list[FileTopic]:
+    """Read an MCAP file's channels with the ``mcap`` library, checking its CRCs."""
+    from mcap.records import Channel, Message, Schema
+    from mcap.stream_reader import StreamReader
+
+    schemas: dict[int, str] = {}
+    channels: dict[int, FileTopic] = {}
+    counts: dict[int, int] = {}
+    with path.open('rb') as stream:
+        for record in StreamReader(stream, validate_crcs=True).records:
+            if isinstance(record, Message):
+                counts[record.channel_id] = counts.get(record.channel_id, 0) + 1
+                channel = channels[record.channel_id]
+                if channel.info.name in wanted:
+                    channel.t_ns.append(record.log_time)
+                    channel.payloads.append(record.data)
+            elif isinstance(record, Schema):
+                schemas[record.id] = record.name
+            elif isinstance(record, Channel) and record.id not in channels:
+                channels[record.id] = FileTopic(TopicInfo(
+                    record.topic, normalize_type(schemas.get(record.schema_id, '')),
+                    record.message_encoding, 0), [], [])
+    return [c._replace(info=c.info._replace(count=counts.get(k, 0)))
+            for k, c in channels.items()]
 
 
 def _decompressed(payloads: list[bytes], name: str) -> list[bytes]:
     """Undo zstd MESSAGE compression, recognised by the zstd magic of each payload."""
     if not payloads or not payloads[0].startswith(_ZSTD_MAGIC):
         return payloads
-    from backports import zstd
     try:
         return [zstd.decompress(p) if p.startswith(_ZSTD_MAGIC) else p for p in payloads]
     except zstd.ZstdError as err:
@@ -347,7 +353,7 @@ def _storage_of(path: Path) -> str:
         return 'mcap'
     if name.endswith('.db3'):
         return 'sqlite3'
-    raise BagError(f'{path}: not a rosbag2 storage file (.db3, .db3.zstd or .mcap)')
+    raise BagError(f'{path}: not a rosbag2 storage file ({", ".join(_SUFFIXES)})')
 
 
 def _parse_metadata(path: Path) -> tuple[str, list[str], dict[str, TopicInfo], str]:
@@ -380,7 +386,7 @@ def open_bag(path: str | Path) -> Bag:
     Parameters
     ----------
     path : str or pathlib.Path
-        Bag directory, or a single ``.db3``, ``.db3.zstd`` or ``.mcap`` file, [-]
+        Bag directory, or a single ``.db3`` or ``.mcap`` file, either possibly ``.zstd``, [-]
 
     Returns
     -------
@@ -402,7 +408,7 @@ def open_bag(path: str | Path) -> Bag:
     meta_path = path / 'metadata.yaml'
     if not meta_path.is_file():
         files = sorted((p for p in path.iterdir()
-                        if p.name.endswith(('.db3', '.db3.zstd', '.mcap'))), key=_split_key)
+                        if p.name.endswith(_SUFFIXES)), key=_split_key)
         if not files:
             raise BagError(f'{path}: no metadata.yaml and no .db3/.mcap storage files')
         kinds = {_storage_of(p) for p in files}

@@ -1,11 +1,17 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Write bags with rosbags' writer: MCAP (default) or sqlite3, messages in log-time order."""
+"""
+Write bags with rosbags' writer: MCAP (default) or sqlite3, messages in log-time order.
+
+rosbags writes metadata.yaml and the sqlite3 storage; the MCAP storage is written by the
+``mcap`` library instead, because rosbags leaves the chunk CRCs zero: with them a reader
+refuses a damaged chunk rather than return altered numbers.
+"""
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 import numpy.typing as npt
@@ -20,6 +26,41 @@ class OutTopic(NamedTuple):
     msgtype: str  # e.g. 'sensor_msgs/msg/JointState'
     t_ns: npt.NDArray[np.int64]  # log times [ns]
     data: Sequence[bytes]  # serialised CDR messages
+
+
+class _McapStorage:
+    """rosbags' storage-writer interface over the ``mcap`` writer (zstd chunks with CRCs)."""
+
+    def __init__(self, path: Path, compression: Any) -> None:  # noqa: ARG002 (see STORAGE)
+        from mcap.writer import CompressionType, Writer
+
+        self.path = path / f'{path.name}.mcap'
+        self.stream = self.path.open('xb')
+        self.mcap = Writer(self.stream, compression=CompressionType.ZSTD, enable_crcs=True)
+        self.mcap.start(profile='ros2', library='satmotor_ros')
+        self.schemas: dict[str, int] = {}
+        self.channels: dict[int, int] = {}
+
+    def add_msgtype(self, connection: Any) -> None:
+        encoding = 'ros2msg' if connection.msgdef.format.name == 'MSG' else 'ros2idl'
+        self.schemas[connection.msgtype] = self.mcap.register_schema(
+            connection.msgtype, encoding, connection.msgdef.data.encode())
+
+    def add_connection(self, connection: Any, offered_qos_profiles: str) -> None:
+        self.channels[connection.id] = self.mcap.register_channel(
+            connection.topic, connection.ext.serialization_format,
+            self.schemas[connection.msgtype], {'offered_qos_profiles': offered_qos_profiles})
+
+    def write(self, connection: Any, timestamp: int, data: bytes) -> None:
+        self.mcap.add_message(self.channels[connection.id], timestamp, data, timestamp)
+
+    def close(self, version: int, metadata: str) -> None:  # noqa: ARG002 (rosbags' signature)
+        self.mcap.add_metadata('rosbag2', {'serialized_metadata': metadata})
+        self.mcap.finish()
+        self.stream.close()
+
+    def abort(self) -> None:
+        self.stream.close()
 
 
 def write_bag(path: str | Path, topics: Sequence[OutTopic], storage: str = 'mcap') -> int:
@@ -49,6 +90,9 @@ def write_bag(path: str | Path, topics: Sequence[OutTopic], storage: str = 'mcap
     from rosbags.rosbag2 import StoragePlugin, Writer, WriterError
     from rosbags.typesys import get_typestore, Stores
 
+    class McapWriter(Writer):
+        STORAGE_PLUGINS = {**Writer.STORAGE_PLUGINS, StoragePlugin.MCAP: _McapStorage}
+
     path = Path(path)
     if path.exists():
         raise BagError(f'{path}: already exists (choose a new directory for the bag)')
@@ -66,7 +110,7 @@ def write_bag(path: str | Path, topics: Sequence[OutTopic], storage: str = 'mcap
     stamps = np.concatenate(times) if times else which
     order = np.argsort(stamps, kind='stable')
     try:
-        writer = Writer(path, version=9, storage_plugin=plugins[storage])
+        writer = McapWriter(path, version=9, storage_plugin=plugins[storage])
         writer.open()
         try:
             connections = [writer.add_connection(t.name, t.msgtype, typestore=typestore)
