@@ -349,6 +349,6 @@ def test_mcap_with_a_schema_encoding_rosbags_does_not_know_reads(tmp_path):
     assert series.t_ns.tolist() == list(range(100, 110))
     mcap = next(bag.glob('*.mcap'))
     _flip(mcap, mcap.read_bytes().index(encode_message(FLOAT64, {'data': 5.0})) + 4, 8)
-    with pytest.raises(BagError, match=f'{mcap.name}: damaged or truncated .*crc validation failed'):
+    with pytest.raises(BagError,
+                       match=f'{mcap.name}: damaged or truncated .*crc validation failed'):
         read_series(bag, ['flow_command'])
-

@@ -24,7 +24,6 @@ DISAGREEING = {'v3_cdr_test_type_mismatch': '/test_topic is test_msgs/msg/BasicT
                                             'metadata.yaml and test_msgs/msg/Primitives in'}
 
 
-
 def test_the_table_covers_all_24_bags():
     bags = sorted(p.name for p in shared_path('data', 'foreign_bags').iterdir() if p.is_dir())
     assert bags == sorted([*STORAGE_COUNTS, *DISAGREEING]) == sorted(FOREIGN_BAGS)

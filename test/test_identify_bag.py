@@ -2,7 +2,6 @@
 """Calibration from rosbag2 recordings (MCAP and sqlite3) and one clear line for foreign bags."""
 
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -12,7 +11,6 @@ from satmotor_ros.identify import calibrate, DataError
 from satmotor_ros.identify.bag import read_bag
 from satmotor_ros.identify.synthetic import generate_series, Injection, Plan, write_bag_of
 from shared_data import foreign_bag, FOREIGN_BAGS
-
 
 
 @pytest.fixture(scope='module')

@@ -2,7 +2,6 @@
 """``satmotor replay``: bags through the node's prediction, CSV, bag and plot out."""
 
 import csv
-from pathlib import Path
 
 import numpy as np
 import pytest

@@ -16,7 +16,10 @@ split into several files, with zstd FILE or MESSAGE compression, or without meta
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
+import gc
 from pathlib import Path
 import re
 import shutil
@@ -296,13 +299,37 @@ def _read_with_rosbags(path: Path, wanted: set[str]) -> list[FileTopic] | None:
                                                  conn.msgcount), [], [])
                     for conn in reader.connections}
         picked = [conn for conn in reader.connections if conn.topic in wanted]
-        for conn, t_ns, data in reader.messages(picked) if picked else ():
-            channel = channels[conn.id]
-            channel.t_ns.append(t_ns)
-            channel.payloads.append(data)
+        with _gc_paused():
+            for conn, t_ns, data in reader.messages(picked) if picked else ():
+                channel = channels[conn.id]
+                channel.t_ns.append(t_ns)
+                channel.payloads.append(data)
     finally:
         reader.close()
     return list(channels.values())
+
+
+@contextmanager
+def _gc_paused() -> Iterator[None]:
+    """
+    Pause the cyclic garbage collector while a file's messages are read.
+
+    Reading allocates a few tuples per message, none of them in a cycle; the collector's
+    passes over them cost a quarter of the read (1.4e6 messages: 3.4 s -> 2.6 s).
+
+    Yields
+    ------
+    None
+        Nothing; the collector runs again (if it did before) on leaving.
+
+    """
+    enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if enabled:
+            gc.enable()
 
 
 def _read_with_mcap(path: Path, wanted: set[str]) -> list[FileTopic]:
