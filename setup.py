@@ -44,10 +44,10 @@ setup(
         'scipy',  # identify/: least squares, t and F distributions
         'PyYAML',
         'matplotlib',  # plots of calibrate, replay, characteristics, demo
-        'rosbags',  # bag writing (and the readers rosbags provides)
-        'lz4',  # lz4-compressed MCAP chunks
-        # zstd-compressed bags (file mode, message mode, MCAP chunks); the stdlib has
-        # compression.zstd from Python 3.14 on, which backports.zstd backports
+        'rosbags',  # bag reading and writing (sqlite3 and MCAP storage, metadata.yaml)
+        'mcap',  # MCAP chunks with CRCs (writing), MCAP files rosbags cannot open (reading)
+        # zstd FILE and MESSAGE compressed bags; the stdlib has compression.zstd from Python
+        # 3.14 on, which backports.zstd backports
         'backports.zstd; python_version < "3.14"',
     ],
     zip_safe=False,

@@ -27,7 +27,7 @@ import sqlite3
 import struct
 import sys
 import tempfile
-from typing import Any, NamedTuple
+from typing import cast, NamedTuple, TYPE_CHECKING
 
 import numpy as np
 import numpy.typing as npt
@@ -35,6 +35,9 @@ import numpy.typing as npt
 from satmotor_ros.bags.decode import pack_payloads
 from satmotor_ros.bags.errors import BagError
 import yaml
+
+if TYPE_CHECKING:
+    from rosbags.interfaces import ConnectionExtRosbag2
 
 if sys.version_info >= (3, 14):
     from compression import zstd
@@ -55,7 +58,7 @@ class TopicInfo(NamedTuple):
     name: str
     msgtype: str  # normalised: 'pkg/msg/Type'
     serialization: str  # 'cdr' for ROS 2
-    count: int  # messages in the storage
+    count: int  # type: ignore[assignment]  # messages in the storage (not tuple.count)
 
 
 class RawTopic(NamedTuple):
@@ -134,7 +137,7 @@ class Bag:
     storage: str  # 'sqlite3' or 'mcap'
     files: list[Path]
     metadata: dict[str, TopicInfo] | None  # from metadata.yaml; None when absent
-    _tmp: Any = field(default=None, repr=False)
+    _tmp: tempfile.TemporaryDirectory[str] | None = field(default=None, repr=False)
 
     def topics(self) -> dict[str, TopicInfo]:
         """
@@ -294,10 +297,10 @@ def _read_with_rosbags(path: Path, wanted: set[str]) -> list[FileTopic] | None:
     except KeyError:  # rosbags 0.11.9 knows no MCAP schema encoding 'unknown' (rosbag2's)
         return None
     try:
-        channels = {conn.id: FileTopic(TopicInfo(conn.topic, normalize_type(conn.msgtype),
-                                                 conn.ext.serialization_format,
-                                                 conn.msgcount), [], [])
-                    for conn in reader.connections}
+        channels = {conn.id: FileTopic(TopicInfo(
+            conn.topic, normalize_type(conn.msgtype),
+            cast('ConnectionExtRosbag2', conn.ext).serialization_format, conn.msgcount), [], [])
+            for conn in reader.connections}
         picked = [conn for conn in reader.connections if conn.topic in wanted]
         with _gc_paused():
             for conn, t_ns, data in reader.messages(picked) if picked else ():

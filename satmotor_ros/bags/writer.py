@@ -11,12 +11,16 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any, NamedTuple
+from typing import cast, NamedTuple, TYPE_CHECKING
 
 import numpy as np
 import numpy.typing as npt
 
 from satmotor_ros.bags.errors import BagError
+
+if TYPE_CHECKING:
+    from rosbags.interfaces import Connection, ConnectionExtRosbag2
+    from rosbags.rosbag2 import CompressionMode
 
 
 class OutTopic(NamedTuple):
@@ -31,7 +35,7 @@ class OutTopic(NamedTuple):
 class _McapStorage:
     """rosbags' storage-writer interface over the ``mcap`` writer (zstd chunks with CRCs)."""
 
-    def __init__(self, path: Path, compression: Any) -> None:  # noqa: ARG002 (see STORAGE)
+    def __init__(self, path: Path, compression: CompressionMode) -> None:  # noqa: ARG002
         from mcap.writer import CompressionType, Writer
 
         self.path = path / f'{path.name}.mcap'
@@ -41,18 +45,19 @@ class _McapStorage:
         self.schemas: dict[str, int] = {}
         self.channels: dict[int, int] = {}
 
-    def add_msgtype(self, connection: Any) -> None:
+    def add_msgtype(self, connection: Connection) -> None:
         encoding = 'ros2msg' if connection.msgdef.format.name == 'MSG' else 'ros2idl'
         self.schemas[connection.msgtype] = self.mcap.register_schema(
             connection.msgtype, encoding, connection.msgdef.data.encode())
 
-    def add_connection(self, connection: Any, offered_qos_profiles: str) -> None:
+    def add_connection(self, connection: Connection, offered_qos_profiles: str) -> None:
+        ext = cast('ConnectionExtRosbag2', connection.ext)
         self.channels[connection.id] = self.mcap.register_channel(
-            connection.topic, connection.ext.serialization_format,
+            connection.topic, ext.serialization_format,
             self.schemas[connection.msgtype], {'offered_qos_profiles': offered_qos_profiles})
 
-    def write(self, connection: Any, timestamp: int, data: bytes) -> None:
-        self.mcap.add_message(self.channels[connection.id], timestamp, data, timestamp)
+    def write(self, connection: Connection, timestamp: int, data: bytes | memoryview) -> None:
+        self.mcap.add_message(self.channels[connection.id], timestamp, bytes(data), timestamp)
 
     def close(self, version: int, metadata: str) -> None:  # noqa: ARG002 (rosbags' signature)
         self.mcap.add_metadata('rosbag2', {'serialized_metadata': metadata})
