@@ -3,8 +3,8 @@
 
 from pathlib import Path
 import shutil
-import sys
 
+from backports import zstd
 import numpy as np
 import pytest
 from rosbags.highlevel import AnyReader
@@ -16,10 +16,6 @@ from satmotor_ros.bags import (BagError, decode, encode_many, encode_message, FL
                                TEMPERATURE, write_bag)
 import yaml
 
-if sys.version_info >= (3, 14):
-    from compression import zstd
-else:
-    from backports import zstd
 
 TYPESTORE = get_typestore(Stores.ROS2_KILTED)
 N = 200
