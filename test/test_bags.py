@@ -12,8 +12,8 @@ from rosbags.rosbag2 import CompressionFormat, CompressionMode, StoragePlugin, W
 from rosbags.typesys import get_typestore, Stores
 from satmotor_ros.bags import (BagError, decode, encode_many, encode_message, FLOAT64,
                                FLUID_PRESSURE, JOINT_STATE, list_topics, match_topics,
-                               missing_topics, OutTopic, parse_topic_map, read_series,
-                               TEMPERATURE, write_bag)
+                               missing_topics, OutTopic, pack_payloads, parse_topic_map,
+                               read_series, TEMPERATURE, write_bag)
 import yaml
 
 
@@ -89,7 +89,7 @@ def test_decoder_equals_rosbags_on_mixed_layouts_and_endianness():
                  effort=rng.normal(size=k) if i % 5 else np.zeros(0))
         msgs.append((msg, bytes(TYPESTORE.serialize_cdr(msg, JOINT_STATE,
                                                         little_endian=bool(i % 7)))))
-    decoded = decode(JOINT_STATE, [raw for _, raw in msgs], 'motor_shaft')
+    decoded = decode(JOINT_STATE, *pack_payloads([raw for _, raw in msgs]), 'motor_shaft')
     expected = [m for m, _ in msgs if 'motor_shaft' in m.name]
     assert decoded.keep.sum() == len(expected) == 45
     for name in ('position', 'velocity', 'effort'):
@@ -118,11 +118,11 @@ def test_encoder_is_byte_identical_to_rosbags():
 
 def test_decoder_rejects_garbage_with_one_line():
     with pytest.raises(BagError, match='truncated'):
-        decode(FLUID_PRESSURE, [b'\x00\x01\x00\x00\x01\x00'])
+        decode(FLUID_PRESSURE, *pack_payloads([b'\x00\x01\x00\x00\x01\x00']))
     with pytest.raises(BagError, match='not a CDR message'):
-        decode(FLOAT64, [b'\xff\xff\x00\x00' + bytes(8)])
+        decode(FLOAT64, *pack_payloads([b'\xff\xff\x00\x00' + bytes(8)]))
     with pytest.raises(BagError, match='no fast decoder'):
-        decode('std_msgs/msg/String', [b''])
+        decode('std_msgs/msg/String', *pack_payloads([b'']))
 
 
 def test_names_match_with_or_without_namespace_and_can_be_renamed():

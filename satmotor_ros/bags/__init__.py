@@ -20,7 +20,7 @@ Example::
 """
 
 from satmotor_ros.bags.decode import decode, FIELDS, FLOAT64, FLUID_PRESSURE, JOINT_STATE, \
-    TEMPERATURE
+    pack_payloads, TEMPERATURE
 from satmotor_ros.bags.encode import encode_many, encode_message
 from satmotor_ros.bags.errors import BagError
 from satmotor_ros.bags.series import (describe_topics, list_topics, match_topics,
@@ -32,5 +32,6 @@ __all__ = [
     'BagError', 'FIELDS', 'FLOAT64', 'FLUID_PRESSURE', 'JOINT_STATE', 'OutTopic', 'Series',
     'TEMPERATURE', 'TopicInfo', 'decode',
     'describe_topics', 'encode_many', 'encode_message', 'list_topics', 'match_topics',
-    'missing_topics', 'open_bag', 'parse_topic_map', 'read_series', 'write_bag',
+    'missing_topics', 'open_bag', 'pack_payloads', 'parse_topic_map', 'read_series',
+    'write_bag',
 ]

@@ -2,7 +2,8 @@
 """
 Fast CDR decoding of the fixed message layouts: Float64, FluidPressure, Temperature, JointState.
 
-A generic deserialiser walks every message field by field (rosbags: ~10 us a message).
+A generic deserialiser walks every message field by field (rosbags' deserialize_cdr: 2.5 us
+a FluidPressure, 6 us a JointState; here 0.08 and 0.22 us, measured on 3.6e5 of each).
 These layouts are fixed up to their strings and sequence lengths, so messages are grouped
 by length; one message per group is parsed in Python to find where each number sits and
 which bytes carry the structure (lengths, joint names); every message of the group whose
@@ -159,28 +160,6 @@ class Decoded(NamedTuple):
     fields: dict[str, npt.NDArray[np.float64]]  # per FIELDS name, kept messages [SI]
 
 
-def decode(msgtype: str, payloads: Sequence[bytes], joint: str | None = None) -> Decoded:
-    """
-    Decode a list of messages of one topic into arrays (see :func:`decode_packed`).
-
-    Parameters
-    ----------
-    msgtype : str
-        One of the types of :data:`FIELDS`, [-]
-    payloads : sequence of bytes
-        The serialised messages, [-]
-    joint : str or None
-        JointState only: the joint to take (None: the first of each message), [-]
-
-    Returns
-    -------
-    Decoded
-        Which messages hold values, their header stamps and their fields.
-
-    """
-    return decode_packed(msgtype, *pack_payloads(payloads), joint)
-
-
 def pack_payloads(payloads: Sequence[bytes]) -> tuple[npt.NDArray[np.uint8],
                                                       npt.NDArray[np.int64],
                                                       npt.NDArray[np.int64]]:
@@ -204,8 +183,8 @@ def pack_payloads(payloads: Sequence[bytes]) -> tuple[npt.NDArray[np.uint8],
     return np.frombuffer(b''.join(payloads), dtype=np.uint8), offsets, lengths
 
 
-def decode_packed(msgtype: str, buf: npt.NDArray[np.uint8], offsets: npt.NDArray[np.int64],
-                  lengths: npt.NDArray[np.int64], joint: str | None = None) -> Decoded:
+def decode(msgtype: str, buf: npt.NDArray[np.uint8], offsets: npt.NDArray[np.int64],
+           lengths: npt.NDArray[np.int64], joint: str | None = None) -> Decoded:
     """
     Decode the messages of one topic, packed in one buffer, into arrays.
 
@@ -214,7 +193,7 @@ def decode_packed(msgtype: str, buf: npt.NDArray[np.uint8], offsets: npt.NDArray
     msgtype : str
         One of the types of :data:`FIELDS`, [-]
     buf : ndarray of uint8
-        The serialised messages, [-]
+        The serialised messages, back to back or not (:func:`pack_payloads` packs a list), [-]
     offsets, lengths : ndarray of int64
         Where each message starts in `buf`, and its length, [bytes]
     joint : str or None

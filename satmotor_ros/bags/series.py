@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 import numpy.typing as npt
 
-from satmotor_ros.bags.decode import decode_packed, FIELDS
+from satmotor_ros.bags.decode import decode, FIELDS
 from satmotor_ros.bags.errors import BagError
 from satmotor_ros.bags.storage import open_bag, TopicInfo
 from satmotor_ros.interface import TOPIC_TYPES
@@ -212,8 +212,8 @@ def read_series(path: str | Path, topics: Iterable[str],
         info = available[name]
         messages = raw[name]
         try:
-            decoded = decode_packed(info.msgtype, messages.buf, messages.offsets,
-                                    messages.lengths, joint)
+            decoded = decode(info.msgtype, messages.buf, messages.offsets, messages.lengths,
+                             joint)
         except BagError as err:
             raise BagError(f'{name}: {err}') from None
         keep = decoded.keep

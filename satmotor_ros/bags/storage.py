@@ -66,20 +66,7 @@ class RawTopic(NamedTuple):
     lengths: npt.NDArray[np.int64]  # length of each payload [bytes]
 
     def payload(self, i: int) -> bytes:
-        """
-        Return one serialised message.
-
-        Parameters
-        ----------
-        i : int
-            Index of the message, [-]
-
-        Returns
-        -------
-        bytes
-            The CDR payload.
-
-        """
+        """Return message `i` as stored: its CDR bytes."""
         start = int(self.offsets[i])
         return self.buf[start:start + int(self.lengths[i])].tobytes()
 
@@ -94,21 +81,8 @@ def _packed(t_ns: list[int], payloads: list[bytes]) -> RawTopic:
     return raw
 
 
-def normalize_type(msgtype: str) -> str:
-    """
-    Give a message type its ``pkg/msg/Type`` form (Crystal-era bags wrote ``pkg/Type``).
-
-    Parameters
-    ----------
-    msgtype : str
-        Type name as stored, [-]
-
-    Returns
-    -------
-    str
-        The normalised name.
-
-    """
+def _normalized_type(msgtype: str) -> str:
+    """Give a type name its ``pkg/msg/Type`` form (Crystal-era bags wrote ``pkg/Type``)."""
     parts = msgtype.strip().split('/')
     return f'{parts[0]}/msg/{parts[1]}' if len(parts) == 2 else msgtype.strip()
 
@@ -260,8 +234,10 @@ def _read_file(path: Path, wanted: set[str], name: str) -> list[FileTopic]:
         channels = _read_with_rosbags(path, wanted)
         if channels is None:
             channels = _read_with_mcap(path, wanted)
+    except BagError:
+        raise
     except (ReaderError, McapError, sqlite3.Error, zstd.ZstdError, struct.error, EOFError,
-            ValueError, TypeError, IndexError, RuntimeError) as err:
+            ValueError, TypeError, LookupError, RuntimeError) as err:
         detail = (str(err).splitlines() or [type(err).__name__])[0]
         raise BagError(f'{name}: damaged or truncated ({detail})') from None
     topics: dict[str, FileTopic] = {}
@@ -294,7 +270,7 @@ def _read_with_rosbags(path: Path, wanted: set[str]) -> list[FileTopic] | None:
         return None
     try:
         channels = {conn.id: FileTopic(TopicInfo(
-            conn.topic, normalize_type(conn.msgtype),
+            conn.topic, _normalized_type(conn.msgtype),
             cast('ConnectionExtRosbag2', conn.ext).serialization_format, conn.msgcount), [], [])
             for conn in reader.connections}
         picked = [conn for conn in reader.connections if conn.topic in wanted]
@@ -351,7 +327,7 @@ def _read_with_mcap(path: Path, wanted: set[str]) -> list[FileTopic]:
                 schemas[record.id] = record.name
             elif isinstance(record, Channel) and record.id not in channels:
                 channels[record.id] = FileTopic(TopicInfo(
-                    record.topic, normalize_type(schemas.get(record.schema_id, '')),
+                    record.topic, _normalized_type(schemas.get(record.schema_id, '')),
                     record.message_encoding, 0), [], [])
     return [c._replace(info=c.info._replace(count=counts.get(k, 0)))
             for k, c in channels.items()]
@@ -391,7 +367,7 @@ def _parse_metadata(path: Path) -> tuple[str, list[str], dict[str, TopicInfo], s
         topics = {}
         for entry in info.get('topics_with_message_count') or ():
             meta = entry['topic_metadata']
-            topics[meta['name']] = TopicInfo(meta['name'], normalize_type(meta['type']),
+            topics[meta['name']] = TopicInfo(meta['name'], _normalized_type(meta['type']),
                                              meta.get('serialization_format', 'cdr'),
                                              int(entry.get('message_count', 0)))
         mode = str(info.get('compression_mode') or '')
