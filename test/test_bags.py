@@ -1,8 +1,10 @@
 # SPDX-License-Identifier: Apache-2.0
 """Bags written and read back: the fast decoder against rosbags, matching, errors."""
 
+import gc
 from pathlib import Path
 import shutil
+import struct
 
 from backports import zstd
 import numpy as np
@@ -53,6 +55,7 @@ def test_written_bag_reads_back_exactly_and_as_rosbags_reads_it(tmp_path, storag
     assert write_bag(bag, data['topics'], storage=storage) == 4 * N
     series = read_series(bag, ['flow_command', 'inlet_pressure', 'outlet_pressure',
                                'joint_states'])
+    assert gc.isenabled()  # paused only while the messages were collected
     np.testing.assert_array_equal(series['flow_command'].fields['data'], data['flow'])
     np.testing.assert_array_equal(series['flow_command'].t_ns, data['t'][0])
     assert series['flow_command'].stamp_ns is None
@@ -347,4 +350,17 @@ def test_mcap_with_a_schema_encoding_rosbags_does_not_know_reads(tmp_path):
     _flip(mcap, mcap.read_bytes().index(encode_message(FLOAT64, {'data': 5.0})) + 4, 8)
     with pytest.raises(BagError,
                        match=f'{mcap.name}: damaged or truncated .*crc validation failed'):
+        read_series(bag, ['flow_command'])
+
+
+def test_mcap_whose_statistics_count_other_messages_than_it_holds_is_refused(tmp_path):
+    bag = _mcap_by_the_mcap_library(tmp_path / 'bag', schema_encoding='ros2msg')
+    mcap = next(bag.glob('*.mcap'))
+    counts = struct.pack('<IHQ', 10, 1, 10)  # statistics: one channel, id 1, 10 messages
+    data = mcap.read_bytes()
+    assert data.count(counts) == 1
+    mcap.write_bytes(data.replace(counts, struct.pack('<IHQ', 10, 1, 11)))
+    assert list_topics(bag)['/flow_command'].count == 11  # the summary, as rosbags reads it
+    with pytest.raises(BagError, match=r'x_0.mcap: damaged or truncated \(/flow_command: its '
+                                       r'index counts 11 messages, 10 were found\)'):
         read_series(bag, ['flow_command'])
