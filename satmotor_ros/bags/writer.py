@@ -61,7 +61,7 @@ class _McapStorage:
 
     def close(self, version: int, metadata: str) -> None:  # noqa: ARG002 (rosbags' signature)
         self.mcap.add_metadata('rosbag2', {'serialized_metadata': metadata})
-        self.mcap.finish()
+        self.mcap.finish()  # type: ignore[no-untyped-call]  # mcap 1.6 leaves it unannotated
         self.stream.close()
 
     def abort(self) -> None:
