@@ -19,8 +19,8 @@ from satmotor_ros.identify.pipeline import calibrate, Calibration, Options, stea
 from satmotor_ros.identify.selection import CrossValidatedSelector, Errors, Selection
 from satmotor_ros.identify.steady import extract_steady, SteadyTolerance
 from satmotor_ros.identify.table import BenchTable, read_csv, REQUIRED, write_csv
-from satmotor_ros.identify.viscosity import standard_law, ViscosityLaw
 from satmotor_ros.model.effects import TERMS
+from satmotor_ros.model.viscosity import standard_law, ViscosityLaw
 
 __all__ = [
     'BenchTable', 'Calibration', 'Candidate', 'CrossValidatedSelector', 'DataError', 'Errors',

@@ -28,26 +28,8 @@ from typing import Any
 import numpy as np
 from satmotor_ros.identify.pipeline import Calibration
 from satmotor_ros.model import LossCoefficients
-from satmotor_ros.model.viscosity import WATER_VOGEL
+from satmotor_ros.model.effects import effect_to_mapping
 import yaml
-
-EVALUATION = {
-    'external_leakage': 'Q_ex = k_ex * p (eq. 24) with p the gauge pressure named by regressor; '
-                        'k_ex is also coefficients.external_leakage',
-    'viscosity_temperature': 'nu(T) from the law (walther: log10(log10(nu_cSt + 0.7)) = '
-                             'log10(log10(nu_ref_cSt + 0.7)) - B (log10 T_K - log10 T_ref_K); '
-                             'vogel: nu = nu_ref 10^(B (1/(T_K - C) - 1/(T_ref_K - C)))) '
-                             'replaces the liquid viscosity in eqs. (1), (5) and (35)',
-    'clearance_wear': 'h_R and h_S grow by w (x - reference), x = time [s] or cumulative '
-                      'revolutions [rev], in eqs. (1), (2) and (5)',
-    'flow_sensor_offset': 'the flowmeter reads Q + b; the motor absorbs Q',
-    'flow_sensor_gain': 'the flowmeter reads (1 + g) Q; the motor absorbs Q',
-    'speed_sensor_gain': 'the speed sensor reads (1 + g) n; the shaft turns at n',
-    'channel': 'extra loss k (x - reference) added to Q_vl (eq. 31), x the channel',
-    'term': 'extra loss k f(n [rad/s], dp [Pa]) added to Q_vl (eq. 31), dp the chamber drop '
-            'dp_i of eq. (34)',
-}
-"""What the model must do with each kind of effect block (also written into the YAML)."""
 
 
 def write_json(cal: Calibration, path: str | Path) -> dict[str, Any]:
@@ -117,22 +99,10 @@ def effect_block(cal: Calibration) -> dict[str, Any]:
     if chosen is None:
         return {}
     value = float(cal.final.values[3])
-    entry: dict[str, Any] = {
-        'regressor': chosen.regressor, 'coefficient': value, 'unit': chosen.unit,
-        'ci95': [float(v) for v in cal.final.ci95[3]], 'source': chosen.source,
-    }
-    kind = chosen.effect.split(':')[0]
-    if chosen.effect == 'viscosity_temperature':
-        law = cal.law
-        entry.update(law=law.law, reference_temperature=float(law.reference_temperature),
-                     reference_viscosity=float(law.reference_viscosity))
-        if law.law == 'vogel':
-            entry['vogel_c'] = WATER_VOGEL[2]
-    elif chosen.effect == 'clearance_wear':
-        entry['reference'] = float(np.min(cal.table.channels[chosen.regressor]))
-    elif kind == 'channel':
-        entry['reference'] = float(np.mean(cal.table.channels[chosen.regressor]))
-    entry['evaluation'] = EVALUATION[kind]
+    entry = effect_to_mapping(chosen.as_effect(value))
+    entry.update(unit=chosen.unit, ci95=[float(v) for v in cal.final.ci95[3]],
+                 source=chosen.source)
+    entry['evaluation'] = entry.pop('evaluation')
     return {chosen.effect: entry}
 
 

@@ -19,6 +19,7 @@ from satmotor_ros.identify.errors import IdentificationError
 from satmotor_ros.identify.table import BenchTable
 from satmotor_ros.model import MotorModel
 from satmotor_ros.model._typing import FloatArray
+from satmotor_ros.model.effects import Modifier
 from satmotor_ros.model.losses import channel_pressure_drop, clearance_height
 
 SCALES = ('leakage_scale', 'c_scale', 'c_id_scale')
@@ -53,18 +54,6 @@ class LossParts:
     def __len__(self) -> int:
         """Return the number of points."""
         return int(self.flow.size)
-
-
-@dataclass(frozen=True)
-class Modifier:
-    """How a candidate effect changes the model's prediction of the measured flow."""
-
-    flow_gain: float = 1.0  # measured / true flow [-]
-    speed_gain: float = 1.0  # measured / true speed [-]
-    flat_clearance: FloatArray | float = 1.0  # factor on Q_Lfg [-]
-    commutation: FloatArray | float = 1.0  # factor on Q_C [-]
-    additive: FloatArray | float = 0.0  # extra loss [m^3/s]
-    offset: float = 0.0  # flowmeter offset [m^3/s]
 
 
 NO_EFFECT = Modifier()

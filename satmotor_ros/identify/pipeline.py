@@ -19,11 +19,11 @@ from satmotor_ros.identify.errors import DataError, IdentificationError
 from satmotor_ros.identify.fit import check_identifiable, FitReport
 from satmotor_ros.identify.parts import loss_parts, LossParts, predict_flow
 from satmotor_ros.identify.selection import CrossValidatedSelector, Errors, Selection
-from satmotor_ros.identify.steady import (extract_steady, looks_like_series, revolutions,
-                                          SteadyTolerance)
+from satmotor_ros.identify.steady import extract_steady, looks_like_series, SteadyTolerance
 from satmotor_ros.identify.table import BenchTable
-from satmotor_ros.identify.viscosity import standard_law, ViscosityLaw
 from satmotor_ros.model import load_motor, MotorModel, MotorSpec
+from satmotor_ros.model.revolutions import sampled_revolutions
+from satmotor_ros.model.viscosity import standard_law, ViscosityLaw
 
 Mode = Literal['auto', 'points', 'series']
 
@@ -139,7 +139,7 @@ def steady_points(table: BenchTable, mode: Mode = 'auto',
         table = table.select(order)
         if 'revolutions' not in table.channels:
             channels = dict(table.channels)
-            channels['revolutions'] = revolutions(table.speed, table.channels['time'])
+            channels['revolutions'] = sampled_revolutions(table.speed, table.channels['time'])
             table = BenchTable(table.speed, table.flow, table.p_in, table.p_out, channels,
                                {**table.units, 'revolutions': 'rev'}, table.source, False,
                                table.notes + ('revolutions integrated from speed between '

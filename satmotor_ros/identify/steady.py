@@ -10,6 +10,7 @@ import numpy as np
 from satmotor_ros.identify.errors import DataError
 from satmotor_ros.identify.table import BenchTable
 from satmotor_ros.model._typing import FloatArray
+from satmotor_ros.model.revolutions import sampled_revolutions
 from satmotor_ros.model.units import LPM, MPA, RPM
 
 
@@ -185,27 +186,6 @@ def steady_runs(table: BenchTable, time: FloatArray,
     return sorted(runs)
 
 
-def revolutions(speed: FloatArray, time: FloatArray) -> FloatArray:
-    """
-    Integrate the shaft speed over time by the trapezoid rule.
-
-    Parameters
-    ----------
-    speed : ndarray
-        Shaft speed, [rad/s]
-    time : ndarray
-        Sample times, increasing, [s]
-
-    Returns
-    -------
-    ndarray
-        Revolutions since the first sample, [rev]
-
-    """
-    steps = 0.5 * (speed[1:] + speed[:-1]) * np.diff(time)
-    return np.concatenate(([0.0], np.cumsum(steps))) / (2.0 * np.pi)
-
-
 def extract_steady(table: BenchTable, tol: SteadyTolerance | None = None) -> BenchTable:
     """
     Average each steady window of a time series into one operating point.
@@ -247,7 +227,7 @@ def extract_steady(table: BenchTable, tol: SteadyTolerance | None = None) -> Ben
         msg = (f'{table.source}: no steady window found in {len(table)} samples (flow, '
                f'pressures and speed must hold within tolerance for >= {tol.min_duration} s)')
         raise DataError(msg)
-    revs = revolutions(table.speed, time)
+    revs = sampled_revolutions(table.speed, time)
     starts = np.array([a for a, _ in runs])
     stops = np.array([b for _, b in runs])
 

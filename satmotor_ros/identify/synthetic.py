@@ -3,12 +3,14 @@
 Synthetic bench data from the model, with one effect injected and seeded noise.
 
 The truth is always :class:`~satmotor_ros.model.MotorModel` itself: the
-flow is its forward map Q(n, dp) (eqs. 34-36, channel drop coupled), with
-a modified coefficient set, liquid or geometry for the physical effects
-(a model per temperature or per wear state), and the sensor effects applied
-to what the sensors report. The viscosity law used here is deliberately not
-the one the candidate library fits (an exponential law for oil, a table for
-water), so a test also checks that the library generalises.
+flow is its forward map Q(n, dp) (eqs. 34-36, channel drop coupled) with the
+injected effect in its coefficient set, evaluated by the effect's own kind
+(:mod:`satmotor_ros.model.effects`), and the sensor effects applied to what
+the sensors report. An :class:`Injection`'s magnitude is turned into the
+effect's coefficient by the kind (:meth:`~satmotor_ros.model.effects.EffectKind.scaled`).
+The injected viscosity law is the liquid's standard one pinned at the mean
+temperature of the data, while the candidate library pins it at the set's
+viscosity, so a test still checks that the fit generalises over the pinning.
 """
 
 from __future__ import annotations
@@ -22,15 +24,10 @@ import numpy as np
 from satmotor_ros.identify.table import BenchTable
 from satmotor_ros.model import load_motor, MotorModel
 from satmotor_ros.model._typing import FloatArray
-from satmotor_ros.model.effects import TERMS
+from satmotor_ros.model.effects import Effect, kind_of, sensor_error, Synthetic, with_effects
+from satmotor_ros.model.revolutions import revolutions
 from satmotor_ros.model.units import LPM, MPA, RPM
-
-WATER_TABLE = ((10.0, 1.3059e-3), (20.0, 1.0016e-3), (30.0, 0.7972e-3), (40.0, 0.6527e-3),
-               (50.0, 0.5465e-3), (60.0, 0.4660e-3), (70.0, 0.4035e-3))
-"""Dynamic viscosity of water [degC], [Pa*s] (IAPWS 2008 at 0.1 MPa)."""
-
-OIL_LAMBDA = 0.042
-"""Exponential viscosity-temperature coefficient of an ISO VG 46 oil near 40 degC, [1/K]."""
+from satmotor_ros.model.viscosity import standard_law
 
 EFFECTS = ('none', 'external_leakage', 'viscosity_temperature', 'clearance_wear',
            'flow_sensor_offset', 'flow_sensor_gain', 'speed_sensor_gain', 'channel:aux',
@@ -138,33 +135,40 @@ class Plan:
         return np.hypot(q, n)
 
 
-def _law_viscosity(liquid: str, nu_ref: float, temperature: FloatArray,
-                   t_ref: float) -> FloatArray:
-    if 'water' in liquid:
-        t, mu = np.array(WATER_TABLE).T
-        rel = np.exp(np.interp(temperature, t, np.log(mu)) - np.interp(t_ref, t, np.log(mu)))
-        return nu_ref * rel
-    return nu_ref * np.exp(-OIL_LAMBDA * (temperature - t_ref))
+def injected_effect(base: MotorModel, injection: Injection, speed: FloatArray,
+                    dp: FloatArray, channels: dict[str, FloatArray]) -> Effect | None:
+    """
+    Turn an injection into the registry's effect at the data's operating points.
+
+    Parameters
+    ----------
+    base : MotorModel
+        The packaged model, [-]
+    injection : Injection
+        The effect and its magnitude, [-]
+    speed : ndarray
+        True speed, [rad/s]
+    dp : ndarray
+        True port drop, [Pa]
+    channels : dict of str to ndarray
+        Channels (time [s], revolutions [rev], temperature [degC], p_case, p_out [Pa],
+        extra), [-]
+
+    Returns
+    -------
+    Effect or None
+        The effect; None for ``'none'``.
+
+    """
+    if injection.effect == 'none':
+        return None
+    kind = kind_of(Effect(injection.effect, 0.0))
+    dp_i = base.absorbency(speed, dp=dp, errors='mask').dp_i
+    data = Synthetic(speed, dp_i, channels, standard_law(base.liquid, base.coefficient_set.name))
+    return kind.scaled(injection.effect, injection.magnitude, injection.regressor, data)
 
 
-def _absorbency(model: MotorModel, speed: FloatArray, dp: FloatArray,
-                p_ex: FloatArray | float = 0.0) -> tuple[FloatArray, FloatArray]:
-    op = model.absorbency(speed, dp=dp, p_ex=p_ex)
-    return op.flow, op.dp_i
-
-
-def _grouped(models: list[MotorModel], group: np.ndarray, speed: FloatArray, dp: FloatArray,
-             p_ex: FloatArray | float) -> tuple[FloatArray, FloatArray]:
-    flow, dp_i = np.empty_like(speed), np.empty_like(speed)
-    p_ex = np.broadcast_to(p_ex, speed.shape)
-    for g, model in enumerate(models):
-        at = group == g
-        if at.any():
-            flow[at], dp_i[at] = _absorbency(model, speed[at], dp[at], p_ex[at])
-    return flow, dp_i
-
-
-def true_flow(base: MotorModel, injection: Injection, speed: FloatArray, dp: FloatArray,
+def true_flow(base: MotorModel, effect: Effect | None, speed: FloatArray, dp: FloatArray,
               channels: dict[str, FloatArray]) -> FloatArray:
     """
     Compute the flow the motor really absorbs, with a physical effect injected.
@@ -173,15 +177,14 @@ def true_flow(base: MotorModel, injection: Injection, speed: FloatArray, dp: Flo
     ----------
     base : MotorModel
         The packaged model, [-]
-    injection : Injection
-        The effect, [-]
+    effect : Effect or None
+        The injected effect (a sensor effect leaves the flow alone), [-]
     speed : ndarray
         True speed, [rad/s]
     dp : ndarray
         True port drop, [Pa]
     channels : dict of str to ndarray
-        Channels (time [s], revolutions [rev], temperature [degC], p_case,
-        p_out [Pa], extra), [-]
+        The channels the effect reads, [-]
 
     Returns
     -------
@@ -189,40 +192,11 @@ def true_flow(base: MotorModel, injection: Injection, speed: FloatArray, dp: Flo
         Flow, [m^3/s]
 
     """
-    effect, k = injection.effect, injection.magnitude
-    spec = base.coefficient_set
-    if effect == 'external_leakage':
-        coef = replace(spec.coefficients, external_leakage=k)
-        model = MotorModel(base.geometry, replace(spec, coefficients=coef), base.valid_range)
-        return _absorbency(model, speed, dp, channels[injection.regressor or 'p_case'])[0]
-    if effect == 'viscosity_temperature':
-        temperature = channels['temperature']
-        bins = np.round(temperature * 4.0) / 4.0
-        levels, group = np.unique(bins, return_inverse=True)
-        t_ref = float(np.mean(temperature))
-        nus = _law_viscosity(spec.name, spec.liquid.kinematic_viscosity, levels, t_ref)
-        models = [MotorModel(base.geometry, spec, base.valid_range,
-                             replace(spec.liquid, kinematic_viscosity=float(nu)))
-                  for nu in nus]
-        return _grouped(models, group, speed, dp, 0.0)[0]
-    if effect == 'clearance_wear':
-        x = channels[injection.regressor or 'time']
-        frac = (x - x.min()) / max(np.ptp(x), 1e-300)
-        steps = np.round(frac * 200).astype(int)
-        levels, group = np.unique(steps, return_inverse=True)
-        g = base.geometry
-        models = [MotorModel(replace(g, clearance_rotor=g.clearance_rotor + k * s / 200,
-                                     clearance_satellites=g.clearance_satellites + k * s / 200),
-                             spec, base.valid_range) for s in levels]
-        return _grouped(models, group, speed, dp, 0.0)[0]
-    flow, dp_i = _absorbency(base, speed, dp)
-    if effect.startswith('term:'):
-        x = TERMS[effect[5:]][0](speed, dp_i)
-        return flow + k * x / np.max(np.abs(x))
-    if effect.startswith('channel:'):
-        x = channels[effect[8:]]
-        return flow + k * (x - x.mean()) / max(np.ptp(x), 1e-300)
-    return flow
+    if effect is None or kind_of(effect).sensor:
+        return base.absorbency(speed, dp=dp).flow
+    model = with_effects(base, (effect,))
+    needed = {name: channels[name] for name in model.channels}
+    return model.absorbency(speed, dp=dp, channels=needed).flow
 
 
 def _operating_points(plan: Plan, rng: np.random.Generator,
@@ -260,16 +234,17 @@ def _channels(plan: Plan, injection: Injection, rng: np.random.Generator, time: 
     return channels
 
 
-def _measure(plan: Plan, injection: Injection, rng: np.random.Generator, flow: FloatArray,
+def _measure(plan: Plan, effect: Effect | None, rng: np.random.Generator, flow: FloatArray,
              speed: FloatArray, dp: FloatArray,
              channels: dict[str, FloatArray], noise: float) -> BenchTable:
     n = flow.size
-    gain_q = 1.0 + (injection.magnitude if injection.effect == 'flow_sensor_gain' else 0.0)
-    gain_n = 1.0 + (injection.magnitude if injection.effect == 'speed_sensor_gain' else 0.0)
-    offset = injection.magnitude if injection.effect == 'flow_sensor_offset' else 0.0
+    effects = () if effect is None else (effect,)
+    gain_q, offset_q = sensor_error(effects, 'flow')
+    gain_n, offset_n = sensor_error(effects, 'speed')
     sd_q = np.hypot(plan.noise_flow_lpm * LPM, plan.noise_flow_rel * flow) * noise
-    flow_m = gain_q * flow + offset + rng.normal(0.0, 1.0, n) * sd_q
-    speed_m = gain_n * speed + rng.normal(0.0, plan.noise_speed_rpm * RPM * noise, n)
+    flow_m = gain_q * flow + offset_q + rng.normal(0.0, 1.0, n) * sd_q
+    speed_m = (gain_n * speed + offset_n
+               + rng.normal(0.0, plan.noise_speed_rpm * RPM * noise, n))
     sd_p = plan.noise_pressure_mpa * MPA * noise
     p_out = channels.pop('p_out') + rng.normal(0.0, sd_p, n)
     p_in = p_out + dp + rng.normal(0.0, sd_p, n)
@@ -306,10 +281,11 @@ def generate(plan: Plan, injection: Injection, seed: int = 0) -> BenchTable:
     speed, dp = _operating_points(plan, rng, n)
     time = np.sort(rng.uniform(0.0, plan.duration_s, n))
     channels = _channels(plan, injection, rng, time, n, np.arange(n))
-    channels['revolutions'] = np.cumsum(np.diff(time, prepend=0.0) * speed) / (2 * np.pi)
+    channels['revolutions'] = revolutions(speed, np.diff(time, prepend=0.0))
     base = MotorModel.from_spec(load_motor(), plan.liquid)
-    flow = true_flow(base, injection, speed, dp, {**channels})
-    return _measure(plan, injection, rng, flow, speed, dp, channels, 1.0)
+    effect = injected_effect(base, injection, speed, dp, channels)
+    flow = true_flow(base, effect, speed, dp, channels)
+    return _measure(plan, effect, rng, flow, speed, dp, channels, 1.0)
 
 
 def generate_series(plan: Plan, injection: Injection, seed: int = 0, samples: int = 20000,
@@ -357,10 +333,11 @@ def generate_series(plan: Plan, injection: Injection, seed: int = 0, samples: in
         d += alpha * (target_d[i] - d)
         speed[i], dp[i] = s, d
     channels = _channels(plan, injection, rng, time, steps, k)
-    channels['revolutions'] = np.cumsum(speed / rate) / (2 * np.pi)
+    channels['revolutions'] = revolutions(speed, 1.0 / rate)
     base = MotorModel.from_spec(load_motor(), plan.liquid)
-    flow = true_flow(base, injection, speed, dp, {**channels})
-    table = _measure(plan, injection, rng, flow, speed, dp, channels, noise)
+    effect = injected_effect(base, injection, speed, dp, channels)
+    flow = true_flow(base, effect, speed, dp, channels)
+    table = _measure(plan, effect, rng, flow, speed, dp, channels, noise)
     return replace(table, time_series=True)
 
 

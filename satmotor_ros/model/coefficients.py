@@ -13,10 +13,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass, fields
 import math
+from typing import TYPE_CHECKING
 
-from satmotor_ros.model.effects import Effect
 from satmotor_ros.model.errors import ConfigError
 from satmotor_ros.model.units import CM3_PER_REV
+
+if TYPE_CHECKING:
+    from satmotor_ros.model.effects import Effect
 
 
 class FieldError(ConfigError):

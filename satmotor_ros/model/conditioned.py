@@ -21,12 +21,11 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from satmotor_ros.model.coefficients import MotorGeometry
-from satmotor_ros.model.effects import Effect, SENSOR_KINDS, TERMS
+from satmotor_ros.model.effects import Conditions, Effect, kind_of
 from satmotor_ros.model.errors import ConfigError, InvalidInputError, ModelError
 from satmotor_ros.model.results import (COMPONENTS, describe_status, INVALID, LossBreakdown,
                                         OperatingPoints, Point, PointStatus)
 from satmotor_ros.model.screening import CHECK, FLOW_ATOL
-from satmotor_ros.model.viscosity import KELVIN, vogel_viscosity, walther_viscosity
 
 if TYPE_CHECKING:
     from satmotor_ros.model.motor import MotorModel
@@ -43,53 +42,6 @@ _SCREENED = int(PointStatus.NOT_FINITE | PointStatus.NEGATIVE | PointStatus.BEYO
 
 def _invalid(status: int) -> Point:
     return Point(*(math.nan,) * 12, status)
-
-
-def effect_viscosity(effect: Effect, temperature: float) -> float:
-    """
-    Return the viscosity of a ``viscosity_temperature`` effect at a temperature.
-
-    Parameters
-    ----------
-    effect : Effect
-        The effect (law, reference temperature and viscosity, slope), [-]
-    temperature : float
-        Liquid temperature, [degC]
-
-    Returns
-    -------
-    float
-        Kinematic viscosity, [m^2/s]
-
-    """
-    if effect.law == 'vogel':
-        if temperature + KELVIN <= effect.vogel_c:  # at or below the law's pole
-            return math.nan
-        return float(vogel_viscosity(temperature, effect.reference_temperature,
-                                     effect.reference_viscosity, effect.coefficient,
-                                     effect.vogel_c))
-    return float(walther_viscosity(temperature, effect.reference_temperature,
-                                   effect.reference_viscosity, effect.coefficient))
-
-
-def wear_growth(effect: Effect, x: float) -> float:
-    """
-    Return the growth of both axial clearances of a ``clearance_wear`` effect.
-
-    Parameters
-    ----------
-    effect : Effect
-        The effect, [-]
-    x : float
-        Time [s] or cumulative revolutions [rev], as the effect's regressor, [s or rev]
-
-    Returns
-    -------
-    float
-        k (x - reference), never below 0, [m]
-
-    """
-    return max(effect.coefficient * (x - effect.reference), 0.0)
 
 
 def _bracketed_root(f: Callable[[float], float], lo: float, f_lo: float, hi: float,
@@ -131,15 +83,11 @@ class ConditionedModel:
 
     def __init__(self, model: MotorModel) -> None:
         """Sort the effects by what they do and build the motor without them."""
-        effects = model.coefficient_set.effects
-        motor = [e for e in effects if e.kind not in SENSOR_KINDS]
-        self.channels = tuple(sorted({e.channel for e in motor if e.channel}))
-        found = {e.kind: e for e in motor}
-        self._leakage = found.get('external_leakage')
-        self._viscosity = found.get('viscosity_temperature')
-        self._wear = found.get('clearance_wear')
-        self._constant = [e for e in motor if e.kind == 'channel']
-        self._terms = [(e.coefficient, TERMS[e.regressor][0]) for e in motor if e.kind == 'term']
+        motor = [(kind_of(e), e) for e in model.coefficient_set.effects]
+        motor = [(kind, e) for kind, e in motor if not kind.sensor]
+        self.channels = tuple(sorted({e.channel for _, e in motor if e.channel}))
+        self._conditioning = tuple((kind, e) for kind, e in motor if e.channel)
+        self._terms = tuple(f for f in (kind.loss(e) for kind, e in motor) if f is not None)
         self._model = model
         self._bare = type(model)(model.geometry, replace(model.coefficient_set, effects=()),
                                  model.valid_range, model.liquid, model.displacement_law,
@@ -202,29 +150,23 @@ class ConditionedModel:
             When a channel an effect needs is not given.
 
         """
-        values = {e.name: self._channel(channels, e)
-                  for e in (self._leakage, self._viscosity, self._wear, *self._constant) if e}
-        if any(not math.isfinite(v) for v in values.values()):
+        values = [self._channel(channels, e) for _, e in self._conditioning]
+        if any(not math.isfinite(v) for v in values):
             return None, p_ex, 0.0, int(PointStatus.NOT_FINITE)
-        if self._leakage is not None:
-            p_ex = values[self._leakage.name]
-        viscosity = self._bare.liquid.kinematic_viscosity
-        if self._viscosity is not None:
-            viscosity = effect_viscosity(self._viscosity, values[self._viscosity.name])
-        growth = 0.0 if self._wear is None else wear_growth(self._wear, values[self._wear.name])
+        now = Conditions(self._bare.liquid.kinematic_viscosity, 0.0, p_ex, 0.0)
+        for (kind, effect), x in zip(self._conditioning, values):
+            now = kind.condition(effect, x, now)
         try:
-            model = self._variant(viscosity, growth)
+            model = self._variant(now.viscosity, now.growth)
         except (ConfigError, OverflowError, ValueError):
-            return None, p_ex, 0.0, int(PointStatus.BEYOND_LIMIT)
-        constant = math.fsum(e.coefficient * (values[e.name] - e.reference)
-                             for e in self._constant)
-        if not math.isfinite(constant):
-            return None, p_ex, 0.0, int(PointStatus.BEYOND_LIMIT)
-        return model, p_ex, constant, 0
+            return None, now.p_ex, 0.0, int(PointStatus.BEYOND_LIMIT)
+        if not math.isfinite(now.extra):
+            return None, now.p_ex, 0.0, int(PointStatus.BEYOND_LIMIT)
+        return model, now.p_ex, now.extra, 0
 
     def _extra(self, speed: float, dp_i: float, constant: float) -> float:
         try:
-            return constant + sum(k * f(speed, dp_i) for k, f in self._terms)
+            return constant + sum(f(speed, dp_i) for f in self._terms)
         except OverflowError:
             return math.inf  # flagged BEYOND_LIMIT by _with_extra
 

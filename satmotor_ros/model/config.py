@@ -20,7 +20,7 @@ from typing import Any
 
 from satmotor_ros.model.coefficients import (CoefficientSet, field_names, FieldError, Liquid,
                                              LossCoefficients, MotorGeometry, ValidRange)
-from satmotor_ros.model.effects import Effect, effect_from_mapping
+from satmotor_ros.model.effects import check_effects, Effect, effect_from_mapping
 from satmotor_ros.model.errors import ConfigError, UnitError
 from satmotor_ros.model.losses import compressibility_coefficient
 from satmotor_ros.model.units import parse_quantity
@@ -209,11 +209,7 @@ def _effects(doc: Any, where: str, coef: LossCoefficients) -> tuple[Effect, ...]
         return ()
     effects = tuple(effect_from_mapping(name, block, where)
                     for name, block in _mapping(doc, where, None).items())
-    kinds = [e.kind for e in effects]
-    twice = sorted({k for k in kinds if kinds.count(k) > 1 and k not in ('channel', 'term')})
-    if twice:
-        msg = f'{where} has more than one {", ".join(twice)} effect'
-        raise ConfigError(msg)
+    check_effects(effects, where)
     for effect in effects:
         k, k_ex = effect.coefficient, coef.external_leakage
         if effect.kind == 'external_leakage' and not math.isclose(k, k_ex, rel_tol=1e-9):

@@ -2,9 +2,11 @@
 """
 Viscosity-temperature laws: Walther (ASTM D341) for mineral oil, Vogel for water.
 
-The paper's model takes one viscosity per liquid; a calibrated
-``viscosity_temperature`` effect (:mod:`.effects`) makes it follow the liquid
-temperature through one of these laws.
+The paper's model takes one viscosity per liquid; a ``viscosity_temperature``
+effect (:mod:`.effects`) makes it follow the liquid temperature through one of
+these laws. :data:`LAWS` is the one registry of laws: the model, the plant and
+calibration all evaluate a law through :class:`ViscosityLaw`, and
+:func:`standard_law` picks a liquid's law and pins it at the liquid's viscosity.
 
 References
 ----------
@@ -18,11 +20,17 @@ References
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from dataclasses import dataclass
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from satmotor_ros.model._typing import ArrayLike, FloatArray
+
+if TYPE_CHECKING:
+    from satmotor_ros.model.coefficients import Liquid
 
 KELVIN = 273.15
 """0 degC in K."""
@@ -134,3 +142,84 @@ def vogel_viscosity(temperature: ArrayLike, t_ref: float, nu_ref: float, slope: 
     """
     t = np.asarray(temperature, dtype=float) + KELVIN
     return nu_ref * 10.0 ** (slope * (1.0 / (t - t_inf) - 1.0 / (t_ref + KELVIN - t_inf)))
+
+
+LAWS: dict[str, tuple[Callable[..., FloatArray], str]] = {
+    'walther': (walther_viscosity, '-'),
+    'vogel': (vogel_viscosity, 'K'),
+}
+"""The viscosity-temperature laws by name: function and the unit of its slope B."""
+
+
+@dataclass(frozen=True)
+class ViscosityLaw:
+    """A viscosity-temperature law of :data:`LAWS` pinned at a reference viscosity."""
+
+    law: str  # a key of LAWS: 'walther' (ASTM D341) or 'vogel'
+    reference_temperature: float  # where the reference viscosity holds [degC]
+    reference_viscosity: float  # kinematic viscosity there [m^2/s]
+    standard_slope: float = math.nan  # B of the liquid's standard law [law unit]
+    vogel_c: float = WATER_VOGEL[2]  # Vogel C [K]
+
+    @property
+    def unit(self) -> str:
+        """Return the unit of the slope B."""
+        return LAWS[self.law][1]
+
+    def viscosity(self, temperature: ArrayLike, slope: float) -> FloatArray:
+        """
+        Evaluate the law with a given slope.
+
+        Parameters
+        ----------
+        temperature : float or ndarray
+            Liquid temperature, [degC]
+        slope : float
+            Walther B [-] or Vogel B [K]; 0 is a constant viscosity, [-]
+
+        Returns
+        -------
+        ndarray
+            Kinematic viscosity; NaN at or below the Vogel pole, [m^2/s]
+
+        """
+        if self.law == 'vogel':
+            t = np.asarray(temperature, dtype=float)
+            nu = vogel_viscosity(t, self.reference_temperature, self.reference_viscosity,
+                                 slope, self.vogel_c)
+            return np.where(t + KELVIN > self.vogel_c, nu, math.nan)
+        return walther_viscosity(temperature, self.reference_temperature,
+                                 self.reference_viscosity, slope)
+
+
+def standard_law(liquid: Liquid, set_name: str = '') -> ViscosityLaw:
+    """
+    Choose the standard law for a liquid and pin it at the liquid's viscosity.
+
+    Water (a set or liquid whose name says so) follows Vogel, anything else
+    the Walther line of an ISO VG 46 mineral oil. The reference temperature is
+    where that standard law gives the liquid's viscosity, so a slope of 0 means
+    a constant viscosity and the standard slope the standard law.
+
+    Parameters
+    ----------
+    liquid : Liquid
+        The liquid, [-]
+    set_name : str
+        Name of the coefficient set, [-]
+
+    Returns
+    -------
+    ViscosityLaw
+        The pinned law.
+
+    """
+    nu = liquid.kinematic_viscosity
+    if 'water' in f'{set_name} {liquid.name}'.lower():
+        a, b, c = WATER_VOGEL
+        t_ref = c + b / math.log10(nu * liquid.density / a) - KELVIN
+        return ViscosityLaw('vogel', t_ref, nu, b)
+    (t1, nu1), (t2, nu2) = ISO_VG46
+    slope = walther_slope(t1, nu1, t2, nu2)
+    t_ref = (t1 + KELVIN) * 10.0 ** ((walther_w(nu1) - walther_w(nu)) / slope) - KELVIN
+    return ViscosityLaw('walther', float(t_ref), nu, slope)

@@ -1,0 +1,420 @@
+# SPDX-License-Identifier: Apache-2.0
+"""
+Effects the paper's model lacks, one kind per file, and the registry that finds them.
+
+A coefficient set's ``effects:`` block (written by ``satmotor calibrate``) is a
+mapping of effect ids to blocks; :func:`effect_from_mapping` reads one into an
+:class:`Effect` through its kind, :func:`effect_to_mapping` writes it back.
+The model (:mod:`..conditioned`), the virtual motor (:mod:`satmotor_ros.plant`),
+synthetic data and the calibration's candidate library all reach an effect
+through its kind in :data:`KINDS`, so a new kind is one new file here that
+defines ``KIND = MyKind()`` (doc/effects.md). The kinds shipped:
+
+=========================  ============================================================
+``external_leakage``       Q_ex = k_ex p (eq. 24), p the gauge pressure named by
+                           ``regressor`` (``p_case`` or ``p_out``)
+``viscosity_temperature``  nu(T) of a Walther or Vogel law replaces the liquid's
+                           viscosity in eqs. (1), (5) and (35)
+``clearance_wear``         h_R and h_S grow by k (x - reference) >= 0, x = ``time`` [s]
+                           or ``revolutions`` [rev], in eqs. (1), (2) and (5)
+``channel:<name>``         extra loss k (x - reference) in Q_vl, x the channel <name>
+``term:<expression>``      extra loss k f(n, dp_i) in Q_vl, f one of :data:`TERMS`
+``flow_sensor_offset``     the flowmeter reads Q + k
+``flow_sensor_gain``       the flowmeter reads (1 + k) Q
+``speed_sensor_gain``      the speed sensor reads (1 + k) n
+=========================  ============================================================
+
+Sensor effects describe the instruments, not the motor: the model's maps take
+the true flow and return the true speed, and :func:`true_flow` and
+:func:`true_speed` convert readings.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+from dataclasses import replace
+import importlib
+import pkgutil
+from typing import Any, TYPE_CHECKING
+
+from satmotor_ros.model.effects._base import (Candidate, CandidateData, Conditions,
+                                              CORE_CHANNELS, DOCUMENTARY, Effect, EffectKind,
+                                              KINDS, Modifier, PlantInjection, PlantParameter,
+                                              SensorError, Synthetic)
+from satmotor_ros.model.effects.term import TERMS
+from satmotor_ros.model.errors import ConfigError
+
+if TYPE_CHECKING:
+    from satmotor_ros.model.motor import MotorModel
+
+
+def register(kind: EffectKind) -> EffectKind:
+    """
+    Add a kind to :data:`KINDS` (every module of this package is registered on import).
+
+    Parameters
+    ----------
+    kind : EffectKind
+        The kind; its ``name`` must be new, [-]
+
+    Returns
+    -------
+    EffectKind
+        `kind`.
+
+    Raises
+    ------
+    ConfigError
+        If the name is empty, has a colon or is taken.
+
+    """
+    if not kind.name or ':' in kind.name or kind.name in KINDS:
+        msg = f'effect kind {kind.name!r}: the name is empty, has a colon or is taken'
+        raise ConfigError(msg)
+    KINDS[kind.name] = kind
+    return kind
+
+
+def unregister(name: str) -> None:
+    """
+    Remove a kind from :data:`KINDS` (for tests that register one of their own).
+
+    Parameters
+    ----------
+    name : str
+        The kind's name, [-]
+
+    """
+    KINDS.pop(name, None)
+
+
+def _discover() -> None:
+    for module in pkgutil.iter_modules(__path__):
+        if not module.name.startswith('_'):
+            kind = getattr(importlib.import_module(f'{__name__}.{module.name}'), 'KIND', None)
+            if kind is not None and kind.name not in KINDS:
+                register(kind)
+
+
+_discover()
+
+
+def ranked() -> list[EffectKind]:
+    """
+    List the registered kinds in their order of :attr:`EffectKind.rank`.
+
+    Returns
+    -------
+    list of EffectKind
+        The kinds; equal ranks by name.
+
+    """
+    return sorted(KINDS.values(), key=lambda k: (k.rank, k.name))
+
+
+def kind_of(effect: Effect) -> EffectKind:
+    """
+    Return the kind of an effect.
+
+    Parameters
+    ----------
+    effect : Effect
+        The effect, [-]
+
+    Returns
+    -------
+    EffectKind
+        Its kind.
+
+    Raises
+    ------
+    ConfigError
+        If no kind of that name is registered.
+
+    """
+    kind = KINDS.get(effect.kind)
+    if kind is None:
+        msg = f'effect {effect.name!r}: no such kind (known: {", ".join(KINDS)})'
+        raise ConfigError(msg)
+    return kind
+
+
+def _known() -> str:
+    return ', '.join(f'{k.name}:<name>' if k.suffixed else k.name for k in ranked())
+
+
+def effect_from_mapping(name: Any, doc: Any, where: str) -> Effect:
+    """
+    Build one validated :class:`Effect` from its YAML block.
+
+    Parameters
+    ----------
+    name : Any
+        The block's key, e.g. ``'external_leakage'`` or ``'term:dp^2*n'``, [-]
+    doc : Any
+        The block: ``coefficient`` and what the kind needs, [-]
+    where : str
+        Key path quoted in errors, [-]
+
+    Returns
+    -------
+    Effect
+        The effect.
+
+    Raises
+    ------
+    ConfigError
+        Naming the key and the value for an unknown kind, key, regressor or law,
+        a missing key, or a value that is not a finite number.
+
+    """
+    name = str(name)
+    kind_name, _, suffix = name.partition(':')
+    where = f'{where}.{name}'
+    kind = KINDS.get(kind_name)
+    if kind is None or kind.suffixed != bool(suffix):
+        msg = f'{where}: unknown effect {name!r} (known: {_known()})'
+        raise ConfigError(msg)
+    if not isinstance(doc, Mapping):
+        msg = f'{where} must be a mapping, got {type(doc).__name__}: {doc!r}'
+        raise ConfigError(msg)
+    unknown = sorted(set(map(str, doc)) - set(kind.keys) - set(DOCUMENTARY))
+    missing = [k for k in kind.required if k not in doc]
+    if unknown or missing:
+        what = (f'unknown key(s) {", ".join(unknown)}' if unknown
+                else f'missing key(s) {", ".join(missing)}')
+        msg = f'{where} has {what} (known: {", ".join(kind.keys)})'
+        raise ConfigError(msg)
+    return kind.parse(name, {k: v for k, v in doc.items() if k in kind.keys}, where)
+
+
+def effect_to_mapping(effect: Effect) -> dict[str, Any]:
+    """
+    Write an effect as its YAML block (what :func:`effect_from_mapping` reads back).
+
+    Parameters
+    ----------
+    effect : Effect
+        The effect, [-]
+
+    Returns
+    -------
+    dict
+        The block, plain SI numbers and strings, with the kind's ``evaluation``.
+
+    """
+    kind = kind_of(effect)
+    return {**kind.to_mapping(effect), 'evaluation': kind.evaluation}
+
+
+def check_effects(effects: Iterable[Effect], where: str) -> tuple[Effect, ...]:
+    """
+    Refuse two effects of one kind (only suffixed kinds may repeat, with other suffixes).
+
+    Parameters
+    ----------
+    effects : iterable of Effect
+        The effects, [-]
+    where : str
+        Key path quoted in errors, [-]
+
+    Returns
+    -------
+    tuple of Effect
+        The effects.
+
+    Raises
+    ------
+    ConfigError
+        Naming the kind given twice or unknown.
+
+    """
+    effects = tuple(effects)
+    seen: set[str] = set()
+    for effect in effects:
+        key = effect.name if kind_of(effect).suffixed else effect.kind
+        if key in seen:
+            msg = f'{where} has more than one {key} effect'
+            raise ConfigError(msg)
+        seen.add(key)
+    return effects
+
+
+def with_effects(model: MotorModel, effects: Iterable[Effect]) -> MotorModel:
+    """
+    Return the model with `effects` added to its coefficient set.
+
+    Parameters
+    ----------
+    model : MotorModel
+        The motor, [-]
+    effects : iterable of Effect
+        Motor effects to add, [-]
+
+    Returns
+    -------
+    MotorModel
+        The same motor, liquid and law, evaluating the effects (`model` when there are none).
+
+    """
+    effects = tuple(effects)
+    if not effects:
+        return model
+    spec = model.coefficient_set
+    coef = spec.coefficients
+    for effect in effects:
+        coef = kind_of(effect).coefficients(effect, coef)
+    combined = check_effects((*spec.effects, *effects), 'effects')
+    return type(model)(model.geometry, replace(spec, coefficients=coef, effects=combined),
+                       model.valid_range, model.liquid, model.displacement_law, model.name)
+
+
+def plant_injection(effects: Iterable[Effect]) -> PlantInjection:
+    """
+    Sort effects by what the virtual motor does with them (:meth:`EffectKind.inject`).
+
+    Parameters
+    ----------
+    effects : iterable of Effect
+        The injected effects, [-]
+
+    Returns
+    -------
+    PlantInjection
+        Motor, drifting, bypass and sensor effects.
+
+    """
+    into = PlantInjection()
+    for effect in effects:
+        into = kind_of(effect).inject(effect, into)
+    return into
+
+
+def sensor_error(effects: Iterable[Effect], channel: str) -> tuple[float, float]:
+    """
+    Compose the instrument errors on one channel into reading = gain * value + offset.
+
+    The last effect acts first (a coefficient set lists the instrument's errors
+    from the reading back to the truth).
+
+    Parameters
+    ----------
+    effects : iterable of Effect
+        A coefficient set's (or the plant's) effects, [-]
+    channel : str
+        ``'flow'`` or ``'speed'``, [-]
+
+    Returns
+    -------
+    tuple of float
+        Gain [-] and offset [unit of the channel].
+
+    """
+    gain, offset = 1.0, 0.0
+    for effect in reversed(tuple(effects)):
+        error = kind_of(effect).sensor_error(effect)
+        if error is not None and error.channel == channel:
+            gain, offset = error.gain * gain, error.gain * offset + error.offset
+    return gain, offset
+
+
+def flow_reading(effects: tuple[Effect, ...], flow: Any) -> Any:
+    """
+    Return what the flowmeter reads at a flow through the motor.
+
+    Parameters
+    ----------
+    effects : tuple of Effect
+        The coefficient set's effects, [-]
+    flow : float or ndarray
+        Flow through the motor, [m^3/s]
+
+    Returns
+    -------
+    float or ndarray
+        ``(1 + k) Q`` (gain), ``Q + k`` (offset), else `flow`, [m^3/s]
+
+    """
+    gain, offset = sensor_error(effects, 'flow')
+    return flow if (gain, offset) == (1.0, 0.0) else gain * flow + offset
+
+
+def true_flow(effects: tuple[Effect, ...], reading: Any) -> Any:
+    """
+    Return the flow through the motor from a flowmeter reading.
+
+    Parameters
+    ----------
+    effects : tuple of Effect
+        The coefficient set's effects, [-]
+    reading : float or ndarray
+        What the flowmeter reads, [m^3/s]
+
+    Returns
+    -------
+    float or ndarray
+        ``(reading - offset) / gain``, the reading itself without a flowmeter error, [m^3/s]
+
+    """
+    gain, offset = sensor_error(effects, 'flow')
+    return reading if (gain, offset) == (1.0, 0.0) else (reading - offset) / gain
+
+
+def true_speed(effects: tuple[Effect, ...], reading: Any) -> Any:
+    """
+    Return the true shaft speed from a speed-sensor reading.
+
+    Parameters
+    ----------
+    effects : tuple of Effect
+        The coefficient set's effects, [-]
+    reading : float or ndarray
+        What the speed sensor reads, [rad/s]
+
+    Returns
+    -------
+    float or ndarray
+        ``(reading - offset) / gain``, the reading itself without a speed error, [rad/s]
+
+    """
+    gain, offset = sensor_error(effects, 'speed')
+    return reading if (gain, offset) == (1.0, 0.0) else (reading - offset) / gain
+
+
+def build_candidates(data: CandidateData) -> tuple[list[Candidate], list[str]]:
+    """
+    Build every kind's candidates, in the order of :func:`ranked`.
+
+    Parameters
+    ----------
+    data : CandidateData
+        Components, channels and law at the points (``covered`` is filled in here), [-]
+
+    Returns
+    -------
+    list of Candidate
+        The candidates.
+    list of str
+        Why other candidates were not offered.
+
+    """
+    covered = frozenset(CORE_CHANNELS).union(*(k.regressors for k in KINDS.values()))
+    data = data._replace(covered=covered)
+    out: list[Candidate] = []
+    skipped: list[str] = []
+    for kind in ranked():
+        offered, why = kind.candidates(data)
+        out += offered
+        skipped += why
+    return out, skipped
+
+
+SENSOR_KINDS = tuple(k.name for k in ranked() if k.sensor)
+"""Kinds shipped that describe an instrument, not the motor (:attr:`EffectKind.sensor`)."""
+
+__all__ = ['Candidate', 'CandidateData', 'Conditions', 'Effect', 'EffectKind', 'KINDS',
+           'Modifier', 'PlantInjection', 'PlantParameter', 'SENSOR_KINDS', 'SensorError',
+           'Synthetic', 'TERMS', 'build_candidates', 'check_effects', 'effect_from_mapping',
+           'effect_to_mapping', 'flow_reading', 'kind_of', 'plant_injection', 'ranked',
+           'register', 'sensor_error', 'true_flow', 'true_speed', 'unregister',
+           'with_effects']

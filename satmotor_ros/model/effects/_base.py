@@ -1,0 +1,428 @@
+# SPDX-License-Identifier: Apache-2.0
+"""
+What every effect kind provides, and the records they exchange with the layers.
+
+An effect kind is one subclass of :class:`EffectKind` in one file of this
+package. It owns four things, each a method with a working default:
+
+- its YAML schema: :meth:`EffectKind.parse` and :meth:`EffectKind.to_mapping`;
+- what it does to the model: :meth:`EffectKind.condition` (a motor built for
+  the channel's value), :meth:`EffectKind.loss` (an extra loss in Q_vl) or
+  :meth:`EffectKind.sensor_error` (what an instrument makes of the truth);
+- its calibration candidate: :meth:`EffectKind.candidates`;
+- its plant injection: :meth:`EffectKind.inject`, with the node parameters
+  :attr:`EffectKind.plant_parameters` and :meth:`EffectKind.from_plant`.
+
+Pure numpy: nothing here imports the plant, identify or ROS.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, replace
+import math
+from typing import Any, ClassVar, NamedTuple, Protocol, TYPE_CHECKING
+
+import numpy as np
+
+from satmotor_ros.model._typing import FloatArray
+from satmotor_ros.model.errors import ConfigError
+from satmotor_ros.model.units import LPM
+
+if TYPE_CHECKING:
+    from satmotor_ros.model.coefficients import LossCoefficients
+    from satmotor_ros.model.viscosity import ViscosityLaw
+
+KINDS: dict[str, EffectKind] = {}
+"""The registry: kind name -> kind, filled by :func:`satmotor_ros.model.effects.register`."""
+
+DOCUMENTARY = ('unit', 'ci95', 'source', 'evaluation')
+"""Keys written for the reader of a ``coefficients.yaml``; the model does not use them."""
+
+MIN_SPREAD = 1.0e-3
+"""A regressor must vary by this share of its largest magnitude to be offered, [-]."""
+
+CORE_CHANNELS = ('p_in', 'speed', 'flow')
+"""Columns of every bench table, never a regressor of their own effect."""
+
+
+@dataclass(frozen=True)
+class Effect:
+    """One effect of a coefficient set (or injected into the plant), SI (temperature in degC)."""
+
+    name: str  # id as in the YAML: a kind, or '<kind>:<suffix>' ('channel:aux', 'term:dp^2')
+    coefficient: float  # k, in the unit the kind implies (m^3/(s*Pa), m/s, -, ...)
+    regressor: str = ''  # channel or expression the effect reads
+    reference: float = 0.0  # x where the effect is zero (wear, channel) [unit of x]
+    law: str = ''  # viscosity_temperature: 'walther' or 'vogel'; '' the liquid's own
+    reference_temperature: float = math.nan  # where the viscosity is the liquid's [degC]
+    reference_viscosity: float = math.nan  # the viscosity there; NaN the liquid's [m^2/s]
+    vogel_c: float = 140.0  # Vogel C [K]
+    options: tuple[tuple[str, Any], ...] = ()  # further parameters of a new kind, by name
+
+    @property
+    def kind(self) -> str:
+        """Return the kind, without a ``:<suffix>``."""
+        return self.name.split(':', 1)[0]
+
+    @property
+    def suffix(self) -> str:
+        """Return what follows ``<kind>:`` in the name, or ''."""
+        return self.name.partition(':')[2]
+
+    @property
+    def channel(self) -> str | None:
+        """Return the measured channel the model needs for this effect, or None."""
+        return self.regressor if KINDS[self.kind].reads_channel else None
+
+    def option(self, key: str, default: Any = None) -> Any:
+        """Return the kind-specific parameter `key` of :attr:`options`, or `default`."""
+        return dict(self.options).get(key, default)
+
+
+class Conditions(NamedTuple):
+    """The motor an effect asks for at a channel's value (what :meth:`condition` returns)."""
+
+    viscosity: float  # kinematic viscosity of the liquid [m^2/s]
+    growth: float  # growth of both axial clearances h_R, h_S [m]
+    p_ex: float  # pressure that drives the external leakage Q_ex of eq. (24) [Pa]
+    extra: float  # extra loss in Q_vl that does not depend on n or dp_i [m^3/s]
+
+
+class SensorError(NamedTuple):
+    """What an instrument makes of the truth: reading = gain * value + offset."""
+
+    channel: str  # 'flow' or 'speed'
+    gain: float  # factor on the true value [-]
+    offset: float  # added to it [unit of the channel]
+
+
+@dataclass(frozen=True)
+class Modifier:
+    """How a candidate effect changes the model's prediction of the measured flow."""
+
+    flow_gain: float = 1.0  # measured / true flow [-]
+    speed_gain: float = 1.0  # measured / true speed [-]
+    flat_clearance: FloatArray | float = 1.0  # factor on Q_Lfg [-]
+    commutation: FloatArray | float = 1.0  # factor on Q_C [-]
+    additive: FloatArray | float = 0.0  # extra loss [m^3/s]
+    offset: float = 0.0  # flowmeter offset [m^3/s]
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """One candidate effect bound to the data it will be fitted on."""
+
+    effect: str  # vocabulary id, e.g. 'external_leakage' or 'term:dp^2*n'
+    regressor: str  # the channel or expression the effect uses
+    unit: str  # unit of the coefficient
+    source: str  # the physics or standard the term comes from
+    values: FloatArray  # the regressor at each point (SI), for plots
+    modify: Callable[[float], Modifier]  # coefficient -> modified prediction
+    typical: float  # coefficient magnitude that changes the loss by ~1 l/min
+    bounds: tuple[float, float] = (-np.inf, np.inf)  # physical range of the coefficient
+    start: float = 0.0  # initial coefficient of the fit
+    make: Callable[[float], Effect] | None = None  # coefficient -> the effect, for the YAML
+
+    @property
+    def label(self) -> str:
+        """Return the effect with its regressor, e.g. ``external_leakage(p_case)``."""
+        if ':' in self.effect or self.regressor in ('', '1'):
+            return self.effect
+        return f'{self.effect}({self.regressor})'
+
+    def as_effect(self, coefficient: float) -> Effect:
+        """Return the effect this candidate stands for at a fitted coefficient."""
+        if self.make is not None:
+            return self.make(coefficient)
+        return Effect(self.effect, coefficient, self.regressor)
+
+
+class Parts(Protocol):
+    """The model's loss components at measured points (``identify.parts.LossParts``)."""
+
+    flow: FloatArray  # measured Q [m^3/s]
+    speed: FloatArray  # measured n [rad/s]
+    dp_i: FloatArray  # chamber drop, eq. (34) [Pa]
+    displacement: FloatArray  # q_t n [m^3/s]
+    clearance: FloatArray  # h, eq. (2) [m]
+    clearance_satellites: float  # h_S [m]
+    h_exponent: float  # Q_Lfg ~ h^(3/(2-beta)) [-]
+    hs_exponent: float  # Q_C ~ h_S^C_2 [-]
+    nu_exponent_lfg: float  # Q_Lfg ~ nu^(-beta/(2-beta)) [-]
+    nu_exponent_c: float  # Q_C ~ nu^(-gamma) [-]
+
+
+class CandidateData(NamedTuple):
+    """What the candidate library offers every kind."""
+
+    parts: Parts  # components at the points
+    channels: Mapping[str, FloatArray]  # extra channels (SI; temperature in degC)
+    law: ViscosityLaw  # the liquid's viscosity law, pinned at its viscosity
+    covered: frozenset[str]  # channels a named kind reads (no generic channel: candidate)
+
+
+class Synthetic(NamedTuple):
+    """Operating points a synthetic injection scales its coefficient on."""
+
+    speed: FloatArray  # true speed [rad/s]
+    dp_i: FloatArray  # chamber drop of the model without the effect [Pa]
+    channels: Mapping[str, FloatArray]  # time [s], temperature [degC], p_case [Pa], ...
+    law: ViscosityLaw  # the liquid's standard viscosity law
+
+
+@dataclass(frozen=True)
+class PlantParameter:
+    """One node parameter of the virtual motor that sets an effect (``effects.<name>``)."""
+
+    name: str  # without the 'effects.' prefix
+    default: Any  # float or str; the default leaves the effect off
+    description: str  # what it is, without the unit
+    unit: str = '-'  # SI unit
+    low: float | None = None  # closed range (numbers)
+    high: float | None = None
+    choices: tuple[str, ...] = ()  # allowed strings
+
+
+@dataclass(frozen=True)
+class PlantInjection:
+    """What the virtual motor does with a tuple of effects, sorted by :meth:`EffectKind.inject`."""
+
+    motor: tuple[Effect, ...] = ()  # evaluated by the plant's motor model at its channels
+    drift: tuple[Effect, ...] = ()  # change the motor itself: rebuilt within a tolerance
+    bypass: tuple[tuple[str, float], ...] = ()  # (gauge pressure channel, k): inlet -> tank
+    sensors: tuple[Effect, ...] = ()  # act on the readings only
+
+    def add(self, slot: str, item: Any) -> PlantInjection:
+        """Return a copy with `item` appended to the tuple `slot`."""
+        return replace(self, **{slot: (*getattr(self, slot), item)})
+
+
+def finite(value: Any, where: str) -> float:
+    """Return `value` as a float, or raise ConfigError naming `where` if it is no finite number."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        msg = f'{where} = {value!r}: expected a finite number'
+        raise ConfigError(msg)
+    return float(value)
+
+
+def varies(x: FloatArray | None) -> bool:
+    """Return whether a regressor is finite and varies enough to be fitted."""
+    return bool(x is not None and np.all(np.isfinite(x))
+                and np.ptp(x) > MIN_SPREAD * np.max(np.abs(x)) > 0.0)
+
+
+def why_not(x: FloatArray | None) -> str:
+    """Say why a regressor was not offered."""
+    if x is None:
+        return 'not measured'
+    if not np.all(np.isfinite(x)):
+        return 'has missing values'
+    return 'does not vary enough'
+
+
+def per_unit(x: FloatArray) -> float:
+    """Return the coefficient that makes `x` contribute 1 l/min at its largest magnitude."""
+    return float(LPM / max(np.max(np.abs(x)), 1e-300))
+
+
+class EffectKind:
+    """
+    One kind of effect; subclass it in a new file of this package (see doc/effects.md).
+
+    The defaults describe an additive loss k f(n, dp_i) that reads no channel:
+    a kind overrides what differs.
+    """
+
+    name: ClassVar[str] = ''  # YAML id; a suffixed kind is written '<name>:<suffix>'
+    suffixed: ClassVar[bool] = False  # the id carries ':<suffix>'
+    rank: ClassVar[int] = 100  # place in the candidate library and in messages
+    keys: ClassVar[tuple[str, ...]] = ('regressor', 'coefficient')  # YAML keys it reads
+    required: ClassVar[tuple[str, ...]] = ('coefficient',)  # of which these must be there
+    regressors: ClassVar[tuple[str, ...]] = ()  # channels it may read, the default first
+    reads_channel: ClassVar[bool] = False  # the model needs its regressor's value
+    drifts: ClassVar[bool] = False  # it changes the motor itself (a rebuilt model)
+    sensor: ClassVar[str] = ''  # the channel of an instrument error ('flow', 'speed')
+    unit: ClassVar[str] = '-'  # unit of the coefficient
+    source: ClassVar[str] = ''  # the physics or standard the term comes from
+    evaluation: ClassVar[str] = ''  # what the model does with it (written into the YAML)
+    plant_parameters: ClassVar[tuple[PlantParameter, ...]] = ()  # node parameters
+
+    # -- YAML --------------------------------------------------------------------------
+
+    def parse(self, name: str, doc: Mapping[str, Any], where: str) -> Effect:
+        """
+        Build one validated effect from its YAML block (keys checked by the registry).
+
+        Parameters
+        ----------
+        name : str
+            The block's key, e.g. ``'term:dp^2*n'``, [-]
+        doc : mapping
+            The block, known keys only, [-]
+        where : str
+            Key path quoted in errors, [-]
+
+        Returns
+        -------
+        Effect
+            The effect.
+
+        """
+        values = {k: finite(doc[k], f'{where}.{k}') for k in self.keys
+                  if k in doc and k not in ('regressor', 'law')}
+        suffix = name.partition(':')[2]
+        return Effect(name=name, regressor=self.regressor(suffix, doc.get('regressor'), where),
+                      **values)
+
+    def regressor(self, suffix: str, value: Any, where: str) -> str:
+        """Return the regressor a YAML block names (or the kind's default), checked."""
+        if not self.regressors:
+            return '' if value is None else str(value)
+        value = self.regressors[0] if value is None else value
+        if value not in self.regressors:
+            msg = f'{where}.regressor = {value!r}: use {" or ".join(self.regressors)}'
+            raise ConfigError(msg)
+        return str(value)
+
+    def to_mapping(self, effect: Effect) -> dict[str, Any]:
+        """Return the YAML block of an effect (the inverse of :meth:`parse`)."""
+        block: dict[str, Any] = {}
+        for key in self.keys:
+            value = getattr(effect, key) if hasattr(effect, key) else effect.option(key)
+            if key == 'regressor' and not value:
+                continue
+            block[key] = value
+        return block
+
+    # -- the model -----------------------------------------------------------------------
+
+    def coefficients(self, effect: Effect, coef: LossCoefficients) -> LossCoefficients:
+        """Return the coefficient set's numbers for a model that carries `effect`."""
+        return coef
+
+    def condition(self, effect: Effect, x: float, now: Conditions) -> Conditions:
+        """Return the motor the effect asks for at its channel's value `x`."""
+        return now
+
+    def loss(self, effect: Effect) -> Callable[[Any, Any], Any] | None:
+        """Return f(n [rad/s], dp_i [Pa]) -> extra loss in Q_vl [m^3/s], or None."""
+        return None
+
+    def sensor_error(self, effect: Effect) -> SensorError | None:
+        """Return what the effect does to an instrument, or None for a motor effect."""
+        return None
+
+    # -- calibration ---------------------------------------------------------------------
+
+    def candidates(self, data: CandidateData) -> tuple[list[Candidate], list[str]]:
+        """
+        Build the candidates of this kind the data can test.
+
+        Parameters
+        ----------
+        data : CandidateData
+            Components, channels and the viscosity law at the points, [-]
+
+        Returns
+        -------
+        list of Candidate
+            The candidates.
+        list of str
+            Why others were not offered.
+
+        """
+        unit_loss = self.loss(Effect(self.name, 1.0))
+        if unit_loss is None:
+            return [], []
+        x = np.asarray(unit_loss(data.parts.speed, data.parts.dp_i), dtype=float)
+        return [additive(self.name, self.name, self.unit, self.source, x)], []
+
+    # -- the plant and synthetic data ----------------------------------------------------
+
+    def inject(self, effect: Effect, into: PlantInjection) -> PlantInjection:
+        """Return `into` with what the virtual motor does with `effect` added."""
+        if self.sensor:
+            return into.add('sensors', effect)
+        return into.add('drift' if self.drifts else 'motor', effect)
+
+    def from_plant(self, values: Mapping[str, Any]) -> Effect | None:
+        """Return the effect the node parameters ask for, or None when it is off."""
+        return None
+
+    def plant_values(self, effect: Effect | None) -> dict[str, Any]:
+        """Return the node parameter values (without prefix) that give `effect`."""
+        return {p.name: p.default for p in self.plant_parameters}
+
+    def bind(self, effect: Effect, law: ViscosityLaw, reference_temperature: float) -> Effect:
+        """Return `effect` with what it left to the plant's liquid filled in."""
+        return effect
+
+    def scaled(self, name: str, magnitude: float, regressor: str, data: Synthetic) -> Effect:
+        """
+        Build the effect a synthetic injection of `magnitude` stands for.
+
+        Parameters
+        ----------
+        name : str
+            Effect id, [-]
+        magnitude : float
+            By default the largest extra loss it causes at the points, [m^3/s]
+        regressor : str
+            Channel or expression, '' for the kind's default, [-]
+        data : Synthetic
+            The operating points, [-]
+
+        Returns
+        -------
+        Effect
+            The effect to inject.
+
+        """
+        regressor = regressor or (self.regressors or (name.partition(':')[2],))[0]
+        unit_loss = self.loss(Effect(name, 1.0, regressor))
+        if unit_loss is None:
+            return Effect(name, magnitude, regressor)
+        x = np.asarray(unit_loss(data.speed, data.dp_i), dtype=float)
+        return Effect(name, magnitude / max(float(np.max(np.abs(x))), 1e-300), regressor)
+
+
+def additive(effect: str, regressor: str, unit: str, source: str, x: FloatArray,
+             bounds: tuple[float, float] = (-np.inf, np.inf),
+             values: FloatArray | None = None,
+             make: Callable[[float], Effect] | None = None) -> Candidate:
+    """
+    Build a candidate that adds k x to the loss.
+
+    Parameters
+    ----------
+    effect : str
+        Effect id, [-]
+    regressor : str
+        Its regressor, [-]
+    unit : str
+        Unit of k, [-]
+    source : str
+        Where the term comes from, [-]
+    x : ndarray
+        The design column, [m^3/s per unit of k]
+    bounds : tuple of float
+        Physical range of k, [unit]
+    values : ndarray, optional
+        The regressor to plot; `x` when omitted, [-]
+    make : callable, optional
+        k -> the effect, [-]
+
+    Returns
+    -------
+    Candidate
+        The candidate.
+
+    """
+    return Candidate(effect, regressor, unit, source, x if values is None else values,
+                     lambda k: Modifier(additive=k * x), per_unit(x), bounds, make=make)
+
+
+__all__ = ['Candidate', 'CandidateData', 'Conditions', 'Effect', 'EffectKind', 'KINDS',
+           'Modifier', 'PlantInjection', 'PlantParameter', 'SensorError', 'Synthetic',
+           'additive', 'finite', 'per_unit', 'varies', 'why_not']

@@ -1,0 +1,89 @@
+# SPDX-License-Identifier: Apache-2.0
+"""
+``external_leakage``: Q_ex = k_ex p (eq. 24), p the gauge pressure of the case or the outlet.
+
+In a coefficient set the effect names the pressure that drives eq. (24); its
+coefficient is ``coefficients.external_leakage``. The virtual motor takes the
+same k_ex p from the inlet line to the tank (solved implicitly with the lines),
+and the flowmeter sees it, as it sees the model's Q_ex.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import replace
+from typing import Any, TYPE_CHECKING
+
+import numpy as np
+
+from satmotor_ros.model.effects._base import (additive, Candidate, CandidateData, Conditions,
+                                              Effect, EffectKind, PlantInjection,
+                                              PlantParameter, varies, why_not)
+from satmotor_ros.model.errors import ConfigError
+
+if TYPE_CHECKING:
+    from satmotor_ros.model.coefficients import LossCoefficients
+
+_DRIVERS = {'case': 'p_case', 'outlet': 'p_out'}
+
+
+class ExternalLeakage(EffectKind):
+    """Q_ex = k_ex p, eq. (24), p the gauge case or outlet pressure."""
+
+    name = 'external_leakage'
+    rank = 40
+    regressors = ('p_case', 'p_out')
+    reads_channel = True
+    unit = 'm^3/(s*Pa)'
+    source = 'eq. (24), lumped'
+    evaluation = ('Q_ex = k_ex * p (eq. 24) with p the gauge pressure named by regressor; '
+                  'k_ex is also coefficients.external_leakage')
+    plant_parameters = (
+        PlantParameter('external_leakage', 0.0, 'k_ex, leakage to the tank per driving pressure '
+                       '(eq. 24)', 'm^3/(s*Pa)', 0.0, 1.0e-8),
+        PlantParameter('leakage_driver', 'case', "pressure that drives k_ex: 'case' or 'outlet'",
+                       choices=tuple(_DRIVERS)),
+    )
+
+    def coefficients(self, effect: Effect, coef: LossCoefficients) -> LossCoefficients:
+        """Return `coef` with eq. (24)'s k_ex set to the effect's coefficient."""
+        return replace(coef, external_leakage=effect.coefficient)
+
+    def condition(self, effect: Effect, x: float, now: Conditions) -> Conditions:
+        """Drive eq. (24) by the channel's gauge pressure `x` [Pa]."""
+        return now._replace(p_ex=x)
+
+    def candidates(self, data: CandidateData) -> tuple[list[Candidate], list[str]]:
+        """Offer k_ex >= 0 for each driving pressure that was measured and varies."""
+        out, skipped = [], []
+        for name in self.regressors:
+            p = data.channels.get(name)
+            if varies(p):
+                out.append(additive(self.name, name, self.unit, self.source, p, (0.0, np.inf),
+                                    make=lambda k, r=name: Effect(self.name, k, r)))
+            else:
+                skipped.append(f'{self.name}({name}): {why_not(p)}')
+        return out, skipped
+
+    def inject(self, effect: Effect, into: PlantInjection) -> PlantInjection:
+        """Let k_ex p leave the plant's inlet line for the tank."""
+        return into.add('bypass', (effect.regressor, effect.coefficient))
+
+    def from_plant(self, values: Mapping[str, Any]) -> Effect | None:
+        """Return the leakage the node parameters set, None at k = 0."""
+        driver = values['leakage_driver']
+        if driver not in _DRIVERS:
+            msg = f"effects.leakage_driver = {driver!r}: use 'case' or 'outlet'"
+            raise ConfigError(msg)
+        k = values['external_leakage']
+        return Effect(self.name, k, _DRIVERS[driver]) if k else None
+
+    def plant_values(self, effect: Effect | None) -> dict[str, Any]:
+        """Return k and the driver of `effect`."""
+        if effect is None:
+            return super().plant_values(None)
+        driver = next(d for d, r in _DRIVERS.items() if r == effect.regressor)
+        return {'external_leakage': effect.coefficient, 'leakage_driver': driver}
+
+
+KIND = ExternalLeakage()
