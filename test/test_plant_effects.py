@@ -8,9 +8,12 @@ import numpy as np
 import pytest
 
 from satmotor_ros.model import MotorModel
+from satmotor_ros.model.effects import Effect
 from satmotor_ros.model.units import LPM
-from satmotor_ros.plant import (ConstantLoad, EffectParams, Plant, PlantParams, SensorParams,
-                                SensorSet, ThermalParams)
+from satmotor_ros.model.viscosity import ViscosityLaw
+from satmotor_ros.plant import (ConstantLoad, Plant, PlantParams, SensorParams, SensorSet,
+                                ThermalParams)
+from satmotor_ros.plant.config import params_from_flat
 
 MODEL = MotorModel.default('water')
 FLOW = 20.0 * LPM
@@ -18,8 +21,13 @@ LOAD = 60.0
 STEPS = 1500
 
 
-def _run(effects=None, thermal=None, sensors=None, seed=0):
-    params = PlantParams(effects=effects or EffectParams(), thermal=thermal or ThermalParams(),
+def _effects(**values):
+    """Return the effects the virtual_motor node parameters ``effects.<name>`` inject."""
+    return params_from_flat({f'effects.{k}': v for k, v in values.items()}).effects
+
+
+def _run(effects=(), thermal=None, sensors=None, seed=0):
+    params = PlantParams(effects=effects, thermal=thermal or ThermalParams(),
                          sensors=sensors or SensorSet(), seed=seed)
     plant = Plant(MODEL, params, load=ConstantLoad(LOAD))
     readings = []
@@ -49,7 +57,7 @@ def test_no_effect_is_on_by_default_and_sensors_read_the_truth():
 ])
 def test_sensor_errors_change_only_their_reading(field, value, channel):
     """The state is bit-identical; one channel reads gain*(1+e)*x + offset; the others true."""
-    plant, readings = _run(EffectParams(**{field: value}))
+    plant, readings = _run(_effects(**{field: value}))
     assert plant.state == BASE.state
     for got, true in zip(readings, BASE_READINGS):
         for name in got._fields:
@@ -67,7 +75,7 @@ def test_sensor_errors_change_only_their_reading(field, value, channel):
 def test_external_leakage_takes_k_times_the_driving_pressure_past_the_model(driver):
     """Q_x = k p_driver leaves the inlet line: the flowmeter reads the model's Q plus Q_x."""
     k = 1.0e-12
-    plant, readings = _run(EffectParams(external_leakage=k, leakage_driver=driver))
+    plant, readings = _run(_effects(external_leakage=k, leakage_driver=driver))
     state, flows = plant.state, plant.flows
     tank = plant.params.lines.tank_pressure
     drive = (plant.case_pressure() if driver == 'case' else state.outlet_pressure) - tank
@@ -81,13 +89,15 @@ def test_external_leakage_takes_k_times_the_driving_pressure_past_the_model(driv
 
 
 def test_viscosity_follows_temperature_and_rebuilds_the_model():
-    """Hot water is thinner: nu = nu_ref exp(-a (T - T_ref)), more leakage, lower speed."""
+    """Hot water is thinner: nu follows Vogel's law through T_ref; more leakage, lower speed."""
     thermal = ThermalParams(initial=70.0, reference=40.0, heat_capacity=1.0e3)
-    a = 0.02
-    plant, _ = _run(EffectParams(viscosity_temperature=a), thermal)
+    slope = 247.8  # Vogel B of water [K]
+    plant, _ = _run(_effects(viscosity_temperature=slope), thermal)
     cold, _ = _run(thermal=thermal)  # same heat, effect off
-    nu_law = MODEL.liquid.kinematic_viscosity * math.exp(-a * (plant.state.temperature - 40.0))
+    law = ViscosityLaw('vogel', 40.0, MODEL.liquid.kinematic_viscosity)
+    nu_law = float(law.viscosity(plant.state.temperature, slope))
     assert plant.model.liquid.kinematic_viscosity == pytest.approx(nu_law, rel=0.006)
+    assert nu_law < 0.75 * MODEL.liquid.kinematic_viscosity
     assert plant.rebuilds >= 1
     assert cold.rebuilds == 0
     assert plant.state.speed < cold.state.speed
@@ -97,8 +107,8 @@ def test_viscosity_follows_temperature_and_rebuilds_the_model():
 def test_clearance_wear_grows_both_clearances_with_revolutions():
     """h_R and h_S grow by rate*revolutions (within the rebuild tolerance); speed drops."""
     rate = 1.0e-8
-    plant, _ = _run(EffectParams(clearance_wear=rate))
-    revolutions = plant.state.angle / (2.0 * math.pi)
+    plant, _ = _run(_effects(clearance_wear=rate))
+    revolutions = plant.state.angle / (2.0 * math.pi)  # the shaft never turned back
     grown = plant.model.geometry.clearance_rotor - MODEL.geometry.clearance_rotor
     h0 = 0.5 * (MODEL.geometry.clearance_rotor + MODEL.geometry.clearance_satellites)
     assert grown == pytest.approx(rate * revolutions, abs=0.005 * h0)
@@ -141,7 +151,9 @@ def test_sensor_bias_gain_and_rate_sample_and_hold():
 def test_effect_records_are_frozen():
     """Parameters cannot change under a running plant."""
     with pytest.raises(dataclasses.FrozenInstanceError):
-        EffectParams().external_leakage = 1.0
+        _effects(external_leakage=1e-12)[0].coefficient = 1.0
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        PlantParams().effects = ()
 
 
 def test_flat_parameter_table_round_trips_and_names_bad_values():
@@ -153,7 +165,8 @@ def test_flat_parameter_table_round_trips_and_names_bad_values():
     assert specs['effects.external_leakage'].low == 0.0
     assert all(s.description and s.unit for s in specs.values())
     params = params_from_flat({'effects.external_leakage': 1e-12, 'sensors.speed.rate': 50.0})
-    assert params.effects.external_leakage == 1e-12 and params.sensors.speed.rate == 50.0
+    assert params.effects == (Effect('external_leakage', 1e-12, 'p_case'),)
+    assert params.sensors.speed.rate == 50.0
     assert params_from_flat(flat_from_params(params)) == params
     with pytest.raises(Exception, match=r'ShaftParams.inertia = -1'):
         params_from_flat({'shaft.inertia': -1.0})
@@ -165,7 +178,7 @@ def test_reconfigure_keeps_the_state_and_applies_the_new_parameters():
     """A new liquid or effect takes hold from the next step without a jump in the state."""
     plant, _ = _run()
     before = plant.state
-    plant.reconfigure(dataclasses.replace(plant.params, effects=EffectParams(
+    plant.reconfigure(dataclasses.replace(plant.params, effects=_effects(
         flow_sensor_offset=1e-5)), MotorModel.default('oil'))
     assert plant.state == before
     assert plant.model.liquid.name != MODEL.liquid.name

@@ -8,10 +8,11 @@ from hypothesis import given, settings, strategies as st
 import pytest
 
 from satmotor_ros.model import MotorModel
-from satmotor_ros.model.effects import effect_from_mapping
+from satmotor_ros.model.effects import Effect, effect_from_mapping
 from satmotor_ros.model.units import ATMOSPHERE, LPM, MPA
-from satmotor_ros.plant import (ConstantLoad, EffectParams, LineParams, Plant, PlantError,
+from satmotor_ros.plant import (ConstantLoad, LineParams, Plant, PlantError,
                                 PlantParams, ShaftParams, SpeedProportionalLoad, StepLoad)
+from satmotor_ros.plant.config import params_from_flat
 
 MODELS = {name: MotorModel.default(name) for name in ('oil', 'water')}
 
@@ -64,7 +65,7 @@ def _volumes(plant):
 @pytest.mark.parametrize('liquid', ['oil', 'water'])
 def test_plant_lines_conserve_volume_through_steps_of_flow_and_load(liquid):
     """Compressed volume in each line changes by exactly what flows in minus what flows out."""
-    params = PlantParams(effects=EffectParams(external_leakage=2.0e-13))
+    params = PlantParams(effects=(Effect('external_leakage', 2.0e-13, 'p_case'),))
     plant = Plant(MODELS[liquid], params, load=StepLoad(20.0, 90.0, 0.15))
     dt = params.step
     stored_in, stored_out = _volumes(plant)
@@ -192,7 +193,7 @@ def test_parameter_records_reject_bad_values_naming_the_field():
     with pytest.raises(PlantError, match=r'ShaftParams.inertia = -1'):
         ShaftParams(inertia=-1.0)
     with pytest.raises(PlantError, match='leakage_driver'):
-        EffectParams(leakage_driver='nowhere')
+        params_from_flat({'effects.leakage_driver': 'nowhere'})
     with pytest.raises(PlantError, match=r'PlantParams.step'):
         PlantParams(step=math.nan)
     assert dataclasses.replace(PlantParams(), step=2e-3).step == 2e-3

@@ -14,6 +14,7 @@ from rclpy.parameter import Parameter
 from rclpy.qos import qos_profile_sensor_data
 from rosgraph_msgs.msg import Clock
 from satmotor_ros.model import MotorModel
+from satmotor_ros.model.effects import Effect
 from satmotor_ros.model.units import LPM, MPA
 from satmotor_ros.nodes.virtual_motor import all_parameters, VirtualMotorNode
 from sensor_msgs.msg import FluidPressure, JointState, Temperature
@@ -128,7 +129,7 @@ def test_parameters_are_refused_with_a_reason_and_the_old_value_kept(ros):
         Parameter('liquid', value='water'), Parameter('effects.flow_sensor_offset', value=1e-5)])
     assert result.successful
     assert node.plant.model.liquid.name == 'tap water'
-    assert node.plant.params.effects.flow_sensor_offset == 1e-5
+    assert node.plant.params.effects == (Effect('flow_sensor_offset', 1e-5, '1'),)
 
 
 def test_every_parameter_has_a_unit_and_numbers_a_range(ros):

@@ -12,7 +12,6 @@ into an MCAP rosbag2 per run; ``report.md`` gets the plots and the metrics table
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import os
 from pathlib import Path
 import sys
@@ -20,7 +19,7 @@ import time
 from typing import Any
 
 from satmotor_ros.cli._common import CliError, fail, subcommand
-from satmotor_ros.plant.params import EffectParams
+from satmotor_ros.plant.config import parameter_specs, params_from_flat
 from satmotor_ros.plant.scenario import default_cycle
 
 LIQUIDS = ('water', 'oil')
@@ -61,7 +60,7 @@ def parse_effects(items: list[str]) -> dict[str, Any]:
     Returns
     -------
     dict
-        ``effects.<name>`` -> value, validated by :class:`EffectParams`.
+        ``effects.<name>`` -> value, validated by :func:`params_from_flat`.
 
     Raises
     ------
@@ -69,14 +68,15 @@ def parse_effects(items: list[str]) -> dict[str, Any]:
         Naming the option and the value.
 
     """
-    known = {f.name: f.type for f in dataclasses.fields(EffectParams)}
+    specs = {s.name.removeprefix('effects.'): s for s in parameter_specs()
+             if s.name.startswith('effects.')}
     values: dict[str, Any] = {}
     for item in items:
         name, sep, text = item.partition('=')
-        if not sep or name not in known:
-            msg = f'--effect {item!r}: use NAME=VALUE with NAME one of {", ".join(known)}'
+        if not sep or name not in specs:
+            msg = f'--effect {item!r}: use NAME=VALUE with NAME one of {", ".join(specs)}'
             raise CliError(msg)
-        if name == 'leakage_driver':
+        if specs[name].choices:
             values[name] = text
             continue
         try:
@@ -84,7 +84,7 @@ def parse_effects(items: list[str]) -> dict[str, Any]:
         except ValueError:
             raise CliError(f'--effect {item!r}: {text!r} is not a number') from None
     try:
-        EffectParams(**values)
+        params_from_flat({f'effects.{k}': v for k, v in values.items()})
     except ValueError as err:
         raise CliError(f'--effect: {err}') from None
     return {f'effects.{k}': v for k, v in values.items()}

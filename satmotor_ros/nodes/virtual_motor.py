@@ -80,9 +80,6 @@ MAX_LOAD_TORQUE = 1.0e4
 """Largest load torque accepted on the topic, [N*m]."""
 
 
-_CHOICES = {'effects.leakage_driver': ('case', 'outlet')}
-
-
 def all_parameters() -> tuple[ParamSpec, ...]:
     """
     List every parameter the node declares.
@@ -94,7 +91,7 @@ def all_parameters() -> tuple[ParamSpec, ...]:
 
     """
     plant = tuple(ParamSpec(s.name, s.default, s.description, s.unit, s.low, s.high,
-                            choices=_CHOICES.get(s.name, ()))
+                            choices=s.choices)
                   for s in parameter_specs())
     return NODE_PARAMETERS + plant
 

@@ -23,12 +23,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 import math
-from typing import ClassVar
 
 from satmotor_ros.model import MotorModel
 from satmotor_ros.model.units import LPM
 from satmotor_ros.plant.errors import PlantError
-from satmotor_ros.plant.params import check_bounds
+from satmotor_ros.plant.params import check_bounds, parameter
 
 FEEDFORWARDS = ('model', 'naive', 'none')
 """The feed-forward choices."""
@@ -38,20 +37,20 @@ FEEDFORWARDS = ('model', 'naive', 'none')
 class ControllerParams:
     """Gains and limits of the speed controller."""
 
-    kp: float = 1.5e-6  # proportional gain, flow per speed error [m^3/rad]
-    ki: float = 3.0e-5  # integral gain, flow per integrated speed error [m^3/(s*rad)]
-    flow_min: float = 0.0  # smallest flow the pump gives [m^3/s]
-    flow_max: float = 60.0 * LPM  # largest flow the pump gives [m^3/s]
-    setpoint_weight: float = 0.0  # b of the proportional part k_p (b n_set - n) [-]
-    feedforward: str = 'model'  # 'model', 'naive' or 'none' [-]
-    anti_windup: bool = True  # back-calculation of the integrator at the limits [-]
-
-    bounds: ClassVar[dict[str, tuple[float, float]]] = {
-        'kp': (0.0, 1.0e-3), 'ki': (0.0, 1.0e-2), 'flow_min': (0.0, 1.0e-2),
-        'flow_max': (1.0e-7, 1.0e-2), 'setpoint_weight': (0.0, 1.0)}
+    kp: float = parameter(
+        1.5e-6, 'proportional gain, flow per speed error', 'm^3/rad', 0.0, 1.0e-3)
+    ki: float = parameter(
+        3.0e-5, 'integral gain, flow per integrated speed error', 'm^3/(s*rad)', 0.0, 1.0e-2)
+    flow_min: float = parameter(0.0, 'smallest flow the pump gives', 'm^3/s', 0.0, 1.0e-2)
+    flow_max: float = parameter(
+        60.0 * LPM, 'largest flow the pump gives', 'm^3/s', 1.0e-7, 1.0e-2)
+    setpoint_weight: float = parameter(
+        0.0, 'b of the proportional part k_p (b n_set - n)', '-', 0.0, 1.0)
+    feedforward: str = parameter('model', "'model', 'naive' or 'none'")
+    anti_windup: bool = parameter(True, 'back-calculation of the integrator at the limits')
 
     def __post_init__(self) -> None:
-        """Reject values outside ``bounds`` and an unknown feed-forward, naming the field."""
+        """Reject values outside their range and an unknown feed-forward, naming the field."""
         check_bounds(self)
         if self.feedforward not in FEEDFORWARDS:
             msg = (f'ControllerParams.feedforward = {self.feedforward!r}: use one of '

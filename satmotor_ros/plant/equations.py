@@ -6,62 +6,15 @@ The motor's volumetric losses are not here: they come from
 :class:`satmotor_ros.model.MotorModel` (Śliwiński 2017, eqs. (31)-(36)). The
 equations below are the standard lumped forms for a hydrostatic drive; the
 paper gives none of them. Equation tags (P1)-(P8) are this package's own and
-are listed in the README.
+are listed in the README. The line pressures (P1) and the relief valve (P2) are
+solved implicitly with the shaft in :meth:`satmotor_ros.plant.Plant._solve`; the
+viscosity follows the liquid's law (:mod:`satmotor_ros.model.viscosity`) through
+the ``viscosity_temperature`` effect.
 """
 
 from __future__ import annotations
 
 import math
-
-
-def line_pressure_rate(net_flow: float, volume: float, bulk_modulus: float) -> float:
-    r"""
-    Compute the pressure build-up of a liquid-filled line, eq. (P1).
-
-    .. math:: \dot p = \frac{K}{V}\,\sum Q
-
-    Parameters
-    ----------
-    net_flow : float
-        Flow into the line minus flow out of it, [m^3/s]
-    volume : float
-        Liquid volume of the line, [m^3]
-    bulk_modulus : float
-        Bulk modulus K of the liquid, [Pa]
-
-    Returns
-    -------
-    float
-        dp/dt, [Pa/s]
-
-    """
-    return bulk_modulus / volume * net_flow
-
-
-def relief_flow(p_in: float, p_tank: float, cracking: float, conductance: float) -> float:
-    r"""
-    Compute the flow through the relief valve, eq. (P2).
-
-    .. math:: Q_{rv} = k_{rv}\,\max(p_{in} - p_t - p_{cr}, 0)
-
-    Parameters
-    ----------
-    p_in : float
-        Inlet-line pressure, absolute, [Pa]
-    p_tank : float
-        Tank pressure, absolute, [Pa]
-    cracking : float
-        Cracking pressure above tank, [Pa]
-    conductance : float
-        Flow per pressure override k_rv, [m^3/(s*Pa)]
-
-    Returns
-    -------
-    float
-        Relief flow to the tank, [m^3/s]
-
-    """
-    return conductance * max(p_in - p_tank - cracking, 0.0)
 
 
 def return_flow(p_out: float, p_tank: float, back_pressure: float, conductance: float) -> float:
@@ -171,32 +124,6 @@ def case_pressure(p_out: float, p_tank: float, offset: float, outlet_share: floa
 
     """
     return p_tank + offset + outlet_share * (p_out - p_tank)
-
-
-def viscosity_at(temperature: float, nu_ref: float, t_ref: float, exponent: float) -> float:
-    r"""
-    Compute the kinematic viscosity at a temperature, eq. (P7).
-
-    .. math:: \nu = \nu_{ref}\,e^{-a\,(T - T_{ref})}
-
-    Parameters
-    ----------
-    temperature : float
-        Liquid temperature, [degC]
-    nu_ref : float
-        Viscosity at t_ref, [m^2/s]
-    t_ref : float
-        Reference temperature, [degC]
-    exponent : float
-        Temperature coefficient a, [1/K]
-
-    Returns
-    -------
-    float
-        Kinematic viscosity, [m^2/s]
-
-    """
-    return nu_ref * math.exp(-exponent * (temperature - t_ref))
 
 
 def temperature_rate(loss_power: float, temperature: float, ambient: float,

@@ -18,7 +18,13 @@ shaft speed omega and angle theta, liquid temperature T. Per step of dt:
    plant settles on the model's eqs. (36)/(40);
 3. dry friction sticks and slips (Karnopp): a resting shaft stays at rest
    while the net torque is within the static limit;
-4. the temperature follows the lost power (P8), explicitly.
+4. the temperature follows the lost power (P8), explicitly;
+5. drifting effects (viscosity, wear) rebuild the motor when their value moved.
+
+Effects are injected through their kinds (:mod:`satmotor_ros.model.effects`):
+the plant's motor model evaluates the motor effects at the plant's channels,
+drifting effects rebuild it within ``rebuild_tolerance``, an external leakage
+leaves the inlet line implicitly, and sensor effects act on the readings.
 """
 
 from __future__ import annotations
@@ -29,8 +35,13 @@ from typing import NamedTuple
 import numpy as np
 
 from satmotor_ros.model import MotorModel
+from satmotor_ros.model.effects import (Conditions, kind_of, plant_injection, PlantInjection,
+                                        sensor_error, with_effects)
+from satmotor_ros.model.revolutions import revolutions
 from satmotor_ros.model.units import ATMOSPHERE
-from satmotor_ros.plant.equations import case_pressure, friction_torque, viscosity_at
+from satmotor_ros.model.viscosity import standard_law
+from satmotor_ros.plant.equations import (case_pressure, driving_torque, friction_torque,
+                                          return_flow, temperature_rate)
 from satmotor_ros.plant.errors import PlantError
 from satmotor_ros.plant.load import ConstantLoad, LoadProfile
 from satmotor_ros.plant.motor import mirrored_point, MotorCache
@@ -61,7 +72,7 @@ class StepFlows(NamedTuple):
     command: float  # from the pump into the inlet line (the command after the pump's lag)
     motor: float  # into the motor's inlet port (model absorbency, linearised)
     relief: float  # relief valve, inlet line to tank
-    leakage: float  # external-leakage effect, inlet line to tank
+    leakage: float  # external-leakage effects, inlet line to tank
     model_external: float  # the model's own external leakage Q_ex (eq. 24)
     returned: float  # return valve, outlet line to tank
     cavitation_in: float  # make-up that held p_in at the vapour pressure
@@ -113,17 +124,28 @@ class Plant:
         """Fold the parameters into the constants of the step."""
         self.params = params if params is not None else PlantParams()
         self.load = load if load is not None else ConstantLoad()
-        self._motor = MotorCache(model, self.params.rebuild_tolerance)
-        self._point = model.absorbency_point
+        self._base = model
+        self._build_motor()
         self._set_constants()
         self.reset()
+
+    def _build_motor(self) -> None:
+        """Inject the effects: the motor ones into the model, the rest sorted by kind."""
+        p, base = self.params, self._base
+        law = standard_law(base.liquid, base.coefficient_set.name)
+        bound = tuple(kind_of(e).bind(e, law, p.thermal.reference) for e in p.effects)
+        self._injection: PlantInjection = plant_injection(bound)
+        self._injected = (p.effects, p.thermal.reference)
+        self._motor = MotorCache(with_effects(base, self._injection.motor), p.rebuild_tolerance)
+        self._point = self._motor.model.absorbency_point
+        self._q_guess: float | None = None
 
     def _set_constants(self) -> None:
         p = self.params
         model = self._motor.model
         dt = self._dt = p.step
         k = model.liquid.bulk_modulus
-        lines, relief, shaft, case, fx = p.lines, p.relief, p.shaft, p.case, p.effects
+        lines, relief, shaft = p.lines, p.relief, p.shaft
         self._qt = model.geometry.displacement
         self._a = lines.inlet_volume / (k * dt)
         self._c = lines.outlet_volume / (k * dt)
@@ -139,18 +161,28 @@ class Plant:
         self._pr0 = lines.tank_pressure + lines.back_pressure
         self._kv = relief.conductance
         self._pcr = lines.tank_pressure + relief.cracking_pressure
-        share = case.outlet_share if fx.leakage_driver == 'case' else 1.0
-        offset = case.offset if fx.leakage_driver == 'case' else 0.0
-        # external-leakage effect, k_x * driver gauge pressure = e1 * p_out + e0
-        self._e1 = fx.external_leakage * share
-        self._e0 = fx.external_leakage * (offset - share * lines.tank_pressure)
+        self._e0, self._e1 = self._bypass()
         th = p.thermal
         self._heat = (th.heat_capacity, th.cooling, th.ambient)
-        self._nu_ref = model.liquid.kinematic_viscosity
-        self._drifts = fx.viscosity_temperature > 0.0 or fx.clearance_wear > 0.0
         self._lag = dt / (p.pump_lag + dt)
         self._solve_constants = (self._qt, self._a, self._c, self._e0, self._e1, self._gr,
                                  self._pr0, self._kv, self._pcr)
+
+    def _bypass(self) -> tuple[float, float]:
+        """Return e0, e1 of the injected leakage k * gauge pressure = e1 * p_out + e0."""
+        case, pt = self.params.case, self.params.lines.tank_pressure
+        e0 = e1 = 0.0
+        for channel, k in self._injection.bypass:
+            if channel == 'p_case':  # eq. (P6): p_case - p_t = offset + share (p_out - p_t)
+                e1 += k * case.outlet_share
+                e0 += k * (case.offset - case.outlet_share * pt)
+            elif channel == 'p_out':
+                e1 += k
+                e0 -= k * pt
+            else:
+                msg = f'an inlet-line leakage driven by {channel!r}: use p_case or p_out'
+                raise PlantError(msg)
+        return e0, e1
 
     def reset(self, inlet_pressure: float | None = None, outlet_pressure: float | None = None,
               speed: float = 0.0, temperature: float | None = None) -> None:
@@ -178,7 +210,7 @@ class Plant:
         self._theta = 0.0
         self._temp = self.params.thermal.initial if temperature is None else float(temperature)
         self._revolutions = 0.0
-        self._q_guess: float | None = None
+        self._q_guess = None
         self._lin = (0.0, 0.0, 0.0, 0.0)  # last good (G, h, channel drop, model Q_ex)
         self._last = (0.0, self._p_in, self._p_out, False)  # q_cmd, P, R, relief open
         self._torque = 0.0
@@ -200,10 +232,12 @@ class Plant:
 
         """
         self.params = params
-        if model is not None or params.rebuild_tolerance != self._motor.tolerance:
-            self._motor = MotorCache(model or self._motor.base, params.rebuild_tolerance)
-            self._point = self._motor.model.absorbency_point
-            self._q_guess = None
+        injected = (params.effects, params.thermal.reference)
+        if (model is not None or params.rebuild_tolerance != self._motor.tolerance
+                or injected != self._injected):
+            self._base = model or self._base
+            self._build_motor()
+            self._drift()
         self._set_constants()
         if self._locked:
             self._w = 0.0
@@ -212,16 +246,15 @@ class Plant:
     def _make_sensors(self) -> None:
         p = self.params
         rng = np.random.default_rng(p.seed)
-        s, fx = p.sensors, p.effects
+        s, effects = p.sensors, self._injection.sensors
         self._sensors = (
             Sensor(s.inlet_pressure, rng), Sensor(s.outlet_pressure, rng),
-            Sensor(s.case_pressure, rng),
-            Sensor(s.flow, rng, fx.flow_sensor_gain, fx.flow_sensor_offset),
-            Sensor(s.speed, rng, fx.speed_sensor_gain), Sensor(s.temperature, rng))
+            Sensor(s.case_pressure, rng), Sensor(s.flow, rng, sensor_error(effects, 'flow')),
+            Sensor(s.speed, rng, sensor_error(effects, 'speed')), Sensor(s.temperature, rng))
 
     @property
     def model(self) -> MotorModel:
-        """Motor model in use now (rebuilt by the drifting effects)."""
+        """Motor model in use now (with the motor effects, rebuilt by the drifting ones)."""
         return self._motor.model
 
     @property
@@ -254,23 +287,36 @@ class Plant:
         if not 0.0 <= flow_command <= MAX_FLOW_COMMAND:
             msg = f'flow_command = {flow_command!r} m^3/s: outside [0, {MAX_FLOW_COMMAND}]'
             raise PlantError(msg)
+        load, slope, dry = self._load_torques(load_torque)
+        flow = self._pump(flow_command)
+        lin = self._linearise()
+        p, r, relief, w_new = self._solve_step(flow, lin, load, slope, dry)
+        self._last = (flow, p, r, relief)  # as solved: the flows balance with these
+        self._settle(max(p, self._pv), max(r, self._pv), w_new, lin[2], flow)
+        if self._injection.drift:
+            self._drift()
+
+    def _load_torques(self, load_torque: float | None) -> tuple[float, float, float]:
+        """Return the load torque, its slope over speed and the dry friction it adds to."""
         if load_torque is None:
-            tl0, tls = self.load.at(self._t)
+            load, slope = self.load.at(self._t)
         elif load_torque - load_torque == 0.0:  # finite
-            tl0, tls = load_torque, 0.0
+            load, slope = load_torque, 0.0
         else:
             msg = f'load_torque = {load_torque!r} N*m: not finite'
             raise PlantError(msg)
-        tc = self._tc
         if not self._active_load:  # a brake: |t0| adds to the dry friction
-            tc, tl0 = tc + abs(tl0), 0.0
-        # the pump follows the command with a first-order lag (implicit: any lag >= 0)
-        flow_command = self._q_pump = self._q_pump + self._lag * (flow_command - self._q_pump)
-        w = self._w
-        dp = self._p_in - self._p_out
-        qt = self._qt
+            return 0.0, slope, self._tc + abs(load)
+        return load, slope, self._tc
 
-        # 1. the motor at the start of the step, linearised as Q_m' = q_t w' + G dp' + h
+    def _pump(self, flow_command: float) -> float:
+        """Follow the command with the pump's first-order lag (implicit: any lag >= 0)."""
+        self._q_pump += self._lag * (flow_command - self._q_pump)
+        return self._q_pump
+
+    def _linearise(self) -> tuple[float, float, float, float]:
+        """Linearise the motor at the start of the step as Q_m' = q_t w' + G dp' + h."""
+        w, dp, qt = self._w, self._p_in - self._p_out, self._qt
         channels = self._channels() if self._motor.model.channels else None
         if w >= 0.0 and dp >= 0.0:
             pt = self._point(w, dp, flow_guess=self._q_guess, channels=channels)
@@ -278,60 +324,57 @@ class Plant:
         else:
             q, dp_i, qx, q_id, self.model_status = mirrored_point(self._motor.model, w, dp,
                                                                   self._q_guess, channels)
-        if q == q:
-            self._q_guess = q
-            qtw = qt * w
-            g = abs(q - qtw - (q_id if w >= 0.0 else -q_id)) / max(abs(dp), _DP_REF)
-            lin = self._lin = (g, q - qtw - g * dp, dp - dp_i, qx)
-        else:  # NaN: the model refused the point; keep the last good linearisation
+        if q != q:  # NaN: the model refused the point; keep the last good linearisation
             self.invalid_points += 1
-            lin = self._lin
-        dich = lin[2]
+            return self._lin
+        self._q_guess = q
+        qtw = qt * w
+        g = abs(q - qtw - (q_id if w >= 0.0 else -q_id)) / max(abs(dp), _DP_REF)
+        self._lin = (g, q - qtw - g * dp, dp - dp_i, qx)
+        return self._lin
 
-        # 2. the implicit step: sliding, sticking or breaking away (Karnopp)
+    def _solve_step(self, flow: float, lin: tuple[float, float, float, float], load: float,
+                    slope: float, dry: float) -> tuple[float, float, bool, float]:
+        """Solve the lines and the shaft: sliding, sticking or breaking away (Karnopp)."""
+        w, dich = self._w, lin[2]
         relief = self._p_in > self._pcr
         if w == 0.0:
-            p, r, relief = self._solve(flow_command, lin, 0.0, 0.0, relief)
-            w_new = 0.0
-            sign = 0.0 if self._locked else self._breakaway(p - r - dich, tl0, tc)
+            p, r, relief = self._solve(flow, lin, 0.0, 0.0, relief)
+            sign = 0.0 if self._locked else self._breakaway(p - r - dich, load, dry)
+            if sign == 0.0:
+                return p, r, relief, 0.0
         else:
             sign = 1.0 if w > 0.0 else -1.0
-        if sign != 0.0:
-            kt = qt * (1.0 - self._cp * sign * (1.0 if dp >= dich else -1.0))
-            m = self._m
-            den = m + self._b + tls
-            w0 = (m * w - kt * dich - sign * tc - tl0) / den
-            wk = kt / den
-            p, r, relief = self._solve(flow_command, lin, w0, wk, relief)
-            w_new = w0 + wk * (p - r)
-            if w_new * sign < 0.0:  # friction stops the shaft within the step
-                p, r, relief = self._solve(flow_command, lin, 0.0, 0.0, relief)
-                w_new = 0.0
+        dp = self._p_in - self._p_out
+        kt = self._qt * (1.0 - self._cp * sign * (1.0 if dp >= dich else -1.0))
+        den = self._m + self._b + slope
+        w0 = (self._m * w - kt * dich - sign * dry - load) / den
+        wk = kt / den
+        p, r, relief = self._solve(flow, lin, w0, wk, relief)
+        w_new = w0 + wk * (p - r)
+        if w_new * sign < 0.0:  # friction stops the shaft within the step
+            p, r, relief = self._solve(flow, lin, 0.0, 0.0, relief)
+            w_new = 0.0
+        return p, r, relief, w_new
 
-        # 3. cavitation floor, torque, heat, angle, time
-        self._last = (flow_command, p, r, relief)  # as solved: the flows balance with these
-        pv = self._pv
-        if p < pv:
-            p = pv
-        if r < pv:
-            r = pv
+    def _settle(self, p: float, r: float, w_new: float, dich: float, flow: float) -> None:
+        """Take the new state: torque, heat (P8), angle, revolutions and time."""
         dt = self._dt
         dp_i = self._dp_i = p - r - dich
         torque = 0.0
         if w_new != 0.0:
-            torque = qt * dp_i - friction_torque(w_new, dp_i, qt, self._b, self._tc, self._cp)
+            torque = (driving_torque(dp_i, self._qt)
+                      - friction_torque(w_new, dp_i, self._qt, self._b, self._tc, self._cp))
         self._torque = torque
         heat_capacity, cooling, ambient = self._heat
-        temp = self._temp
-        loss_power = flow_command * (p - self._pt) - w_new * torque
-        self._temp = temp + dt * (loss_power - cooling * (temp - ambient)) / heat_capacity
+        loss_power = flow * (p - self._pt) - w_new * torque
+        self._temp += dt * temperature_rate(loss_power, self._temp, ambient, heat_capacity,
+                                            cooling)
         self._p_in, self._p_out, self._w = p, r, w_new
         self._theta += w_new * dt
-        n = self._n = self._n + 1
-        self._t = n * dt
-        if self._drifts:
-            self._revolutions += abs(w_new) * dt / (2.0 * math.pi)
-            self._drift()
+        self._revolutions = revolutions(w_new, dt, self._revolutions)
+        self._n += 1
+        self._t = self._n * dt
 
     def _breakaway(self, dp_i: float, load: float, dry: float) -> float:
         """Return 0 while static friction holds the shaft, else the direction it breaks away."""
@@ -375,10 +418,13 @@ class Plant:
         return p, r, relief
 
     def _drift(self) -> None:
-        fx = self.params.effects
-        nu = viscosity_at(self._temp, self._nu_ref, self.params.thermal.reference,
-                          fx.viscosity_temperature)
-        if self._motor.update(nu, fx.clearance_wear * self._revolutions):
+        """Rebuild the motor when a drifting effect has moved its viscosity or clearances."""
+        base = self._motor.base
+        now = Conditions(base.liquid.kinematic_viscosity, 0.0, 0.0, 0.0)
+        channels = self._channels()
+        for effect in self._injection.drift:
+            now = kind_of(effect).condition(effect, channels[effect.regressor], now)
+        if self._motor.update(now.viscosity, now.growth):
             self._q_guess = None
             self._point = self._motor.model.absorbency_point
 
@@ -413,7 +459,7 @@ class Plant:
             command=q_cmd, motor=motor,
             relief=self._kv * (p - self._pcr) if relief else 0.0,
             leakage=self._e1 * r + self._e0, model_external=qx,
-            returned=self._gr * (r - self._pr0),
+            returned=return_flow(r, self._pr0, 0.0, self._gr),
             cavitation_in=cav_in, cavitation_out=cav_out)
 
     @property
@@ -443,7 +489,7 @@ class Plant:
         """Return what a calibrated coefficient set's effects read (gauge Pa, degC, s, rev)."""
         return {'p_case': max(self.case_pressure() - ATMOSPHERE, 0.0),
                 'p_out': max(self._p_out - ATMOSPHERE, 0.0), 'temperature': self._temp,
-                'time': self._t, 'revolutions': self._theta / (2.0 * math.pi)}
+                'time': self._t, 'revolutions': self._revolutions}
 
     def measure(self) -> Measurement:
         """

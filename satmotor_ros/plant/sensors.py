@@ -12,7 +12,7 @@ from satmotor_ros.plant.params import SensorParams
 
 class Sensor:
     """
-    One sensed channel: reading = gain*(1 + gain_error)*value + bias + offset + noise.
+    One sensed channel: reading = gain*g_e*value + bias + o_e + noise, (g_e, o_e) the effects.
 
     Parameters
     ----------
@@ -20,20 +20,19 @@ class Sensor:
         Noise, bias, gain and rate, [channel unit]
     rng : numpy.random.Generator
         Source of the noise (seeded by the plant), [-]
-    gain_error : float
-        Extra relative gain error (an effect), [-]
-    offset : float
-        Extra offset (an effect), [channel unit]
+    error : tuple of float
+        Gain g_e [-] and offset o_e [channel unit] of the injected effects
+        (:func:`satmotor_ros.model.effects.sensor_error`), [-]
 
     """
 
     __slots__ = ('_gain', '_bias', '_noise', '_rate', '_index', '_held', '_rng')
 
-    def __init__(self, params: SensorParams, rng: np.random.Generator, gain_error: float = 0.0,
-                 offset: float = 0.0) -> None:
+    def __init__(self, params: SensorParams, rng: np.random.Generator,
+                 error: tuple[float, float] = (1.0, 0.0)) -> None:
         """Fold the effects into one gain and one bias."""
-        self._gain = params.gain * (1.0 + gain_error)
-        self._bias = params.bias + offset
+        self._gain = params.gain * error[0]
+        self._bias = params.bias + error[1]
         self._noise = params.noise
         self._rate = params.rate
         self._index = -1

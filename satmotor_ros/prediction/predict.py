@@ -20,6 +20,7 @@ import numpy as np
 import numpy.typing as npt
 
 from satmotor_ros.model import COMPONENTS, describe_status, INVALID, MotorModel, PointStatus
+from satmotor_ros.model.revolutions import revolutions
 from satmotor_ros.model.units import ATMOSPHERE
 from satmotor_ros.prediction.rule import (describe_input, FIELDS, input_level, INPUTS,
                                           InputState, Level, pick, Snapshot, SnapshotBatch)
@@ -42,7 +43,6 @@ and shaft revolutions [rev] since the first prediction (see :class:`Progress`), 
 ``satmotor calibrate`` counts them from the start of a bag.
 """
 
-_TWO_PI = 2.0 * math.pi
 # plain ints: an enum member looked up on its class costs a microsecond per message
 _FRESH = int(InputState.FRESH)
 _OK, _WARN, _ERROR = int(Level.OK), int(Level.WARN), int(Level.ERROR)
@@ -96,12 +96,11 @@ class Progress:
             self.origin_ns = self.last_ns = int(stamps[0] if batch else stamps)
         dt = (np.diff(stamps, prepend=self.last_ns) if batch else stamps - self.last_ns) * 1e-9
         fresh = snap.states[_I_SPEED] == _FRESH
-        with _quiet(batch):  # inf or NaN where not fresh
-            turns = pick(fresh, snap.values[_I_SPEED] * dt / _TWO_PI, 0.0)
-        revolutions = self.revolutions + (np.cumsum(turns) if batch else turns)
-        self.revolutions = float(revolutions[-1] if batch else revolutions)
+        speed = pick(fresh, snap.values[_I_SPEED], 0.0)  # inf or NaN where not fresh
+        turned = revolutions(speed, dt, self.revolutions)
+        self.revolutions = float(turned[-1] if batch else turned)
         self.last_ns = int(stamps[-1] if batch else stamps)
-        return (stamps - self.origin_ns) * 1e-9, revolutions
+        return (stamps - self.origin_ns) * 1e-9, turned
 
     def peek(self, stamp_ns: int) -> tuple[float, float]:
         """
