@@ -336,7 +336,7 @@ class EffectKind:
         if unit_loss is None:
             return [], []
         x = np.asarray(unit_loss(data.parts.speed, data.parts.dp_i), dtype=float)
-        return [additive(self.name, self.name, self.unit, self.source, x)], []
+        return [additive(self.name, '', self.unit, self.source, x)], []
 
     # -- the plant and synthetic data ----------------------------------------------------
 
