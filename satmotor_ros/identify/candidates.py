@@ -45,22 +45,4 @@ def build_library(parts: LossParts, channels: Mapping[str, FloatArray],
     return build_candidates(CandidateData(parts, channels, law, frozenset()))
 
 
-def describe(candidate: Candidate) -> str:
-    """
-    Describe a candidate in one line for reports.
-
-    Parameters
-    ----------
-    candidate : Candidate
-        The candidate, [-]
-
-    Returns
-    -------
-    str
-        ``label [unit] (source)``.
-
-    """
-    return f'{candidate.label} [{candidate.unit}] ({candidate.source})'
-
-
-__all__ = ['Candidate', 'TERMS', 'build_library', 'describe']
+__all__ = ['Candidate', 'TERMS', 'build_library']

@@ -10,7 +10,6 @@ from types import ModuleType
 
 import numpy as np
 
-from satmotor_ros.identify.candidates import describe
 from satmotor_ros.identify.output import effect_block, fitted_coefficients
 from satmotor_ros.identify.parts import SCALES
 from satmotor_ros.identify.pipeline import Calibration
@@ -214,7 +213,7 @@ def write_report(cal: Calibration, out: Path, summary: dict[str, object]) -> Pat
         f'No effect: CV RMSE {sel.baseline.cv_rmse / LPM:.4g} l/min. An effect is accepted '
         f'when p < {sel.alpha:g}/{len(sel.ranking)} (Bonferroni) and it cuts the CV error by '
         'more than 5 %.', '']
-    lines += ['Library:', ''] + [f'- {describe(c)}' for c in cal.candidates]
+    lines += ['Library:', ''] + [f'- {c.description}' for c in cal.candidates]
     if cal.skipped:
         lines += ['', 'Not tested:', ''] + [f'- {why}' for why in cal.skipped]
     block = effect_block(cal)

@@ -55,20 +55,7 @@ class ConstantLoad:
         _finite(self, 'torque')
 
     def at(self, time: float) -> tuple[float, float]:
-        """
-        Give the load law at `time`.
-
-        Parameters
-        ----------
-        time : float
-            Simulation time, [s]
-
-        Returns
-        -------
-        tuple of float
-            Torque [N*m] and slope 0 [N*m*s/rad].
-
-        """
+        """Return (torque [N*m], slope 0) at `time` [s], as :meth:`LoadProfile.at`."""
         return self.torque, 0.0
 
 
@@ -85,20 +72,7 @@ class StepLoad:
         _finite(self, 'before', 'after', 'time')
 
     def at(self, time: float) -> tuple[float, float]:
-        """
-        Give the load law at `time`.
-
-        Parameters
-        ----------
-        time : float
-            Simulation time, [s]
-
-        Returns
-        -------
-        tuple of float
-            Torque [N*m] and slope 0 [N*m*s/rad].
-
-        """
+        """Return (torque [N*m], slope 0) at `time` [s], as :meth:`LoadProfile.at`."""
         return (self.after if time >= self.time else self.before), 0.0
 
 
@@ -119,20 +93,7 @@ class RampLoad:
             raise PlantError(msg)
 
     def at(self, time: float) -> tuple[float, float]:
-        """
-        Give the load law at `time`.
-
-        Parameters
-        ----------
-        time : float
-            Simulation time, [s]
-
-        Returns
-        -------
-        tuple of float
-            Torque [N*m] and slope 0 [N*m*s/rad].
-
-        """
+        """Return (torque [N*m], slope 0) at `time` [s], as :meth:`LoadProfile.at`."""
         share = min(max((time - self.t_start) / (self.t_end - self.t_start), 0.0), 1.0)
         return self.start + share * (self.end - self.start), 0.0
 
@@ -152,20 +113,7 @@ class SpeedProportionalLoad:
             raise PlantError(msg)
 
     def at(self, time: float) -> tuple[float, float]:
-        """
-        Give the load law at `time`.
-
-        Parameters
-        ----------
-        time : float
-            Simulation time, [s]
-
-        Returns
-        -------
-        tuple of float
-            Offset [N*m] and slope [N*m*s/rad].
-
-        """
+        """Return (offset [N*m], slope [N*m*s/rad]) at any `time`, as :meth:`LoadProfile.at`."""
         return self.offset, self.coefficient
 
 

@@ -21,7 +21,7 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, replace
 import math
-from typing import Any, ClassVar, NamedTuple, Protocol, TYPE_CHECKING
+from typing import Any, NamedTuple, Protocol, TYPE_CHECKING
 
 import numpy as np
 
@@ -131,6 +131,11 @@ class Candidate:
             return self.effect
         return f'{self.effect}({self.regressor})'
 
+    @property
+    def description(self) -> str:
+        """Return ``label [unit] (source)``, one line for reports."""
+        return f'{self.label} [{self.unit}] ({self.source})'
+
     def as_effect(self, coefficient: float) -> Effect:
         """Return the effect this candidate stands for at a fitted coefficient."""
         if self.make is not None:
@@ -234,41 +239,24 @@ class EffectKind:
     a kind overrides what differs.
     """
 
-    name: ClassVar[str] = ''  # YAML id; a suffixed kind is written '<name>:<suffix>'
-    suffixed: ClassVar[bool] = False  # the id carries ':<suffix>'
-    rank: ClassVar[int] = 100  # place in the candidate library and in messages
-    keys: ClassVar[tuple[str, ...]] = ('regressor', 'coefficient')  # YAML keys it reads
-    required: ClassVar[tuple[str, ...]] = ('coefficient',)  # of which these must be there
-    regressors: ClassVar[tuple[str, ...]] = ()  # channels it may read, the default first
-    reads_channel: ClassVar[bool] = False  # the model needs its regressor's value
-    drifts: ClassVar[bool] = False  # it changes the motor itself (a rebuilt model)
-    sensor: ClassVar[str] = ''  # the channel of an instrument error ('flow', 'speed')
-    unit: ClassVar[str] = '-'  # unit of the coefficient
-    source: ClassVar[str] = ''  # the physics or standard the term comes from
-    evaluation: ClassVar[str] = ''  # what the model does with it (written into the YAML)
-    plant_parameters: ClassVar[tuple[PlantParameter, ...]] = ()  # node parameters
+    name: str = ''  # YAML id; a suffixed kind is written '<name>:<suffix>'
+    suffixed: bool = False  # the id carries ':<suffix>'
+    rank: int = 100  # place in the candidate library and in messages
+    keys: tuple[str, ...] = ('regressor', 'coefficient')  # YAML keys it reads
+    required: tuple[str, ...] = ('coefficient',)  # of which these must be there
+    regressors: tuple[str, ...] = ()  # channels it may read, the default first
+    reads_channel: bool = False  # the model needs its regressor's value
+    drifts: bool = False  # it changes the motor itself (a rebuilt model)
+    sensor: str = ''  # the channel of an instrument error ('flow', 'speed')
+    unit: str = '-'  # unit of the coefficient
+    source: str = ''  # the physics or standard the term comes from
+    evaluation: str = ''  # what the model does with it (written into the YAML)
+    plant_parameters: tuple[PlantParameter, ...] = ()  # node parameters
 
     # -- YAML --------------------------------------------------------------------------
 
     def parse(self, name: str, doc: Mapping[str, Any], where: str) -> Effect:
-        """
-        Build one validated effect from its YAML block (keys checked by the registry).
-
-        Parameters
-        ----------
-        name : str
-            The block's key, e.g. ``'term:dp^2*n'``, [-]
-        doc : mapping
-            The block, known keys only, [-]
-        where : str
-            Key path quoted in errors, [-]
-
-        Returns
-        -------
-        Effect
-            The effect.
-
-        """
+        """Build the effect of YAML block `doc` (known keys only) named `name` at `where`."""
         values = {k: finite(doc[k], f'{where}.{k}') for k in self.keys
                   if k in doc and k not in ('regressor', 'law')}
         suffix = name.partition(':')[2]
