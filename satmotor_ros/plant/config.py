@@ -135,9 +135,8 @@ def _check(spec: ParameterSpec, value: Any) -> None:
               and math.isfinite(value)
               and (spec.low is None or spec.low <= value <= spec.high))
     if not ok:
-        allowed = (', '.join(spec.choices) if spec.choices
-                   else f'[{spec.low:g}, {spec.high:g}] {spec.unit}')
-        msg = f'{spec.name} = {value!r} is outside {allowed}'
+        msg = (f'{spec.name} = {value!r}: use one of {", ".join(spec.choices)}' if spec.choices
+               else f'{spec.name} = {value!r} is outside [{spec.low:g}, {spec.high:g}]')
         raise PlantError(msg)
 
 
