@@ -2,10 +2,9 @@
 """One effect kind, one file: a kind registered alone reaches the model, plant, data and fit."""
 
 import importlib
+
 import numpy as np
 import pytest
-import yaml
-
 from satmotor_ros.identify.candidates import build_library
 from satmotor_ros.identify.parts import loss_parts
 from satmotor_ros.identify.synthetic import generate, Injection, Plan
@@ -17,6 +16,7 @@ from satmotor_ros.model.units import LPM
 from satmotor_ros.model.viscosity import standard_law
 from satmotor_ros.plant import ConstantLoad, Plant
 from satmotor_ros.plant.config import parameter_specs, params_from_flat
+import yaml
 
 K = 2.0e-11  # coefficient of the test kind [m^3/s/(rad/s)^3]
 
