@@ -40,9 +40,11 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
                         help='length of the cycle per run in seconds of simulated time '
                              '(default 24; the steps scale with it)')
     parser.add_argument('--effect', action='append', default=[], metavar='NAME=VALUE',
-                        help='inject a plant effect the model does not know, SI value, e.g. '
-                             'external_leakage=2e-12, viscosity_temperature=0.03, '
-                             'clearance_wear=1e-9, flow_sensor_gain=0.03 (repeatable)')
+                        help='inject a plant effect the model does not know (an effects.* '
+                             'parameter of virtual_motor), SI value, e.g. '
+                             'external_leakage=2e-12, viscosity_temperature=247.8 (Vogel B '
+                             'of water [K]; Walther B of oil: 3.68), clearance_wear=1e-9, '
+                             'flow_sensor_gain=0.03 (repeatable)')
     parser.add_argument('--out', default='out/demo', metavar='DIR',
                         help='output directory (default out/demo)')
     parser.add_argument('--quiet', action='store_true', help='no progress bar')

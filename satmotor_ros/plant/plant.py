@@ -132,8 +132,10 @@ class Plant:
     def _build_motor(self) -> None:
         """Inject the effects: the motor ones into the model, the rest sorted by kind."""
         p, base = self.params, self._base
-        law = standard_law(base.liquid, base.coefficient_set.name)
-        bound = tuple(kind_of(e).bind(e, law, p.thermal.reference) for e in p.effects)
+        bound = p.effects
+        if bound:  # effects that leave the law to the liquid take its standard one
+            law = standard_law(base.liquid, base.coefficient_set.name)
+            bound = tuple(kind_of(e).bind(e, law, p.thermal.reference) for e in bound)
         self._injection: PlantInjection = plant_injection(bound)
         self._injected = (p.effects, p.thermal.reference)
         self._motor = MotorCache(with_effects(base, self._injection.motor), p.rebuild_tolerance)
