@@ -137,6 +137,7 @@ class Plant:
             law = standard_law(base.liquid, base.coefficient_set.name)
             bound = tuple(kind_of(e).bind(e, law, p.thermal.reference) for e in bound)
         self._injection: PlantInjection = plant_injection(bound)
+        self._drifting = bool(self._injection.drift)
         self._injected = (p.effects, p.thermal.reference)
         self._motor = MotorCache(with_effects(base, self._injection.motor), p.rebuild_tolerance)
         self._point = self._motor.model.absorbency_point
@@ -295,7 +296,7 @@ class Plant:
         p, r, relief, w_new = self._solve_step(flow, lin, load, slope, dry)
         self._last = (flow, p, r, relief)  # as solved: the flows balance with these
         self._settle(max(p, self._pv), max(r, self._pv), w_new, lin[2], flow)
-        if self._injection.drift:
+        if self._drifting:
             self._drift()
 
     def _load_torques(self, load_torque: float | None) -> tuple[float, float, float]:
