@@ -14,12 +14,12 @@ selector, and :mod:`.pipeline` composes them; :mod:`.output` and
 from satmotor_ros.identify.candidates import build_library, Candidate
 from satmotor_ros.identify.errors import DataError, IdentificationError
 from satmotor_ros.identify.fit import check_identifiable, FitReport, LossFit
-from satmotor_ros.identify.parts import loss_parts, LossParts, Modifier, predict_flow
+from satmotor_ros.identify.parts import loss_parts, LossParts, predict_flow
 from satmotor_ros.identify.pipeline import calibrate, Calibration, Options, steady_points
 from satmotor_ros.identify.selection import CrossValidatedSelector, Errors, Selection
 from satmotor_ros.identify.steady import extract_steady, SteadyTolerance
 from satmotor_ros.identify.table import BenchTable, read_csv, REQUIRED, write_csv
-from satmotor_ros.model.effects import TERMS
+from satmotor_ros.model.effects import Modifier, TERMS
 from satmotor_ros.model.viscosity import standard_law, ViscosityLaw
 
 __all__ = [

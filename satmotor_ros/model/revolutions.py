@@ -4,12 +4,23 @@
 from __future__ import annotations
 
 import math
+from typing import overload
 
 import numpy as np
 
 from satmotor_ros.model._typing import ArrayLike, FloatArray
 
 _TWO_PI = 2.0 * math.pi
+
+
+@overload
+def revolutions(speed: float, dt: float, start: float = 0.0) -> float:
+    ...
+
+
+@overload
+def revolutions(speed: FloatArray, dt: ArrayLike, start: float = 0.0) -> FloatArray:
+    ...
 
 
 def revolutions(speed: ArrayLike, dt: ArrayLike, start: float = 0.0) -> float | FloatArray:

@@ -221,5 +221,6 @@ def standard_law(liquid: Liquid, set_name: str = '') -> ViscosityLaw:
         return ViscosityLaw('vogel', t_ref, nu, b)
     (t1, nu1), (t2, nu2) = ISO_VG46
     slope = walther_slope(t1, nu1, t2, nu2)
-    t_ref = (t1 + KELVIN) * 10.0 ** ((walther_w(nu1) - walther_w(nu)) / slope) - KELVIN
-    return ViscosityLaw('walther', float(t_ref), nu, slope)
+    w1, w = float(walther_w(nu1)), float(walther_w(nu))
+    t_ref = (t1 + KELVIN) * 10.0 ** ((w1 - w) / slope) - KELVIN
+    return ViscosityLaw('walther', t_ref, nu, slope)

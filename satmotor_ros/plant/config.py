@@ -129,14 +129,15 @@ def flat_from_params(params: PlantParams) -> dict[str, Any]:
 
 def _check(spec: ParameterSpec, value: Any) -> None:
     if spec.choices:
-        ok = value in spec.choices
-    else:
-        ok = (isinstance(value, (int, float)) and not isinstance(value, bool)
-              and math.isfinite(value)
-              and (spec.low is None or spec.low <= value <= spec.high))
-    if not ok:
-        msg = (f'{spec.name} = {value!r}: use one of {", ".join(spec.choices)}' if spec.choices
-               else f'{spec.name} = {value!r} is outside [{spec.low:g}, {spec.high:g}]')
+        if value not in spec.choices:
+            msg = f'{spec.name} = {value!r}: use one of {", ".join(spec.choices)}'
+            raise PlantError(msg)
+        return
+    low = -math.inf if spec.low is None else spec.low
+    high = math.inf if spec.high is None else spec.high
+    if not (isinstance(value, (int, float)) and not isinstance(value, bool)
+            and math.isfinite(value) and low <= value <= high):
+        msg = f'{spec.name} = {value!r} is outside [{low:g}, {high:g}]'
         raise PlantError(msg)
 
 

@@ -146,16 +146,45 @@ class Candidate:
 class Parts(Protocol):
     """The model's loss components at measured points (``identify.parts.LossParts``)."""
 
-    flow: FloatArray  # measured Q [m^3/s]
-    speed: FloatArray  # measured n [rad/s]
-    dp_i: FloatArray  # chamber drop, eq. (34) [Pa]
-    displacement: FloatArray  # q_t n [m^3/s]
-    clearance: FloatArray  # h, eq. (2) [m]
-    clearance_satellites: float  # h_S [m]
-    h_exponent: float  # Q_Lfg ~ h^(3/(2-beta)) [-]
-    hs_exponent: float  # Q_C ~ h_S^C_2 [-]
-    nu_exponent_lfg: float  # Q_Lfg ~ nu^(-beta/(2-beta)) [-]
-    nu_exponent_c: float  # Q_C ~ nu^(-gamma) [-]
+    @property
+    def flow(self) -> FloatArray:
+        """Measured Q [m^3/s]."""
+
+    @property
+    def speed(self) -> FloatArray:
+        """Measured n [rad/s]."""
+
+    @property
+    def dp_i(self) -> FloatArray:
+        """Chamber drop, eq. (34) [Pa]."""
+
+    @property
+    def displacement(self) -> FloatArray:
+        """q_t n [m^3/s]."""
+
+    @property
+    def clearance(self) -> FloatArray:
+        """h, eq. (2) [m]."""
+
+    @property
+    def clearance_satellites(self) -> float:
+        """h_S [m]."""
+
+    @property
+    def h_exponent(self) -> float:
+        """Q_Lfg ~ h^(3/(2-beta)) [-]."""
+
+    @property
+    def hs_exponent(self) -> float:
+        """Q_C ~ h_S^C_2 [-]."""
+
+    @property
+    def nu_exponent_lfg(self) -> float:
+        """Q_Lfg ~ nu^(-beta/(2-beta)) [-]."""
+
+    @property
+    def nu_exponent_c(self) -> float:
+        """Q_C ~ nu^(-gamma) [-]."""
 
 
 class CandidateData(NamedTuple):
@@ -201,6 +230,13 @@ class PlantInjection:
     def add(self, slot: str, item: Any) -> PlantInjection:
         """Return a copy with `item` appended to the tuple `slot`."""
         return replace(self, **{slot: (*getattr(self, slot), item)})
+
+
+def maker(name: str, regressor: str = '', reference: float = 0.0) -> Callable[[float], Effect]:
+    """Return coefficient -> ``Effect(name, coefficient, regressor, reference)``."""
+    def make(coefficient: float) -> Effect:
+        return Effect(name, coefficient, regressor, reference)
+    return make
 
 
 def finite(value: Any, where: str) -> float:
@@ -257,8 +293,8 @@ class EffectKind:
 
     def parse(self, name: str, doc: Mapping[str, Any], where: str) -> Effect:
         """Build the effect of YAML block `doc` (known keys only) named `name` at `where`."""
-        values = {k: finite(doc[k], f'{where}.{k}') for k in self.keys
-                  if k in doc and k not in ('regressor', 'law')}
+        values: dict[str, Any] = {k: finite(doc[k], f'{where}.{k}') for k in self.keys
+                                  if k in doc and k not in ('regressor', 'law')}
         suffix = name.partition(':')[2]
         return Effect(name=name, regressor=self.regressor(suffix, doc.get('regressor'), where),
                       **values)
@@ -413,4 +449,4 @@ def additive(effect: str, regressor: str, unit: str, source: str, x: FloatArray,
 
 __all__ = ['Candidate', 'CandidateData', 'Conditions', 'Effect', 'EffectKind', 'KINDS',
            'Modifier', 'PlantInjection', 'PlantParameter', 'SensorError', 'Synthetic',
-           'additive', 'finite', 'per_unit', 'varies', 'why_not']
+           'additive', 'finite', 'maker', 'per_unit', 'varies', 'why_not']

@@ -8,7 +8,8 @@ from typing import Any
 import numpy as np
 
 from satmotor_ros.model.effects._base import (additive, Candidate, CandidateData, Conditions,
-                                              Effect, EffectKind, Synthetic, varies, why_not)
+                                              Effect, EffectKind, maker, Synthetic, varies,
+                                              why_not)
 from satmotor_ros.model.errors import ConfigError
 
 
@@ -42,14 +43,13 @@ class Channel(EffectKind):
         for name, values in data.channels.items():
             if name in data.covered:
                 continue
-            if not varies(values):
+            if values is None or not varies(values):
                 skipped.append(f'{self.name}:{name}: {why_not(values)}')
                 continue
             mean = float(np.mean(values))
             out.append(additive(f'{self.name}:{name}', name, f'm^3/s per {name} unit',
                                 self.source, values - mean, values=values,
-                                make=lambda k, n=name, m=mean: Effect(
-                                    f'{self.name}:{n}', k, n, reference=m)))
+                                make=maker(f'{self.name}:{name}', name, mean)))
         return out, skipped
 
     def scaled(self, name: str, magnitude: float, regressor: str, data: Synthetic) -> Effect:

@@ -3,14 +3,15 @@
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from typing import Any
 
 import numpy as np
 
+from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.effects._base import (Candidate, CandidateData, Conditions, Effect,
-                                              EffectKind, Modifier, PlantParameter, Synthetic,
-                                              varies, why_not)
+                                              EffectKind, maker, Modifier, Parts,
+                                              PlantParameter, Synthetic, varies, why_not)
 
 
 class ClearanceWear(EffectKind):
@@ -41,23 +42,19 @@ class ClearanceWear(EffectKind):
         parts = data.parts
         for name in self.regressors:
             exposure = data.channels.get(name)
-            if not varies(exposure):
+            if exposure is None or not varies(exposure):
                 skipped.append(f'{self.name}({name}): {why_not(exposure)}')
                 continue
             start = float(np.min(exposure))
             x = exposure - start
 
-            def modify(rate: float, x: np.ndarray = x) -> Modifier:
-                grow = rate * x
-                return Modifier(flat_clearance=(1.0 + grow / parts.clearance) ** parts.h_exponent,
-                                commutation=(1.0 + grow / parts.clearance_satellites)
-                                ** parts.hs_exponent)
+            modify = _wear_modifier(parts, x)
 
             typical = float(np.mean(parts.clearance)) * 0.05 / max(float(np.max(x)), 1e-300)
             unit = 'm/s' if name == 'time' else 'm/rev'
             out.append(Candidate(
                 self.name, name, unit, self.source, exposure, modify, typical, (0.0, np.inf),
-                make=lambda k, r=name, s=start: Effect(self.name, k, r, reference=s)))
+                make=maker(self.name, name, start)))
         return out, skipped
 
     def from_plant(self, values: Mapping[str, Any]) -> Effect | None:
@@ -74,6 +71,16 @@ class ClearanceWear(EffectKind):
         x = data.channels[regressor or self.regressors[0]]
         return Effect(name, magnitude / max(float(np.ptp(x)), 1e-300),
                       regressor or self.regressors[0], reference=float(np.min(x)))
+
+
+def _wear_modifier(parts: Parts, x: FloatArray) -> Callable[[float], Modifier]:
+    """Return rate -> the factors on Q_Lfg and Q_C of clearances grown by rate * x."""
+    def modify(rate: float) -> Modifier:
+        grow = rate * x
+        return Modifier(flat_clearance=(1.0 + grow / parts.clearance) ** parts.h_exponent,
+                        commutation=(1.0 + grow / parts.clearance_satellites)
+                        ** parts.hs_exponent)
+    return modify
 
 
 KIND = ClearanceWear()

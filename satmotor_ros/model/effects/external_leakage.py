@@ -17,7 +17,7 @@ from typing import Any, TYPE_CHECKING
 import numpy as np
 
 from satmotor_ros.model.effects._base import (additive, Candidate, CandidateData, Conditions,
-                                              Effect, EffectKind, PlantInjection,
+                                              Effect, EffectKind, maker, PlantInjection,
                                               PlantParameter, varies, why_not)
 from satmotor_ros.model.errors import ConfigError
 
@@ -58,11 +58,11 @@ class ExternalLeakage(EffectKind):
         out, skipped = [], []
         for name in self.regressors:
             p = data.channels.get(name)
-            if varies(p):
-                out.append(additive(self.name, name, self.unit, self.source, p, (0.0, np.inf),
-                                    make=lambda k, r=name: Effect(self.name, k, r)))
-            else:
+            if p is None or not varies(p):
                 skipped.append(f'{self.name}({name}): {why_not(p)}')
+                continue
+            out.append(additive(self.name, name, self.unit, self.source, p, (0.0, np.inf),
+                                make=maker(self.name, name)))
         return out, skipped
 
     def inject(self, effect: Effect, into: PlantInjection) -> PlantInjection:

@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 
 from satmotor_ros.model.effects._base import (additive, Candidate, CandidateData, Effect,
-                                              EffectKind)
+                                              EffectKind, maker)
 from satmotor_ros.model.errors import ConfigError
 
 TERMS: Mapping[str, tuple[Callable[[Any, Any], Any], str]] = {
@@ -51,7 +51,10 @@ class Term(EffectKind):
     def loss(self, effect: Effect) -> Callable[[Any, Any], Any] | None:
         """Return k f(n, dp_i)."""
         f, k = TERMS[effect.suffix][0], effect.coefficient
-        return lambda n, dp_i: k * f(n, dp_i)
+
+        def loss(n: Any, dp_i: Any) -> Any:
+            return k * f(n, dp_i)
+        return loss
 
     def candidates(self, data: CandidateData) -> tuple[list[Candidate], list[str]]:
         """Offer every expression of :data:`TERMS`."""
@@ -60,7 +63,7 @@ class Term(EffectKind):
             x = np.asarray(f(data.parts.speed, data.parts.dp_i), dtype=float)
             name = f'{self.name}:{expression}'
             out.append(additive(name, expression, unit, self.source, x,
-                                make=lambda k, n=name, e=expression: Effect(n, k, e)))
+                                make=maker(name, expression)))
         return out, []
 
 

@@ -57,8 +57,8 @@ class ViscosityTemperature(EffectKind):
         if law not in LAWS:
             msg = f"{where}.law = {doc.get('law')!r}: use {' or '.join(map(repr, LAWS))}"
             raise ConfigError(msg)
-        values = {k: finite(doc[k], f'{where}.{k}') for k in self.keys
-                  if k in doc and k not in ('regressor', 'law')}
+        values: dict[str, Any] = {k: finite(doc[k], f'{where}.{k}') for k in self.keys
+                                  if k in doc and k not in ('regressor', 'law')}
         return Effect(name, regressor=self.regressor('', doc.get('regressor'), where), law=law,
                       **values)
 
@@ -76,10 +76,9 @@ class ViscosityTemperature(EffectKind):
     def candidates(self, data: CandidateData) -> tuple[list[Candidate], list[str]]:
         """Offer the slope of the liquid's law, pinned at the set's viscosity."""
         temperature, law, parts = data.channels.get('temperature'), data.law, data.parts
-        ok = (temperature is not None and np.all(np.isfinite(temperature))
-              and np.ptp(temperature) >= MIN_SPAN
-              and np.ptp(temperature) > 1e-3 * np.max(np.abs(temperature)))
-        if not ok:
+        if (temperature is None or not np.all(np.isfinite(temperature))
+                or np.ptp(temperature) < MIN_SPAN
+                or not np.ptp(temperature) > 1e-3 * np.max(np.abs(temperature))):
             why = ('not measured' if temperature is None else 'has missing values'
                    if not np.all(np.isfinite(temperature)) else 'does not vary enough')
             return [], [f'{self.name}: {why}']
