@@ -319,22 +319,7 @@ def sensor_error(effects: Iterable[Effect], channel: str) -> tuple[float, float]
 
 
 def flow_reading(effects: tuple[Effect, ...], flow: Any) -> Any:
-    """
-    Return what the flowmeter reads at a flow through the motor.
-
-    Parameters
-    ----------
-    effects : tuple of Effect
-        The coefficient set's effects, [-]
-    flow : float or ndarray
-        Flow through the motor, [m^3/s]
-
-    Returns
-    -------
-    float or ndarray
-        ``(1 + k) Q`` (gain), ``Q + k`` (offset), else `flow`, [m^3/s]
-
-    """
+    """Return what the flowmeter reads [m^3/s] at a flow through the motor (see true_flow)."""
     gain, offset = sensor_error(effects, 'flow')
     return flow if (gain, offset) == (1.0, 0.0) else gain * flow + offset
 
@@ -361,22 +346,7 @@ def true_flow(effects: tuple[Effect, ...], reading: Any) -> Any:
 
 
 def true_speed(effects: tuple[Effect, ...], reading: Any) -> Any:
-    """
-    Return the true shaft speed from a speed-sensor reading.
-
-    Parameters
-    ----------
-    effects : tuple of Effect
-        The coefficient set's effects, [-]
-    reading : float or ndarray
-        What the speed sensor reads, [rad/s]
-
-    Returns
-    -------
-    float or ndarray
-        ``(reading - offset) / gain``, the reading itself without a speed error, [rad/s]
-
-    """
+    """Return the shaft speed [rad/s] from a speed-sensor reading, as :func:`true_flow`."""
     gain, offset = sensor_error(effects, 'speed')
     return reading if (gain, offset) == (1.0, 0.0) else (reading - offset) / gain
 
