@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 from satmotor_ros.model import (COMPONENTS, ConfigError, INVALID, InvalidInputError, load_motor,
                                 ModelError, MotorModel, PointStatus)
-from satmotor_ros.model.conditioned import _bracketed_root
 from satmotor_ros.model.config import default_config_path, motor_from_mapping
 from satmotor_ros.model.effects import flow_reading
+from satmotor_ros.model.solve import solve_increasing_scalar, Tolerance, with_secant_slope
 from satmotor_ros.model.units import LPM, MPA, RPM
 from satmotor_ros.model.viscosity import vogel_viscosity, walther_slope, walther_viscosity
 import yaml
@@ -264,9 +264,13 @@ def test_root_search_stops_on_nan_and_converges_fast():
         calls.append(x)
         return x ** 3 - 2.0
 
-    root, done = _bracketed_root(cubic, 0.0, -2.0, 4.0, 62.0)
-    assert done and root == pytest.approx(2.0 ** (1 / 3), rel=1e-15) and len(calls) < 40
-    assert _bracketed_root(lambda x: math.nan, 0.0, -1.0, 1.0, 1.0)[1] is False
+    # the effects' residuals have no derivative: the solver steps along the secant
+    root, status = solve_increasing_scalar(with_secant_slope(cubic, 4.0, 62.0), 0.0, 4.0, 2.0,
+                                           Tolerance(0.0, 1e-15))
+    assert status == 0 and root == pytest.approx(2.0 ** (1 / 3), rel=1e-15) and len(calls) < 40
+    _, status = solve_increasing_scalar(with_secant_slope(lambda x: math.nan, 1.0, 1.0), 0.0,
+                                        1.0, 0.5, Tolerance(0.0, 1e-15))
+    assert status == PointStatus.NO_ROOT
 
 
 def test_water_follows_the_vogel_law():

@@ -32,8 +32,7 @@ def _kwargs(port, dp):
 
 
 def _channel(model, flow):
-    return channel_pressure_drop(flow, model.liquid.kinematic_viscosity, model.liquid.density,
-                                 model.coef)
+    return channel_pressure_drop(flow, model.derived.ch_a, model.derived.ch_b)
 
 
 def _assert_eq36(model, ops, valid):
@@ -114,7 +113,9 @@ def test_a_solve_that_runs_out_of_iterations_is_flagged_not_converged(monkeypatc
     real = solve.solve_increasing
     for module in (forward, inverse):
         monkeypatch.setattr(module, 'solve_increasing',
-                            lambda *a, **k: real(*a, **{**k, 'maxiter': 1}))
+                            lambda f, lo, hi, x0, tol, *a, **k: real(f, lo, hi, x0,
+                                                                     tol._replace(maxiter=1),
+                                                                     *a, **k))
     model = MODELS['water', 'eq39']
     ops = model.speed(np.array([5.0, 20.0]) * LPM, 10 * MPA, errors='mask')
     assert (ops.status == PointStatus.NOT_CONVERGED).all()

@@ -27,7 +27,8 @@ def test_channel_drop_has_a_positive_laminar_term_as_eq35(liquid):
     flow = np.array([1.0, 5.0, 20.0, 40.0])  # [l/min]
     mu_mpas = fluid.density * fluid.kinematic_viscosity * 1e3
     expected = coef.c_t * fluid.density * flow ** 2 + coef.c_l * mu_mpas * flow  # [Pa]
-    got = eq.channel_pressure_drop(flow * LPM, fluid.kinematic_viscosity, fluid.density, coef)
+    got = eq.channel_pressure_drop(flow * LPM,
+                                   *eq.channel_coefficients(fluid, coef))
     np.testing.assert_allclose(got, expected, rtol=1e-12)
     laminar = got - coef.c_t * fluid.density * flow ** 2
     np.testing.assert_allclose(laminar, coef.c_l * mu_mpas * flow, rtol=1e-9)
@@ -56,8 +57,8 @@ def test_the_chamber_drop_limit_is_where_flat_clearance_leakage_peaks():
     assert model.dp_limit / MPA == pytest.approx(50.6, abs=0.05)
     liquid = model.liquid
     dp = model.dp_limit * np.array([0.999, 1.0, 1.001])
-    h = eq.clearance_height(dp, g, coef)
-    q = eq.flat_clearance_leakage(dp, h, liquid.kinematic_viscosity, liquid.density, g, coef)
+    h = eq.clearance_height(dp, *eq.clearance_coefficients(g, coef))
+    q = eq.flat_clearance_leakage(dp, h, *eq.flat_clearance_coefficients(liquid, g, coef))
     assert q[1] > q[0] and q[1] > q[2]  # the maximum of eq. (1) with eq. (2)
     ok = model.speed(20 * LPM, dp_i=model.dp_limit * np.array([0.999, 1.001]), errors='mask')
     assert ok.status.tolist() == [PointStatus.EXTRAPOLATED, PointStatus.BEYOND_LIMIT]
@@ -75,23 +76,23 @@ def _central(f, x, step):
 @pytest.mark.parametrize('law', ['eq33', 'eq39'])
 def test_analytic_slopes_match_finite_differences(liquid, law):
     model = _model(liquid, law)
-    eqs = Equations(model.geometry, model.coef, model.liquid, model.derived, model.law)
+    eqs = Equations(model.derived, model.law)
     speed = np.array([30.0, 150.0, 900.0, 1500.0]) * RPM
     dp_i = np.array([0.5, 3.0, 12.0, 24.0]) * MPA
     loss = model.law.loss(speed, dp_i)
-    d_speed, d_dp = model.law.slopes(speed, dp_i, loss)
+    at_dp, d_speed = model.law.at_pressure(dp_i)[1](speed)
+    at_n, d_dp = model.law.at_speed(speed)(dp_i)
+    np.testing.assert_allclose(at_dp, loss, rtol=1e-14)
+    np.testing.assert_allclose(at_n, loss, rtol=1e-14)
     np.testing.assert_allclose(d_speed, _central(lambda n: model.law.loss(n, dp_i), speed,
                                                  1e-4 * speed), rtol=1e-6)
     np.testing.assert_allclose(d_dp, _central(lambda p: model.law.loss(speed, p), dp_i,
                                               1e-5 * dp_i), rtol=1e-6, atol=1e-22)
-    q_lfg, q_c, _ = eqs.leakage(dp_i, 0.0)
-    slope = eqs.leakage_slope(dp_i, q_lfg, q_c)
-
-    def leak(p):
-        a, b, _ = eqs.leakage(p, 0.0)
-        return a + b
-
-    np.testing.assert_allclose(slope, _central(leak, dp_i, 1e-5 * dp_i), rtol=1e-6)
+    for dp in dp_i + 1.0 * MPA:  # the coupled residual's slope, through eqs. (1), (2), (5), (35)
+        residual = eqs.flow_problem(float(speed[1]), float(dp), 0.0)[2]
+        q = float(model.absorbency_point(float(speed[1]), float(dp)).flow)
+        slope = residual(q)[1]
+        assert slope == pytest.approx(_central(lambda x: residual(x)[0], q, 1e-6 * q), rel=1e-6)
 
 
 @pytest.mark.parametrize('law', ['eq33', 'eq39'])
@@ -224,10 +225,10 @@ def test_equation_functions_return_floats_for_integer_input(fn):
     from satmotor_ros.model import speed as sp
     model = _model('oil', external_leakage=1e-12)
     calls = {
-        'external_leakage': lambda: eq.external_leakage(np.array([3]), model.coef),
-        'chamber_pressure_drop': lambda: eq.chamber_pressure_drop(np.array([7]), np.array([2])),
-        'speed_loss': lambda: sp.speed_loss(np.array([1]), np.array([2]), model.geometry),
-        'absorbency': lambda: sp.absorbency(np.array([2]), np.array([1]), model.geometry),
+        'external_leakage': lambda: eq.external_leakage(np.array([3]), model.derived.k_ex),
+        'chamber_pressure_drop': lambda: eq.chamber_pressure_drop(np.array([7]), np.array([2.0])),
+        'speed_loss': lambda: sp.speed_loss(np.array([1]), np.array([2]), model.derived.qt),
+        'absorbency': lambda: sp.absorbency(np.array([2]), np.array([1]), model.derived.qt),
     }
     assert calls[fn]().dtype == np.float64
 

@@ -54,26 +54,25 @@ def test_paper_water_oil_loss_ratio_peaks_as_published(flow_lpm, peak):
 def test_paper_channel_drop_for_oil_is_0_03_0_44_1_76_mpa():
     from satmotor_ros.model.losses import channel_pressure_drop
     oil = MotorModel.default('oil')
-    dp = channel_pressure_drop(np.array([5, 20, 40]) * LPM, oil.liquid.kinematic_viscosity,
-                               oil.liquid.density, oil.coef)
+    dp = channel_pressure_drop(np.array([5, 20, 40]) * LPM, oil.derived.ch_a, oil.derived.ch_b)
     np.testing.assert_allclose(dp / MPA, [0.03, 0.44, 1.76], atol=0.005)
     water = MotorModel.default('water')
-    dp_w = channel_pressure_drop(40 * LPM, water.liquid.kinematic_viscosity,
-                                 water.liquid.density, water.coef)
+    dp_w = channel_pressure_drop(40 * LPM, water.derived.ch_a, water.derived.ch_b)
     assert float(dp_w / dp[2]) == pytest.approx(0.95, abs=0.01)
 
 
 def test_paper_clearance_is_5_865_um_unloaded_and_5_140_um_at_25_mpa():
     from satmotor_ros.model.losses import clearance_height
     oil = MotorModel.default('oil')
-    h = clearance_height(np.array([0.0, 25 * MPA]), oil.geometry, oil.coef)
+    h = clearance_height(np.array([0.0, 25 * MPA]), oil.derived.h0, oil.derived.compliance)
     np.testing.assert_allclose(h * 1e6, [5.865, 5.140], atol=5e-4)
 
 
 def test_paper_eq39_is_nearly_independent_of_pressure():
     from satmotor_ros.model.losses import displacement_change_empirical
     oil = MotorModel.default('oil')
-    dq = displacement_change_empirical(np.array([2, 25]) * MPA, 1000 * RPM, oil.coef)
+    dq = displacement_change_empirical(np.array([2, 25]) * MPA, 1000 * RPM, oil.coef.c1_39,
+                                       oil.coef.c2_39)
     assert abs(dq[1] / dq[0] - 1) < 0.02  # eq. (33) changes by ~70 % over the same range
 
 
@@ -119,17 +118,21 @@ def test_model_matches_reference_speed_ratio_water_over_oil():
 
 def test_clearance_and_displacement_change_match_the_reference_grid(liquid):
     from satmotor_ros.model.losses import (clearance_height, displacement_change,
-                                           displacement_change_empirical)
+                                           displacement_change_empirical, EMPIRICAL_DP_FLOOR,
+                                           inertia_coefficient, pressure_speed_coefficient)
     model = MotorModel.default(liquid)
     rows = [r for r in _grid(liquid) if r['case'] == 'n_const']
     n = np.array([float(r['n_rpm']) for r in rows]) * RPM
     dp_i = np.array([float(r['dp_i_MPa']) for r in rows]) * MPA
     cm3_per_rev = 1e-6 / (2 * np.pi)
     columns = {
-        'h_um': clearance_height(dp_i, model.geometry, model.coef) * 1e6,
-        'dq33_cm3_rev': displacement_change(dp_i, n, model.coef.c, model.coef.c_id,
-                                            model.geometry) / cm3_per_rev,
-        'dq39_cm3_rev': displacement_change_empirical(dp_i, n, model.coef) / cm3_per_rev,
+        'h_um': clearance_height(dp_i, model.derived.h0, model.derived.compliance) * 1e6,
+        'dq33_cm3_rev': displacement_change(
+            dp_i, n, pressure_speed_coefficient(model.coef.c, model.geometry),
+            inertia_coefficient(model.coef.c_id, model.geometry)) / cm3_per_rev,
+        'dq39_cm3_rev': displacement_change_empirical(
+            np.maximum(dp_i, EMPIRICAL_DP_FLOOR), n, model.coef.c1_39,
+            model.coef.c2_39) / cm3_per_rev,
     }
     for name, value in columns.items():
         expected = np.array([float(r[name]) for r in rows])

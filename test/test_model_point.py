@@ -8,7 +8,7 @@ import pytest
 
 from satmotor_ros.model import (COMPONENTS, InvalidInputError, ModelError, MotorModel, Point,
                                 PointStatus)
-from satmotor_ros.model import losses as eq
+from satmotor_ros.model import losses as eq, speed as sp
 from satmotor_ros.model.units import LPM, MPA, RPM
 
 MODELS = {(liquid, law): MotorModel.default(liquid, law)
@@ -91,36 +91,59 @@ def test_breakdown_point_equals_the_array_breakdown(key):
                                    rtol=RTOL, atol=0.0, err_msg=name)
 
 
+D = MODELS['water', 'eq39'].derived
+KERNELS = {  # every equation function with the model's constants, by its variables
+    'clearance_height': (lambda p, n: eq.clearance_height(p, D.h0, D.compliance)),
+    'flat_clearance_leakage': (lambda p, n: eq.flat_clearance_leakage(
+        p, eq.clearance_height(p, D.h0, D.compliance), D.lfg_k, D.lfg_e)),
+    'commutation_leakage': (lambda p, n: eq.commutation_leakage(p, D.com_k, D.com_e)),
+    'pressure_speed_loss': (lambda p, n: eq.pressure_speed_loss(p, n, D.k_dch)),
+    'inertia_loss': (lambda p, n: eq.inertia_loss(n, D.k_i)),
+    'displacement_change': (lambda p, n: eq.displacement_change(p, n, D.k_p, D.k_i)),
+    'displacement_loss': (lambda p, n: eq.displacement_loss(p, n, D.k_p, D.k_i)),
+    'displacement_change_empirical': (lambda p, n: eq.displacement_change_empirical(
+        p + eq.EMPIRICAL_DP_FLOOR, n, D.c1_39, D.c2_39)),
+    'empirical_speed_floor': (lambda p, n: eq.empirical_speed_floor(p, D.c2_39)),
+    'external_leakage': (lambda p, n: eq.external_leakage(p, 1e-12)),
+    'channel_pressure_drop': (lambda p, n: eq.channel_pressure_drop(n * 1e-6, D.ch_a, D.ch_b)),
+    'chamber_pressure_drop': (lambda p, n: eq.chamber_pressure_drop(p, n * 1e3)),
+    'absorbency': (lambda p, n: sp.absorbency(n, p * 1e-12, D.qt)),
+    'effective_speed': (lambda p, n: sp.effective_speed(n * 1e-6, p, 1e-6, D.es_a0, D.es_a1,
+                                                        D.es_scale, D.es_b)),
+    'speed_loss': (lambda p, n: sp.speed_loss(n * 1e-6, n, D.qt)),
+}
+KERNEL_DROPS = [0.0, 0.3 * MPA, 2 * MPA, 25 * MPA]
+KERNEL_SPEEDS = [1e-3, 40 * RPM, 150 * RPM, 1000 * RPM]
+
+
+@pytest.mark.parametrize('name', KERNELS)
+def test_each_equation_is_one_function_for_floats_and_arrays(name):
+    kernel = KERNELS[name]
+    p, n = (a.ravel() for a in np.meshgrid(KERNEL_DROPS, KERNEL_SPEEDS))
+    on_arrays = kernel(p, n)
+    assert isinstance(on_arrays, np.ndarray) and on_arrays.shape == p.shape
+    for i, (pp, nn) in enumerate(zip(p.tolist(), n.tolist())):
+        on_floats = kernel(pp, nn)
+        assert type(on_floats) is float, f'{name} returned {type(on_floats).__name__}'
+        assert on_floats == pytest.approx(float(on_arrays[i]), rel=1e-15, abs=0.0), name
+
+
 @pytest.mark.parametrize('key', MODELS)
-def test_point_components_equal_the_equation_functions(key):
+def test_point_components_are_the_equation_functions(key):
     model = MODELS[key]
-    g, coef, liq = model.geometry, model.coef, model.liquid
+    d = model.derived
     for n, dp_i in [(150 * RPM, 2 * MPA), (1000 * RPM, 25 * MPA), (40 * RPM, 0.3 * MPA)]:
         p = model.breakdown_point(n, dp_i)
-        h = eq.clearance_height(dp_i, g, coef)
-        expected = {
-            'flat_clearance': eq.flat_clearance_leakage(dp_i, h, liq.kinematic_viscosity,
-                                                        liq.density, g, coef),
-            'commutation': eq.commutation_leakage(dp_i, liq.kinematic_viscosity, liq.density,
-                                                  g, coef),
-        }
-        if key[1] == 'eq33':
-            expected.update(
-                compressibility=eq.compressibility_loss(dp_i, n, model.c_fc_beta, g),
-                deformation=eq.deformation_loss(dp_i, n, model.c_dch, g),
-                backlash=eq.backlash_loss(dp_i, n, model.c_b, g),
-                inertia=eq.inertia_loss(n, coef.c_id, g))
-            displacement = eq.displacement_loss(dp_i, n, model.c, coef.c_id, g)
-        else:
-            displacement = eq.displacement_loss_empirical(dp_i, n, coef)
-        for name, value in expected.items():
-            assert getattr(p, name) == pytest.approx(float(value), rel=RTOL), name
+        assert p.flat_clearance == eq.flat_clearance_leakage(
+            dp_i, eq.clearance_height(dp_i, d.h0, d.compliance), d.lfg_k, d.lfg_e)
+        assert p.commutation == eq.commutation_leakage(dp_i, d.com_k, d.com_e)
         parts = p.compressibility + p.deformation + p.backlash + p.inertia
-        assert parts == pytest.approx(float(displacement), rel=RTOL)
-        assert p.flow == pytest.approx(float(model.geometry.displacement * n + p.total), rel=RTOL)
-        dp = p.dp_i + float(eq.channel_pressure_drop(p.flow, liq.kinematic_viscosity,
-                                                     liq.density, coef))
-        assert p.dp == pytest.approx(dp, rel=RTOL)
+        assert parts == pytest.approx(model.law.loss(n, dp_i), rel=RTOL)
+        if key[1] == 'eq33':
+            assert p.compressibility == eq.pressure_speed_loss(dp_i, n, d.k_fc)
+            assert p.inertia == eq.inertia_loss(n, d.k_i)
+        assert p.flow == sp.absorbency(n, p.total, d.qt)
+        assert p.dp == p.dp_i + eq.channel_pressure_drop(p.flow, d.ch_a, d.ch_b)
 
 
 def test_point_is_python_floats_and_an_int_status():

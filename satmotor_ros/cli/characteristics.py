@@ -13,7 +13,8 @@ import numpy as np
 from satmotor_ros.cli._common import add_motor_options, CliError, fail, subcommand
 from satmotor_ros.interface import MotorOptions
 from satmotor_ros.model import load_motor, ModelError, MotorModel
-from satmotor_ros.model.losses import displacement_change, displacement_change_empirical
+from satmotor_ros.model.losses import (displacement_change, displacement_change_empirical,
+                                       EMPIRICAL_DP_FLOOR)
 from satmotor_ros.model.units import LPM, MPA, RPM
 
 FLOWS_LPM = (5.0, 10.0, 20.0, 40.0)
@@ -129,8 +130,10 @@ def displacement(model: MotorModel, dp_i: np.ndarray) -> Figure:
     """Compute dq of eqs. (33) and (39) over `dp_i` [Pa] at each of SPEEDS_RPM (Figs. 11-12)."""
     n = np.array(SPEEDS_RPM)[:, None] * RPM
     to_cm3 = 2.0 * np.pi * 1.0e6
-    dq33 = displacement_change(dp_i[None, :], n, model.c, model.coef.c_id, model.geometry)
-    dq39 = displacement_change_empirical(dp_i[None, :], n, model.coef)
+    d = model.derived
+    dq33 = displacement_change(dp_i[None, :], n, d.k_p, d.k_i)
+    dq39 = displacement_change_empirical(np.maximum(dp_i[None, :], EMPIRICAL_DP_FLOOR), n,
+                                         d.c1_39, d.c2_39)
     return Figure('displacement_change', 'Change of displacement (Figs. 11-12 kind)',
                   'dq [cm^3/rev]', 'n [rpm]', SPEEDS_RPM,
                   {'dq eq.33 [cm^3/rev]': dq33 * to_cm3, 'dq eq.39 [cm^3/rev]': dq39 * to_cm3},

@@ -117,10 +117,10 @@ def loss_parts(model: MotorModel, table: BenchTable) -> tuple[LossParts, np.ndar
         If no point is usable.
 
     """
-    liquid, coef = model.liquid, model.coef
+    coef = model.coef
     flow, speed, dp = table.flow, table.speed, table.dp
-    dp_i = dp - channel_pressure_drop(np.maximum(flow, 0.0), liquid.kinematic_viscosity,
-                                      liquid.density, coef)
+    d = model.derived
+    dp_i = dp - channel_pressure_drop(np.maximum(flow, 0.0), d.ch_a, d.ch_b)
     usable = (np.isfinite(flow) & np.isfinite(speed) & np.isfinite(dp) & (flow > 0.0)
               & (speed >= 0.0) & (dp_i >= 0.0) & (dp_i < model.dp_limit))
     if not usable.any():
@@ -135,7 +135,7 @@ def loss_parts(model: MotorModel, table: BenchTable) -> tuple[LossParts, np.ndar
         displacement=model.geometry.displacement * n,
         flat_clearance=losses.flat_clearance, commutation=losses.commutation,
         pressure_speed=losses.compressibility + losses.deformation + losses.backlash,
-        inertia=losses.inertia, clearance=clearance_height(dpi, model.geometry, coef),
+        inertia=losses.inertia, clearance=clearance_height(dpi, d.h0, d.compliance),
         clearance_satellites=model.geometry.clearance_satellites,
         h_exponent=3.0 / (2.0 - beta), hs_exponent=coef.c2,
         nu_exponent_lfg=-beta / (2.0 - beta), nu_exponent_c=-coef.gamma)

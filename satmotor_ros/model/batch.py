@@ -9,8 +9,10 @@ import numpy as np
 
 from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.coefficients import MotorGeometry
-from satmotor_ros.model.results import COMPONENTS, INVALID, LossBreakdown, OperatingPoints
-from satmotor_ros.model.screening import Status
+from satmotor_ros.model.composition import Equations
+from satmotor_ros.model.results import (COMPONENTS, INVALID, LossBreakdown, OperatingPoints,
+                                        PointStatus)
+from satmotor_ros.model.screening import Errors, prepare, Status
 
 CHUNK = 8192
 """
@@ -38,6 +40,76 @@ def _join(parts: list[Chunk], shape: tuple[int, ...]) -> dict[str, np.ndarray]:
         joined[key] = (np.concatenate(values) if len(values) > 1
                        else np.asarray(values[0])).reshape(shape)
     return joined
+
+
+def map_inputs(first: tuple[str, object, str], dp_name: str, dp_value: object, p_ex: object,
+               errors: Errors) -> tuple[tuple[FloatArray, ...], Status, bool,
+                                        dict[str, FloatArray]]:
+    """
+    Screen and broadcast a map's inputs: the given flow or speed, a pressure drop and p_ex.
+
+    Parameters
+    ----------
+    first : tuple of (str, array_like, str)
+        Name, value and SI unit of the flow or speed, [-]
+    dp_name : {'dp', 'dp_i'}
+        Which pressure drop is given, [-]
+    dp_value : float or array_like
+        The pressure drop, [Pa]
+    p_ex : float or array_like
+        Pressure driving the external leakage, [Pa]
+    errors : {'raise', 'mask'}
+        What to do with a bad element, [-]
+
+    Returns
+    -------
+    arrays : tuple of ndarray
+        The three inputs, broadcast.
+    status : ndarray of uint8
+        Their screening flags.
+    port : bool
+        Whether the drop is between the ports.
+    given : dict
+        The inputs that come back as fields of the result, by field name.
+
+    """
+    name, value, unit = first
+    arrays, status = prepare({name: (value, unit), dp_name: (dp_value, 'Pa'),
+                              'p_ex': (p_ex, 'Pa')}, errors)
+    port = dp_name == 'dp'
+    given = {name: arrays[0], 'dp': arrays[1]} if port else {name: arrays[0]}
+    return arrays, status, port, given
+
+
+def components(eqs: Equations, speed: FloatArray, dp_i: FloatArray, q_lfg: FloatArray,
+               q_c: FloatArray, q_ex: FloatArray | float,
+               leak: FloatArray) -> tuple[Chunk, FloatArray]:
+    """Return the components of eq. (31) by name, and Q_vl; `leak` is Q_Lfg + Q_C + Q_ex."""
+    fc, dch, bl, ine, total = eqs.breakdown(speed, dp_i, leak)
+    return dict(zip(COMPONENTS, (q_lfg, q_c, fc, dch, bl, ine, q_ex, total))), total
+
+
+def clip_chamber_drop(dp_i: FloatArray, status: Status) -> FloatArray:
+    """
+    Clip the chamber drop of eq. (34) to 0, flagged CHANNEL_LIMITED where it was below.
+
+    Parameters
+    ----------
+    dp_i : ndarray
+        Chamber pressure drop, [Pa]
+    status : ndarray of uint8
+        Flags, updated in place, [-]
+
+    Returns
+    -------
+    ndarray
+        dp_i >= 0, [Pa]
+
+    """
+    if dp_i.size == 0 or dp_i.min() >= 0.0:
+        return dp_i
+    status |= (dp_i < 0.0) * np.uint8(PointStatus.CHANNEL_LIMITED)
+    return np.maximum(dp_i, 0.0)
 
 
 def mask_invalid(chunk: Chunk, status: Status) -> Chunk:

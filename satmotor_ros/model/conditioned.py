@@ -16,23 +16,21 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from dataclasses import replace
 import math
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from satmotor_ros.model.coefficients import MotorGeometry
+from satmotor_ros.model.core import ModelCore
 from satmotor_ros.model.effects import Conditions, Effect, kind_of
 from satmotor_ros.model.errors import ConfigError, InvalidInputError, ModelError
 from satmotor_ros.model.results import (COMPONENTS, describe_status, INVALID, LossBreakdown,
                                         OperatingPoints, Point, PointStatus)
 from satmotor_ros.model.screening import CHECK, FLOW_ATOL
-
-if TYPE_CHECKING:
-    from satmotor_ros.model.motor import MotorModel
+from satmotor_ros.model.solve import solve_increasing_scalar, Tolerance, with_secant_slope
 
 Channels = Mapping[str, float]
 _CACHE = 4096  # variants kept before the cache is cleared
-_ITERATIONS = 200
+_TOLERANCE = Tolerance(0.0, 4e-16, maxiter=200)  # the effects' solves, to the last bits
 _EXPANSIONS = 60
 _INVALID_FLAGS = int(INVALID)
 _STALLED = int(PointStatus.STALLED)
@@ -44,30 +42,15 @@ def _invalid(status: int) -> Point:
     return Point(*(math.nan,) * 12, status)
 
 
-def _bracketed_root(f: Callable[[float], float], lo: float, f_lo: float, hi: float,
-                    f_hi: float) -> tuple[float, bool]:
-    """Find a root of f in [lo, hi] with f(lo) < 0 < f(hi) (Illinois false position)."""
-    side = 0
-    for _ in range(_ITERATIONS):
-        x = hi - f_hi * (hi - lo) / (f_hi - f_lo)
-        if not lo < x < hi:
-            x = 0.5 * (lo + hi)
-        fx = f(x)
-        if fx != fx:
-            return x, False
-        if fx == 0.0 or hi - lo <= 4e-16 * abs(x):
-            return x, True
-        if fx < 0.0:
-            lo, f_lo = x, fx
-            if side == -1:
-                f_hi *= 0.5
-            side = -1
-        else:
-            hi, f_hi = x, fx
-            if side == 1:
-                f_lo *= 0.5
-            side = 1
-    return x, False
+def _solve(excess: Callable[[float], float], lo: float, f_lo: float, hi: float,
+           f_hi: float, check: float) -> tuple[float, bool]:
+    """Find the root of an increasing `excess` in [lo, hi] (secant, bracketed), and check it."""
+    start = hi - f_hi * (hi - lo) / (f_hi - f_lo)  # false position from the bracket's ends
+    if not lo < start < hi:
+        start = 0.5 * (lo + hi)
+    x, failed = solve_increasing_scalar(with_secant_slope(excess, hi, f_hi), lo, hi, start,
+                                        _TOLERANCE, check)
+    return x, not failed and abs(excess(x)) <= check
 
 
 class ConditionedModel:
@@ -76,23 +59,20 @@ class ConditionedModel:
 
     Parameters
     ----------
-    model : MotorModel
-        A model whose coefficient set has effects, [-]
+    core : ModelCore
+        The motor without its effects, whose coefficient set has effects, [-]
 
     """
 
-    def __init__(self, model: MotorModel) -> None:
-        """Sort the effects by what they do and build the motor without them."""
-        motor = [(kind_of(e), e) for e in model.coefficient_set.effects]
+    def __init__(self, core: ModelCore) -> None:
+        """Sort the effects by what they do and keep the motor without them."""
+        motor = [(kind_of(e), e) for e in core.coefficient_set.effects]
         motor = [(kind, e) for kind, e in motor if not kind.sensor]
         self.channels = tuple(sorted({e.channel for _, e in motor if e.channel}))
         self._conditioning = tuple((kind, e) for kind, e in motor if e.channel)
         self._terms = tuple(f for f in (kind.loss(e) for kind, e in motor) if f is not None)
-        self._model = model
-        self._bare = type(model)(model.geometry, replace(model.coefficient_set, effects=()),
-                                 model.valid_range, model.liquid, model.displacement_law,
-                                 model.name)
-        self._variants: dict[tuple[float, float], MotorModel] = {}
+        self._bare = core
+        self._variants: dict[tuple[float, float], ModelCore] = {}
 
     # -- conditions ------------------------------------------------------------------------
 
@@ -105,7 +85,7 @@ class ConditionedModel:
             raise ModelError(msg)
         return float(channels[name])
 
-    def _variant(self, viscosity: float, growth: float) -> MotorModel:
+    def _variant(self, viscosity: float, growth: float) -> ModelCore:
         bare = self._bare
         if growth == 0.0 and viscosity == bare.liquid.kinematic_viscosity:
             return bare
@@ -121,13 +101,12 @@ class ConditionedModel:
                 liquid = replace(liquid, kinematic_viscosity=viscosity)
             if len(self._variants) >= _CACHE:
                 self._variants.clear()
-            model = type(bare)(g, bare.coefficient_set, bare.valid_range, liquid,
-                               bare.displacement_law, bare.name)
+            model = ModelCore(g, bare.coefficient_set, bare.valid_range, liquid, bare.law_name)
             self._variants[key] = model
         return model
 
     def conditions(self, channels: Channels | None,
-                   p_ex: float) -> tuple[MotorModel | None, float, float, int]:
+                   p_ex: float) -> tuple[ModelCore | None, float, float, int]:
         """
         Return the motor at the channels' values, p_ex, the constant extra loss and a status.
 
@@ -171,7 +150,7 @@ class ConditionedModel:
             return math.inf  # flagged BEYOND_LIMIT by _with_extra
 
     @staticmethod
-    def _with_extra(model: MotorModel, point: Point, flow: float | None, dp: float | None,
+    def _with_extra(model: ModelCore, point: Point, flow: float | None, dp: float | None,
                     extra: float, status: int) -> Point:
         """
         Return `point` with `extra` in Q_vl, and in Q when `flow` is None.
@@ -186,8 +165,7 @@ class ConditionedModel:
         if not (total >= 0.0 and q >= 0.0 and total < math.inf):
             # a negative or unbounded Q_vl, or flow out of the inlet: past the model
             return _invalid(int(PointStatus.BEYOND_LIMIT))
-        d = model.derived
-        values['dp'] = point.dp_i + (d.ch_a * q + d.ch_b) * q if dp is None else dp
+        values['dp'] = point.dp_i + model.eqs.channel_drop(q) if dp is None else dp
         values['status'] = (point.status & ~_STALLED) | status
         return Point(**values)
 
@@ -220,24 +198,19 @@ class ConditionedModel:
         model, p_ex, constant, status = self.conditions(channels, p_ex)
         if model is None:
             return _invalid(status)
-        if not self._terms and constant == 0.0:
-            return model.speed_point(flow, dp if port else None,
-                                     dp_i=None if port else dp, p_ex=p_ex)
-        first = model.speed_point(flow, dp if port else None, dp_i=None if port else dp,
-                                  p_ex=p_ex)
-        if first.status & _SCREENED:  # bad input or beyond the limit, whatever the effect
-            return first
-        d = model.derived
-        dp_i = dp - (d.ch_a * flow + d.ch_b) * flow if port else dp  # eqs. (34)-(35)
+        evaluator = model.point
+        first = evaluator.speed(flow, dp, port, p_ex)
+        if (not self._terms and constant == 0.0) or first.status & _SCREENED:
+            return first  # no extra loss; or bad input or beyond the limit, whatever the effect
+        dp_i = model.eqs.chamber_drop(dp, flow) if port else dp
         limited = _CHANNEL_LIMITED if dp_i < 0.0 else 0
         dp_i = max(dp_i, 0.0)
-        evaluator = model._point  # noqa: SLF001 -- the same equations, on floats
 
         def excess(n: float) -> float:
             at = evaluator.absorbency(n, dp_i, False, p_ex, None)
             return at.flow + self._extra(n, dp_i, constant) - flow
 
-        lo = evaluator.speed_floor(dp_i) if evaluator.empirical else 0.0
+        lo = model.eqs.law.floor(dp_i)
         f_lo = excess(lo)
         if f_lo != f_lo:
             return _invalid(int(PointStatus.NO_ROOT))
@@ -248,7 +221,7 @@ class ConditionedModel:
                 return _invalid(int(PointStatus.NO_ROOT))
             speed, status = 0.0, _STALLED
         else:
-            hi = max(2.0 * flow / model.geometry.displacement, 2.0 * lo, 1.0)
+            hi = max(2.0 * flow / model.derived.qt, 2.0 * lo, 1.0)
             f_hi = excess(hi)
             for _ in range(_EXPANSIONS):
                 if not f_hi < 0.0:
@@ -257,8 +230,8 @@ class ConditionedModel:
                 f_hi = excess(hi)
             if not f_hi >= 0.0:
                 return _invalid(int(PointStatus.NO_ROOT))
-            speed, done = _bracketed_root(excess, lo, f_lo, hi, f_hi)
-            if not (done and abs(excess(speed)) <= CHECK * abs(flow) + FLOW_ATOL):
+            speed, done = _solve(excess, lo, f_lo, hi, f_hi, CHECK * abs(flow) + FLOW_ATOL)
+            if not done:
                 return _invalid(int(PointStatus.NOT_CONVERGED))
             status = 0
         point = evaluator.absorbency(speed, dp_i, False, p_ex, None)
@@ -294,17 +267,16 @@ class ConditionedModel:
         model, p_ex, constant, status = self.conditions(channels, p_ex)
         if model is None:
             return _invalid(status)
-        first = model.absorbency_point(speed, dp if port else None, dp_i=None if port else dp,
-                                       p_ex=p_ex, flow_guess=flow_guess)
+        evaluator = model.point
+        first = evaluator.absorbency(speed, dp, port, p_ex, flow_guess)
         if (not self._terms and constant == 0.0) or first.status & _INVALID_FLAGS:
             return first
         if not port:
             return self._with_extra(model, first, None, None, self._extra(speed, dp, constant),
                                     first.status & _STALLED)
-        evaluator, d = model._point, model.derived  # noqa: SLF001
 
         def chamber(q: float) -> float:
-            return max(dp - (d.ch_a * q + d.ch_b) * q, 0.0)
+            return max(model.eqs.chamber_drop(dp, q), 0.0)
 
         def excess(q: float) -> float:
             dp_i = chamber(q)
@@ -327,11 +299,11 @@ class ConditionedModel:
                 f_hi = excess(hi)
         if not f_lo < 0.0 < f_hi:
             return _invalid(int(PointStatus.NO_ROOT))
-        flow, done = _bracketed_root(excess, lo, f_lo, hi, f_hi)
-        if not (done and abs(excess(flow)) <= CHECK * abs(flow) + FLOW_ATOL):
+        flow, done = _solve(excess, lo, f_lo, hi, f_hi, CHECK * abs(q0) + FLOW_ATOL)
+        if not done:
             return _invalid(int(PointStatus.NOT_CONVERGED))
         dp_i = chamber(flow)
-        limited = _CHANNEL_LIMITED if dp - (d.ch_a * flow + d.ch_b) * flow < 0.0 else 0
+        limited = _CHANNEL_LIMITED if model.eqs.chamber_drop(dp, flow) < 0.0 else 0
         point = evaluator.absorbency(speed, dp_i, False, p_ex, None)
         point = self._with_extra(model, point, None, dp, self._extra(speed, dp_i, constant),
                                  (point.status & _STALLED) | limited)

@@ -78,7 +78,7 @@ def derive(geometry: MotorGeometry, coefficient_set: CoefficientSet, valid_range
 
     """
     coef = coefficient_set.coefficients
-    nu, rho = liquid.kinematic_viscosity, liquid.density
+    nu = liquid.kinematic_viscosity
     low, high = coefficient_set.fitted_viscosity
     c_fc_ref = eq.compressibility_coefficient(coefficient_set.liquid.bulk_modulus, geometry, coef)
     c_fc_beta = eq.compressibility_coefficient(liquid.bulk_modulus, geometry, coef)
@@ -87,21 +87,21 @@ def derive(geometry: MotorGeometry, coefficient_set: CoefficientSet, valid_range
     c_b = rest - c_dch
     c_lumped = c_fc_beta + rest
     h0, compliance = eq.clearance_coefficients(geometry, coef)
-    lfg_k, lfg_e = eq.flat_clearance_coefficients(nu, rho, geometry, coef)
-    ch_a, ch_b = eq.channel_coefficients(nu, rho, coef)
+    lfg_k, lfg_e = eq.flat_clearance_coefficients(liquid, geometry, coef)
+    ch_a, ch_b = eq.channel_coefficients(liquid, coef)
     es = effective_speed_coefficients(c_lumped, coef.c_id, geometry)
     # Q_Lfg ~ (h^3 dp)^e rises with dp only while h - 3 s dp > 0 with h = h0 - s dp: dp < h0/4s
     dp_limit = h0 / (4.0 * compliance) if compliance > 0.0 else math.inf
     return DerivedCoefficients(
         qt=geometry.displacement, c_fc_beta=c_fc_beta, c_dch=c_dch, c_b=c_b, c_lumped=c_lumped,
-        h0=h0, compliance=compliance, lfg_k=float(lfg_k), lfg_e=lfg_e,
-        com_k=float(eq.commutation_coefficient(nu, rho, geometry, coef)), com_e=coef.gamma,
+        h0=h0, compliance=compliance, lfg_k=lfg_k, lfg_e=lfg_e,
+        com_k=eq.commutation_coefficient(liquid, geometry, coef), com_e=coef.gamma,
         k_fc=eq.pressure_speed_coefficient(c_fc_beta, geometry),
         k_dch=eq.pressure_speed_coefficient(c_dch, geometry),
         k_b=eq.pressure_speed_coefficient(c_b, geometry),
         k_p=eq.pressure_speed_coefficient(c_lumped, geometry),
         k_i=eq.inertia_coefficient(coef.c_id, geometry), k_ex=coef.external_leakage,
-        ch_a=float(ch_a), ch_b=float(ch_b), es_a0=es[0], es_a1=es[1], es_scale=es[2],
+        ch_a=ch_a, ch_b=ch_b, es_a0=es[0], es_a1=es[1], es_scale=es[2],
         es_b=es[3], c1_39=coef.c1_39, c2_39=coef.c2_39, dp_limit=dp_limit,
         dp_max=valid_range.dp_max, speed_max=valid_range.speed_max,
         dp_min=valid_range.dp_min, speed_min=valid_range.speed_min,

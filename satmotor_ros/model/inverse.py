@@ -6,30 +6,21 @@ from __future__ import annotations
 import numpy as np
 
 from satmotor_ros.model._typing import FloatArray
-from satmotor_ros.model.batch import Chunk, mask_invalid, run
+from satmotor_ros.model.batch import (Chunk, clip_chamber_drop, components, map_inputs,
+                                      mask_invalid, run)
+from satmotor_ros.model.coefficients import MotorGeometry
 from satmotor_ros.model.composition import Equations
 from satmotor_ros.model.results import OperatingPoints, PointStatus
-from satmotor_ros.model.screening import (At, check_limit, check_solution, Errors,
-                                          flag_extrapolated, prepare, Status)
+from satmotor_ros.model.screening import (At, CHECK, check_limit, check_solution, Errors,
+                                          flag_extrapolated, FLOW_ATOL, SPEED_SOLVE, Status)
 from satmotor_ros.model.solve import solve_increasing
-from satmotor_ros.model.speed import absorbency, effective_speed
-
-RTOL = 1e-11
-"""
-Relative tolerance of the iterative maps.
-
-A solve ends on a Newton step smaller than this and takes the step, which
-leaves an error of the order of its square; only a bisection ends at it.
-"""
-
-SPEED_ATOL = 1e-40
-"""Absolute resolution of n in the speed solve, [rad/s]; its loss is below 1e-24 m^3/s."""
+from satmotor_ros.model.speed import absorbency
 
 
 def solve_speed(eqs: Equations, flow: FloatArray, dp_i: FloatArray, leak: FloatArray,
-                status: Status) -> tuple[FloatArray, np.ndarray]:
+                status: Status) -> tuple[FloatArray, Status]:
     """
-    Solve eq. (36) for n at given flow and dp_i (Newton, bracketed).
+    Solve eq. (36) for n at given flow and dp_i (the solver of :mod:`.solve`).
 
     Where the law has no speed at or above its floor for a flow the leakage
     alone does not take (eq. 39 near stall), the point is flagged NO_ROOT.
@@ -51,76 +42,44 @@ def solve_speed(eqs: Equations, flow: FloatArray, dp_i: FloatArray, leak: FloatA
     -------
     speed : ndarray
         n; 0 where the shaft does not turn, [rad/s]
-    converged : ndarray of bool
-        What the solver reported.
+    solved : ndarray of uint8
+        The solver's status per point.
 
     """
-    law, geometry = eqs.law, eqs.geometry
-    qt = geometry.displacement
-    hi = np.maximum(flow - leak, 0.0) / qt  # all of it through the displacement
-    lo = law.floor(dp_i)
-    moving = (absorbency(lo, law.loss(lo, dp_i) + leak, geometry) < flow) & (hi > lo)
-    status |= (~moving & (hi > 0.0) & (lo > 0.0)) * np.uint8(PointStatus.NO_ROOT)
-
-    def residual(n: FloatArray) -> tuple[FloatArray, FloatArray]:
-        loss = law.loss(n, dp_i)
-        return absorbency(n, loss + leak, geometry) - flow, qt + law.slopes(n, dp_i, loss)[0]
-
-    lo, hi = np.where(moving, lo, 0.0), np.where(moving, hi, 0.0)
-    n, converged = solve_increasing(residual, lo, hi, hi, xtol=SPEED_ATOL, rtol=RTOL)
-    return np.where(moving, n, 0.0), converged
+    lo, hi, residual = eqs.speed_problem(flow, dp_i, leak)
+    with np.errstate(divide='ignore', invalid='ignore'):  # the stalled elements sit at n = 0
+        above_floor = residual(np.where(lo > 0.0, lo, hi))[0] < 0.0
+        moving = (hi > lo) & ((lo <= 0.0) | above_floor)
+        status |= (~moving & (hi > 0.0) & (lo > 0.0)) * np.uint8(PointStatus.NO_ROOT)
+        lo, hi = np.where(moving, lo, 0.0), np.where(moving, hi, 0.0)
+        n, solved = solve_increasing(residual, lo, hi, hi, SPEED_SOLVE, CHECK * flow + FLOW_ATOL)
+    return np.where(moving, n, 0.0), solved
 
 
-def speed_map(eqs: Equations, flow: object, dp_name: str, dp_value: object, p_ex: object,
-              errors: Errors, closed_form: bool) -> OperatingPoints:
-    """
-    Compute n(Q, dp) over a batch; see :meth:`MotorModel.speed`.
-
-    Parameters
-    ----------
-    eqs : Equations
-        The model's equations, [-]
-    flow : float or array_like
-        Flow into the motor, [m^3/s]
-    dp_name : {'dp', 'dp_i'}
-        Which pressure drop is given, [-]
-    dp_value : float or array_like
-        The pressure drop, [Pa]
-    p_ex : float or array_like
-        Pressure driving the external leakage, [Pa]
-    errors : {'raise', 'mask'}
-        What to do with a bad element, [-]
-    closed_form : bool
-        Use eq. (40) rather than solve eq. (36), [-]
-
-    Returns
-    -------
-    OperatingPoints
-        The result.
-
-    """
-    arrays, status = prepare(
-        {'flow': (flow, 'm^3/s'), dp_name: (dp_value, 'Pa'), 'p_ex': (p_ex, 'Pa')}, errors)
-    port = dp_name == 'dp'
-    given = {'flow': arrays[0], 'dp': arrays[1]} if port else {'flow': arrays[0]}
+def speed_map(eqs: Equations, geometry: MotorGeometry, flow: object, dp_name: str,
+              dp_value: object, p_ex: object, errors: Errors,
+              closed_form: bool) -> OperatingPoints:
+    """Compute n(Q, dp) over a batch: :meth:`MotorModel.speed` without effects."""
+    arrays, status, port, given = map_inputs(('flow', flow, 'm^3/s'), dp_name, dp_value,
+                                             p_ex, errors)
     d = eqs.derived
 
     def core(q: FloatArray, dpv: FloatArray, pex: FloatArray, status: Status,
              at: At) -> Chunk:
-        chamber = eqs.chamber_drop(dpv, q, status) if port else dpv
+        chamber = clip_chamber_drop(eqs.chamber_drop(dpv, q), status) if port else dpv
         chamber = check_limit(chamber, d.dp_limit, (dp_name, dpv), status, errors, at)
         q_lfg, q_c, q_ex = eqs.leakage(chamber, pex)
         leak = q_lfg + q_c + q_ex
         if closed_form:
-            n = effective_speed(q, chamber, leak, d.c_lumped, eqs.coef.c_id, eqs.geometry)
+            n = eqs.closed_form_speed(q, chamber, leak)
         else:
-            n, converged = solve_speed(eqs, q, chamber, leak, status)
+            n, solved = solve_speed(eqs, q, chamber, leak, status)
         if n.size and n.min() == 0.0:
             status |= (n == 0.0) * np.uint8(PointStatus.STALLED)
-        losses = eqs.breakdown(n, chamber, q_lfg, q_c, q_ex, leak)
+        losses, total = components(eqs, n, chamber, q_lfg, q_c, q_ex, leak)
         if not closed_form:
-            absorbed = absorbency(n, losses['total'], eqs.geometry)
-            check_solution(absorbed, q, converged, n > 0.0, status, errors,
+            absorbed = absorbency(n, total, d.qt)
+            check_solution(absorbed, q, solved, n > 0.0, status, errors,
                            ('flow', 'm^3/s', q, at), f'eq. (36) with eq. ({eqs.law.name[2:]})')
         flag_extrapolated(d, n, chamber, status)
         fields_ = {'speed': n, 'dp_i': chamber, **losses}
@@ -128,4 +87,4 @@ def speed_map(eqs: Equations, flow: object, dp_name: str, dp_value: object, p_ex
             fields_['dp'] = chamber + eqs.channel_drop(q)
         return mask_invalid(fields_, status)
 
-    return run(core, arrays, status, given, not closed_form, eqs.geometry)
+    return run(core, arrays, status, given, not closed_form, geometry)

@@ -4,137 +4,173 @@ The two laws for the change of displacement: the physical eq. (33) and the empir
 
 Each law gives its loss Delta Q_vl = Delta q * n, the slopes of that loss,
 the lowest speed it is used at, and how its loss is shared among the
-components of eq. (31). The array maps never branch on the law; only the
-float-specialised single-point path (:mod:`.point`) inlines both.
+components of eq. (31). Every method works on Python floats and on arrays
+alike, so the single-point path and the array maps share them.
 """
 
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-
-import numpy as np
+from collections.abc import Callable
 
 from satmotor_ros.model import losses as eq
-from satmotor_ros.model._typing import FloatArray
-from satmotor_ros.model.coefficients import LossCoefficients, MotorGeometry
+from satmotor_ros.model._numeric import log, maximum
+from satmotor_ros.model._typing import Real
 from satmotor_ros.model.derived import DerivedCoefficients
 from satmotor_ros.model.errors import ModelError
 from satmotor_ros.model.units import MPA, RPM
 
+_TINY_FLOW = 1e-300  # [m^3/s]; below the resolution of any loss but 0
+
+Parts = tuple[Real, Real, Real, Real]
+"""Delta Q_fc, Delta Q_dch, Delta Q_b and Delta Q_id of eqs. (11)-(14), [m^3/s]."""
+
+Terms = Callable[[Real], tuple[Real, Real]]
+"""A loss and one of its slopes as a function of one variable, the other held fixed: n > 0."""
+
 
 class DisplacementLaw(ABC):
     """
-    What a law of Delta q holds: the model's constants, geometry and coefficients.
+    What a law of Delta q holds: the model's constants.
 
     Parameters
     ----------
     derived : DerivedCoefficients
         The model's constants, [-]
-    geometry : MotorGeometry
-        Motor geometry, [-]
-    coef : LossCoefficients
-        Coefficient set, [-]
 
     """
 
     name = ''
     closed_form = False  # whether eq. (40) inverts it, with no solve
     has_floor = False  # whether it is used only above a floor speed
+    shares = False  # whether its loss is shared among eqs. (11)-(14) by :meth:`share`
 
-    def __init__(self, derived: DerivedCoefficients, geometry: MotorGeometry,
-                 coef: LossCoefficients) -> None:
+    def __init__(self, derived: DerivedCoefficients) -> None:
         """Keep the constants."""
-        self.derived, self.geometry, self.coef = derived, geometry, coef
+        self.derived = derived
+        # the floor rises with dp_i: below this speed a point may be under it, [rad/s]
+        self.max_floor = float(self.floor(derived.dp_limit)) if self.has_floor else 0.0
 
     @abstractmethod
-    def loss(self, speed: FloatArray, dp_i: FloatArray) -> FloatArray:
+    def loss(self, speed: Real, dp_i: Real) -> Real:
         """Return Delta Q_vl = Delta q n, [m^3/s]."""
 
     @abstractmethod
-    def slopes(self, speed: FloatArray, dp_i: FloatArray,
-               loss: FloatArray) -> tuple[FloatArray, FloatArray]:
-        """Return d(Delta Q_vl)/dn [m^3/rad] and d(Delta Q_vl)/d(dp_i) [m^3/(s*Pa)]."""
+    def at_pressure(self, dp_i: Real) -> tuple[Real, Terms[Real]]:
+        """Return the floor speed [rad/s] and n -> (Delta Q_vl, its slope in n) at fixed dp_i."""
 
     @abstractmethod
-    def floor(self, dp_i: FloatArray) -> FloatArray:
+    def at_speed(self, speed: Real) -> Terms[Real]:
+        """Return dp_i -> (Delta Q_vl [m^3/s], its slope in dp_i [m^3/(s*Pa)]) at a fixed n."""
+
+    @abstractmethod
+    def floor(self, dp_i: Real) -> Real:
         """Return the lowest speed the law is used at, [rad/s]."""
 
-    @abstractmethod
-    def share(self, parts: list[FloatArray], speed: FloatArray,
-              dp_i: FloatArray) -> list[FloatArray]:
+    def share(self, parts: Parts[Real], speed: Real, dp_i: Real) -> Parts[Real]:
         """Return the components of eqs. (11)-(14) that add up to this law's loss, [m^3/s]."""
+        return parts
 
 
 class PhysicalLaw(DisplacementLaw):
-    """Delta q of eq. (33): (C dp_i + C_id / sqrt(n)) m^2 H, split by eqs. (11)-(14)."""
+    """Delta q of eq. (33): (C dp_i + C_id / sqrt(n)) m^2 H, the sum of eqs. (11)-(14)."""
 
     name = 'eq33'
     closed_form = True
 
-    def loss(self, speed: FloatArray, dp_i: FloatArray) -> FloatArray:
+    def loss(self, speed: Real, dp_i: Real) -> Real:
         """Return Delta Q_vl of eqs. (32)-(33), [m^3/s]."""
-        return eq.displacement_loss(dp_i, speed, self.derived.c_lumped, self.coef.c_id,
-                                    self.geometry)
-
-    def slopes(self, speed: FloatArray, dp_i: FloatArray,
-               loss: FloatArray) -> tuple[FloatArray, FloatArray]:
-        """Return d(Delta Q_vl)/dn [m^3/rad] and d(Delta Q_vl)/d(dp_i) [m^3/(s*Pa)]."""
         d = self.derived
-        with np.errstate(divide='ignore'):
-            return d.k_p * dp_i + 0.5 * d.k_i / np.sqrt(speed), d.k_p * speed
+        return eq.displacement_loss(dp_i, speed, d.k_p, d.k_i)
 
-    def floor(self, dp_i: FloatArray) -> FloatArray:
+    def at_pressure(self, dp_i: Real) -> tuple[Real, Terms[Real]]:
+        """Return the floor speed [rad/s] and n -> (Delta Q_vl, its slope in n) at fixed dp_i."""
+        k_p, k_i = self.derived.k_p, self.derived.k_i
+
+        def terms(speed: Real) -> tuple[Real, Real]:
+            return (eq.displacement_loss(dp_i, speed, k_p, k_i),
+                    k_p * dp_i + 0.5 * k_i / speed ** 0.5)
+        return 0.0 * dp_i, terms
+
+    def at_speed(self, speed: Real) -> Terms[Real]:
+        """Return dp_i -> (Delta Q_vl [m^3/s], its slope in dp_i [m^3/(s*Pa)]) at a fixed n."""
+        k_p, k_i = self.derived.k_p, self.derived.k_i
+        k_pn = k_p * speed
+
+        def terms(dp_i: Real) -> tuple[Real, Real]:
+            return eq.displacement_loss(dp_i, speed, k_p, k_i), k_pn
+        return terms
+
+    def floor(self, dp_i: Real) -> Real:
         """Return the lowest speed the law is used at: none, [rad/s]."""
-        return np.zeros_like(dp_i)
-
-    def share(self, parts: list[FloatArray], speed: FloatArray,
-              dp_i: FloatArray) -> list[FloatArray]:
-        """Return the components of eqs. (11)-(14): they are this law's loss."""
-        return parts
+        return 0.0 * dp_i
 
 
 class EmpiricalLaw(DisplacementLaw):
-    """Delta q of eq. (39): C_1/sqrt(n) dp_i^(C_2/sqrt(n)), shared as eq. (33) would split it."""
+    """
+    Delta q of eq. (39): C_1/sqrt(n) dp_i^(C_2/sqrt(n)), shared as eq. (33) would split it.
+
+    Below :data:`~satmotor_ros.model.losses.EMPIRICAL_DP_FLOOR` the chamber drop is
+    taken at that floor (see :func:`~satmotor_ros.model.losses.displacement_change_empirical`),
+    and at n = 0 the loss is 0 (no revolution, no displacement loss).
+    """
 
     name = 'eq39'
     closed_form = False
     has_floor = True
+    shares = True
 
-    def loss(self, speed: FloatArray, dp_i: FloatArray) -> FloatArray:
+    def loss(self, speed: Real, dp_i: Real) -> Real:
         """Return Delta Q_vl of eqs. (32), (39), [m^3/s]."""
-        return eq.displacement_loss_empirical(dp_i, speed, self.coef)
+        d = self.derived
+        # at n = 0, Delta q at n = 1 (speed + True) times n = 0 is the loss: 0
+        return eq.displacement_change_empirical(maximum(dp_i, eq.EMPIRICAL_DP_FLOOR),
+                                                speed + (speed <= 0.0), d.c1_39,
+                                                d.c2_39) * speed
 
-    def slopes(self, speed: FloatArray, dp_i: FloatArray,
-               loss: FloatArray) -> tuple[FloatArray, FloatArray]:
-        """Return d(Delta Q_vl)/dn [m^3/rad] and d(Delta Q_vl)/d(dp_i) [m^3/(s*Pa)]."""
+    def at_pressure(self, dp_i: Real) -> tuple[Real, Terms[Real]]:
+        """Return the floor speed [rad/s] and n -> (Delta Q_vl, its slope in n) at fixed dp_i."""
         # Delta Q_vl = C_1 s exp(a / s) with s = sqrt(n [rpm]), a = C_2 ln(dp_i [MPa])
-        c2 = self.coef.c2_39
-        with np.errstate(divide='ignore', invalid='ignore'):
-            inv_s = 1.0 / np.sqrt(speed / RPM)
-            above = dp_i > eq.EMPIRICAL_DP_FLOOR  # below it, eq. (39) is flat in dp_i
-            log_dp = np.log(np.where(above, dp_i, eq.EMPIRICAL_DP_FLOOR) / MPA)
-            d_speed = loss * (1.0 - c2 * log_dp * inv_s) / (2.0 * speed)
-            return d_speed, np.where(above, loss * c2 * inv_s / dp_i, 0.0)
+        c1, c2 = self.derived.c1_39, self.derived.c2_39
+        dp = maximum(dp_i, eq.EMPIRICAL_DP_FLOOR)
+        c2_log_dp = c2 * log(dp / MPA)
 
-    def floor(self, dp_i: FloatArray) -> FloatArray:
+        def terms(speed: Real) -> tuple[Real, Real]:
+            loss = eq.displacement_change_empirical(dp, speed, c1, c2) * speed
+            return loss, loss * (1.0 - c2_log_dp / (speed / RPM) ** 0.5) / (2.0 * speed)
+        return eq.empirical_speed_floor(dp, c2), terms
+
+    def at_speed(self, speed: Real) -> Terms[Real]:
+        """Return dp_i -> (Delta Q_vl [m^3/s], its slope in dp_i [m^3/(s*Pa)]) at a fixed n."""
+        c1, c2 = self.derived.c1_39, self.derived.c2_39
+        moving = speed > 0.0
+        safe = speed + (speed <= 0.0)  # at n = 0 the loss is 0 and flat: at n = 1, times 0
+        c2_inv_s = moving * (c2 / (safe / RPM) ** 0.5)
+        floor, change = eq.EMPIRICAL_DP_FLOOR, eq.displacement_change_empirical
+
+        def terms(dp_i: Real) -> tuple[Real, Real]:
+            dp = maximum(dp_i, floor)  # below the floor, eq. (39) is flat in dp_i
+            loss = change(dp, safe, c1, c2) * speed
+            return loss, (dp_i > floor) * (loss * c2_inv_s / dp)
+        return terms
+
+    def floor(self, dp_i: Real) -> Real:
         """Return the lowest speed eq. (39) is used at, (C_2 ln dp_i)^2 rpm, [rad/s]."""
-        return eq.empirical_speed_floor(dp_i, self.coef)
+        return eq.empirical_speed_floor(dp_i, self.derived.c2_39)
 
-    def share(self, parts: list[FloatArray], speed: FloatArray,
-              dp_i: FloatArray) -> list[FloatArray]:
+    def share(self, parts: Parts[Real], speed: Real, dp_i: Real) -> Parts[Real]:
         """Scale the components of eqs. (11)-(14) so that they add up to eq. (39)'s loss."""
-        physical = parts[0] + parts[1] + parts[2] + parts[3]
-        scale = np.divide(self.loss(speed, dp_i), physical, out=np.zeros_like(physical),
-                          where=physical > 0.0)
-        return [p * scale for p in parts]
+        fc, dch, bl, ine = parts
+        physical = fc + dch + bl + ine
+        scale = self.loss(speed, dp_i) / (physical + _TINY_FLOW)  # parts of 0 stay 0
+        return fc * scale, dch * scale, bl * scale, ine * scale
 
 
 LAWS = {'eq33': PhysicalLaw, 'eq39': EmpiricalLaw}
 """The displacement laws by name."""
 
 
-def displacement_law(name: str, derived: DerivedCoefficients, geometry: MotorGeometry,
-                     coef: LossCoefficients) -> DisplacementLaw:
+def displacement_law(name: str, derived: DerivedCoefficients) -> DisplacementLaw:
     """
     Build the displacement law of a given name.
 
@@ -144,10 +180,6 @@ def displacement_law(name: str, derived: DerivedCoefficients, geometry: MotorGeo
         The law, [-]
     derived : DerivedCoefficients
         The model's constants, [-]
-    geometry : MotorGeometry
-        Motor geometry, [-]
-    coef : LossCoefficients
-        Coefficient set, [-]
 
     Returns
     -------
@@ -163,4 +195,4 @@ def displacement_law(name: str, derived: DerivedCoefficients, geometry: MotorGeo
     if name not in LAWS:
         msg = f"displacement_law = {name!r}: use 'eq33' or 'eq39'"
         raise ModelError(msg)
-    return LAWS[name](derived, geometry, coef)
+    return LAWS[name](derived)

@@ -2,10 +2,14 @@
 """
 The components of the volumetric losses, one function per equation of [1]_.
 
-Every function takes and returns SI arrays (broadcasting like numpy) and
-converts to the unit system the paper's coefficients were fitted in
-internally. Inputs are assumed valid (finite, chamber pressure drop >= 0,
-speed >= 0): screening belongs to :class:`satmotor_ros.model.MotorModel`.
+Each equation is one function of its variables and of constants that depend only
+on the motor, the coefficient set and the liquid; those constants come from the
+``*_coefficients`` functions beside it, computed once per model (see
+:mod:`.derived`). Every equation function is plain arithmetic: correct on a
+Python float (the few-microsecond single point) and on numpy arrays (the batch
+maps), broadcasting like numpy. Inputs are assumed valid (finite, chamber
+pressure drop >= 0, speed >= 0): screening belongs to
+:class:`satmotor_ros.model.MotorModel`.
 
 References
 ----------
@@ -18,35 +22,33 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-
-from satmotor_ros.model._typing import ArrayLike, FloatArray
-from satmotor_ros.model.coefficients import LossCoefficients, MotorGeometry
+from satmotor_ros.model._numeric import log, maximum
+from satmotor_ros.model._typing import Real
+from satmotor_ros.model.coefficients import Liquid, LossCoefficients, MotorGeometry
 from satmotor_ros.model.units import CM3_PER_MIN, CM3_PER_REV, LPM, MPA, RPM
 
 EMPIRICAL_DP_FLOOR = 1.0 * MPA
 """Chamber drop below which eq. (39) holds its value at this drop, [Pa] (see eq. 39)."""
 
 
-def clearance_height(dp_i: ArrayLike, geometry: MotorGeometry,
-                     coef: LossCoefficients) -> FloatArray:
+def clearance_height(dp_i: Real, h0: float, compliance: float) -> Real:
     r"""
     Compute the equivalent axial clearance under pressure, eq. (2).
 
-    .. math:: h = \frac{h_R + h_S}{2} - (D_C H + D_K)\,\Delta p_i
+    .. math:: h = \frac{h_R + h_S}{2} - (D_C H + D_K)\,\Delta p_i = h_0 - s\,\Delta p_i
 
     Parameters
     ----------
     dp_i : float or ndarray
         Pressure drop in the working chambers, [Pa]
-    geometry : MotorGeometry
-        Motor geometry (h_R, h_S, H), [-]
-    coef : LossCoefficients
-        Coefficient set (D_C, D_K), [-]
+    h0 : float
+        Unloaded clearance h_0 from :func:`clearance_coefficients`, [m]
+    compliance : float
+        Compliance s from :func:`clearance_coefficients`, [m/Pa]
 
     Returns
     -------
-    ndarray
+    float or ndarray
         Equivalent clearance h, [m]
 
     Notes
@@ -58,13 +60,12 @@ def clearance_height(dp_i: ArrayLike, geometry: MotorGeometry,
     --------
     >>> from satmotor_ros.model.config import load_motor
     >>> spec = load_motor()
-    >>> h = clearance_height(25e6, spec.geometry, spec.sets['oil'].coefficients)
-    >>> round(float(h) * 1e6, 3)
+    >>> h0, s = clearance_coefficients(spec.geometry, spec.sets['oil'].coefficients)
+    >>> round(clearance_height(25e6, h0, s) * 1e6, 3)
     5.14
 
     """
-    h0, slope = clearance_coefficients(geometry, coef)
-    return h0 - slope * np.asarray(dp_i, dtype=float)
+    return h0 - compliance * dp_i
 
 
 def clearance_coefficients(geometry: MotorGeometry,
@@ -94,15 +95,15 @@ def clearance_coefficients(geometry: MotorGeometry,
     return h0, slope
 
 
-def flat_clearance_leakage(dp_i: ArrayLike, h: ArrayLike, nu: ArrayLike, rho: ArrayLike,
-                           geometry: MotorGeometry, coef: LossCoefficients) -> FloatArray:
+def flat_clearance_leakage(dp_i: Real, h: Real, k_lfg: float,
+                           e_lfg: float) -> Real:
     r"""
     Compute the leakage in the flat axial clearances Q_Lfg, eq. (1).
 
     .. math::
         Q_{Lfg} = A_1 m^{\frac{1-\beta}{2-\beta}} \nu^{-\frac{\beta}{2-\beta}}
         \left(\frac{2 h^3}{K A_2 \rho}\right)^{\frac{1}{2-\beta}}
-        \Delta p_i^{\frac{1}{2-\beta}}
+        \Delta p_i^{\frac{1}{2-\beta}} = k\,(h^3 \Delta p_i)^e
 
     Parameters
     ----------
@@ -110,18 +111,14 @@ def flat_clearance_leakage(dp_i: ArrayLike, h: ArrayLike, nu: ArrayLike, rho: Ar
         Pressure drop in the working chambers, [Pa]
     h : float or ndarray
         Equivalent axial clearance from eq. (2), [m]
-    nu : float or ndarray
-        Kinematic viscosity of the liquid, [m^2/s]
-    rho : float or ndarray
-        Density of the liquid, [kg/m^3]
-    geometry : MotorGeometry
-        Motor geometry (tooth module m), [-]
-    coef : LossCoefficients
-        Coefficient set (A_1, A_2, K, beta), [-]
+    k_lfg : float
+        Prefactor k from :func:`flat_clearance_coefficients`, [m^3/s / (m^3 Pa)^e]
+    e_lfg : float
+        Exponent e = 1/(2 - beta), [-]
 
     Returns
     -------
-    ndarray
+    float or ndarray
         Leakage flow Q_Lfg, [m^3/s]
 
     Notes
@@ -130,13 +127,11 @@ def flat_clearance_leakage(dp_i: ArrayLike, h: ArrayLike, nu: ArrayLike, rho: Ar
     Q_Lfg in l/min; beta = 1 is laminar flow, beta -> 0 turbulent.
 
     """
-    prefactor, e = flat_clearance_coefficients(nu, rho, geometry, coef)
-    h = np.asarray(h, dtype=float)
-    return prefactor * (h * h * h * np.asarray(dp_i, dtype=float)) ** e
+    return k_lfg * (h * h * h * dp_i) ** e_lfg
 
 
-def flat_clearance_coefficients(nu: ArrayLike, rho: ArrayLike, geometry: MotorGeometry,
-                                coef: LossCoefficients) -> tuple[FloatArray, float]:
+def flat_clearance_coefficients(liquid: Liquid, geometry: MotorGeometry,
+                                coef: LossCoefficients) -> tuple[float, float]:
     r"""
     Compute the constants of eq. (1): Q_Lfg = k * (h^3 dp_i)^e.
 
@@ -147,10 +142,8 @@ def flat_clearance_coefficients(nu: ArrayLike, rho: ArrayLike, geometry: MotorGe
 
     Parameters
     ----------
-    nu : float or ndarray
-        Kinematic viscosity of the liquid, [m^2/s]
-    rho : float or ndarray
-        Density of the liquid, [kg/m^3]
+    liquid : Liquid
+        The working liquid (nu, rho), [-]
     geometry : MotorGeometry
         Motor geometry (tooth module m), [-]
     coef : LossCoefficients
@@ -158,46 +151,42 @@ def flat_clearance_coefficients(nu: ArrayLike, rho: ArrayLike, geometry: MotorGe
 
     Returns
     -------
-    prefactor : ndarray
+    prefactor : float
         k, for h in m and dp_i in Pa, [m^3/s / (m^3 Pa)^e]
     exponent : float
         e, [-]
 
     """
+    nu, rho = liquid.kinematic_viscosity, liquid.density
     e = 1.0 / (2.0 - coef.beta)
-    nu_cst = np.asarray(nu, dtype=float) * 1.0e6
     # h^3 [um^3] * dp_i [MPa] = h^3 [m^3] * dp_i [Pa] * 1e12; the 1e12 goes into the prefactor
     prefactor = (coef.a1 * (geometry.module * 1.0e3) ** ((1.0 - coef.beta) * e)
-                 * nu_cst ** (-coef.beta * e)
-                 * (2.0e12 / (coef.k * coef.a2 * np.asarray(rho, dtype=float))) ** e * LPM)
-    return prefactor, e
+                 * (nu * 1.0e6) ** (-coef.beta * e)
+                 * (2.0e12 / (coef.k * coef.a2 * rho)) ** e * LPM)
+    return float(prefactor), e
 
 
-def commutation_leakage(dp_i: ArrayLike, nu: ArrayLike, rho: ArrayLike,
-                        geometry: MotorGeometry, coef: LossCoefficients) -> FloatArray:
+def commutation_leakage(dp_i: Real, k_c: float, gamma: float) -> Real:
     r"""
     Compute the leakage in the commutation-unit clearances Q_C, eq. (5).
 
     .. math::
         Q_C = C_1 (D_o h_S)^{C_2}
         \left(\frac{1}{\rho \nu C_3}\right)^{\gamma} \Delta p_i^{\gamma}
+        = k\,\Delta p_i^{\gamma}
 
     Parameters
     ----------
     dp_i : float or ndarray
         Pressure drop in the working chambers, [Pa]
-    nu : float or ndarray
-        Kinematic viscosity of the liquid, [m^2/s]
-    rho : float or ndarray
-        Density of the liquid, [kg/m^3]
-    geometry : MotorGeometry
-        Motor geometry (D_o, h_S), [-]
-    coef : LossCoefficients
-        Coefficient set (C_1, C_2, C_3, gamma), [-]
+    k_c : float
+        Prefactor k from :func:`commutation_coefficient`, [m^3/s / Pa^gamma]
+    gamma : float
+        Exponent gamma, [-]
 
     Returns
     -------
-    ndarray
+    float or ndarray
         Leakage flow Q_C, [m^3/s]
 
     Notes
@@ -206,12 +195,11 @@ def commutation_leakage(dp_i: ArrayLike, nu: ArrayLike, rho: ArrayLike,
     is read as m^3/s. It stays below 0.012 l/min for the SM-0,75/25.
 
     """
-    return (commutation_coefficient(nu, rho, geometry, coef)
-            * np.asarray(dp_i, dtype=float) ** coef.gamma)
+    return k_c * dp_i ** gamma
 
 
-def commutation_coefficient(nu: ArrayLike, rho: ArrayLike, geometry: MotorGeometry,
-                            coef: LossCoefficients) -> FloatArray:
+def commutation_coefficient(liquid: Liquid, geometry: MotorGeometry,
+                            coef: LossCoefficients) -> float:
     r"""
     Compute the prefactor of eq. (5): Q_C = k * dp_i^gamma.
 
@@ -219,10 +207,8 @@ def commutation_coefficient(nu: ArrayLike, rho: ArrayLike, geometry: MotorGeomet
 
     Parameters
     ----------
-    nu : float or ndarray
-        Kinematic viscosity of the liquid, [m^2/s]
-    rho : float or ndarray
-        Density of the liquid, [kg/m^3]
+    liquid : Liquid
+        The working liquid (rho, nu), [-]
     geometry : MotorGeometry
         Motor geometry (D_o, h_S), [-]
     coef : LossCoefficients
@@ -230,15 +216,14 @@ def commutation_coefficient(nu: ArrayLike, rho: ArrayLike, geometry: MotorGeomet
 
     Returns
     -------
-    ndarray
+    float
         k, for dp_i in Pa, [m^3/s / Pa^gamma]
 
     """
-    nu_cst = np.asarray(nu, dtype=float) * 1.0e6
     base = (geometry.commutation_diameter * 1.0e3) * (geometry.clearance_satellites * 1.0e6)
-    return (coef.c1 * base ** coef.c2
-            * (1.0 / (np.asarray(rho, dtype=float) * nu_cst * coef.c3)) ** coef.gamma
-            * MPA ** -coef.gamma)
+    mu_cst = liquid.density * liquid.kinematic_viscosity * 1.0e6
+    return float(coef.c1 * base ** coef.c2 * (1.0 / (mu_cst * coef.c3)) ** coef.gamma
+                 * MPA ** -coef.gamma)
 
 
 def compressibility_coefficient(bulk_modulus: float, geometry: MotorGeometry,
@@ -292,19 +277,14 @@ def pressure_speed_coefficient(c: float, geometry: MotorGeometry) -> float:
     return c * geometry.m2h * CM3_PER_MIN / (MPA * RPM)
 
 
-def _pressure_speed_loss(c: float, dp_i: ArrayLike, speed: ArrayLike,
-                         geometry: MotorGeometry) -> FloatArray:
-    """Evaluate c * m^2 H * dp_i * n, the common form of eqs. (11)-(13), in m^3/s."""
-    scale = pressure_speed_coefficient(c, geometry)
-    return scale * np.asarray(dp_i, dtype=float) * np.asarray(speed, dtype=float)
-
-
-def compressibility_loss(dp_i: ArrayLike, speed: ArrayLike, c_fc_beta: float,
-                         geometry: MotorGeometry) -> FloatArray:
+def pressure_speed_loss(dp_i: Real, speed: Real, k: float) -> Real:
     r"""
-    Compute the loss from liquid compressibility Delta Q_fc, eq. (11).
+    Compute a loss proportional to pressure and speed, eqs. (11), (12) and (13).
 
-    .. math:: \Delta Q_{fc} = C_{fc}\,\beta_l\,m^2 H\,\Delta p_i\,n
+    .. math:: \Delta Q_{fc},\ \Delta Q_{dch},\ \Delta Q_b = c\,m^2 H\,\Delta p_i\,n
+
+    with c = C_fc*beta_l (compressibility, eq. 11), C_dch (deformation of the
+    chambers, eq. 12) or C_b (tip clearance and backlash, eq. 13).
 
     Parameters
     ----------
@@ -312,75 +292,19 @@ def compressibility_loss(dp_i: ArrayLike, speed: ArrayLike, c_fc_beta: float,
         Pressure drop in the working chambers, [Pa]
     speed : float or ndarray
         Shaft speed n, [rad/s]
-    c_fc_beta : float
-        C_fc*beta_l from :func:`compressibility_coefficient`, [1/(MPa*rev)]
-    geometry : MotorGeometry
-        Motor geometry (m, H), [-]
+    k : float
+        c m^2 H from :func:`pressure_speed_coefficient`, [m^3/(Pa*rad)]
 
     Returns
     -------
-    ndarray
-        Delta Q_fc, [m^3/s]
+    float or ndarray
+        The loss, [m^3/s]
 
     """
-    return _pressure_speed_loss(c_fc_beta, dp_i, speed, geometry)
+    return k * dp_i * speed
 
 
-def deformation_loss(dp_i: ArrayLike, speed: ArrayLike, c_dch: float,
-                     geometry: MotorGeometry) -> FloatArray:
-    r"""
-    Compute the loss from elastic deformation of the chambers Delta Q_dch, eq. (12).
-
-    .. math:: \Delta Q_{dch} = C_{dch}\,m^2 H\,\Delta p_i\,n
-
-    Parameters
-    ----------
-    dp_i : float or ndarray
-        Pressure drop in the working chambers, [Pa]
-    speed : float or ndarray
-        Shaft speed n, [rad/s]
-    c_dch : float
-        Deformation coefficient C_dch, [1/(MPa*rev)]
-    geometry : MotorGeometry
-        Motor geometry (m, H), [-]
-
-    Returns
-    -------
-    ndarray
-        Delta Q_dch, [m^3/s]
-
-    """
-    return _pressure_speed_loss(c_dch, dp_i, speed, geometry)
-
-
-def backlash_loss(dp_i: ArrayLike, speed: ArrayLike, c_b: float,
-                  geometry: MotorGeometry) -> FloatArray:
-    r"""
-    Compute the loss from tip clearance and backlash Delta Q_b, eq. (13).
-
-    .. math:: \Delta Q_b = C_b\,m^2 H\,\Delta p_i\,n
-
-    Parameters
-    ----------
-    dp_i : float or ndarray
-        Pressure drop in the working chambers, [Pa]
-    speed : float or ndarray
-        Shaft speed n, [rad/s]
-    c_b : float
-        Backlash coefficient C_b, [1/(MPa*rev)]
-    geometry : MotorGeometry
-        Motor geometry (m, H), [-]
-
-    Returns
-    -------
-    ndarray
-        Delta Q_b, [m^3/s]
-
-    """
-    return _pressure_speed_loss(c_b, dp_i, speed, geometry)
-
-
-def inertia_loss(speed: ArrayLike, c_id: float, geometry: MotorGeometry) -> FloatArray:
+def inertia_loss(speed: Real, k_id: float) -> Real:
     r"""
     Compute the loss from satellite and liquid inertia Delta Q_id, eq. (14).
 
@@ -390,18 +314,16 @@ def inertia_loss(speed: ArrayLike, c_id: float, geometry: MotorGeometry) -> Floa
     ----------
     speed : float or ndarray
         Shaft speed n, [rad/s]
-    c_id : float
-        Inertia coefficient C_id, [1/(rev*min)^0.5]
-    geometry : MotorGeometry
-        Motor geometry (m, H), [-]
+    k_id : float
+        C_id m^2 H from :func:`inertia_coefficient`, [m^3/s / (rad/s)^0.5]
 
     Returns
     -------
-    ndarray
+    float or ndarray
         Delta Q_id, [m^3/s]
 
     """
-    return inertia_coefficient(c_id, geometry) * np.sqrt(np.asarray(speed, dtype=float))
+    return k_id * speed ** 0.5
 
 
 def inertia_coefficient(c_id: float, geometry: MotorGeometry) -> float:
@@ -426,8 +348,8 @@ def inertia_coefficient(c_id: float, geometry: MotorGeometry) -> float:
     return c_id * geometry.m2h * CM3_PER_MIN / math.sqrt(RPM)
 
 
-def displacement_change(dp_i: ArrayLike, speed: ArrayLike, c: float, c_id: float,
-                        geometry: MotorGeometry) -> FloatArray:
+def displacement_change(dp_i: Real, speed: Real, k_p: float,
+                        k_id: float) -> Real:
     r"""
     Compute the change of displacement per revolution Delta q, eq. (33).
 
@@ -439,36 +361,32 @@ def displacement_change(dp_i: ArrayLike, speed: ArrayLike, c: float, c_id: float
         Pressure drop in the working chambers, [Pa]
     speed : float or ndarray
         Shaft speed n > 0, [rad/s]
-    c : float
-        Lumped coefficient C = C_fc*beta_l + C_dch + C_b, [1/(MPa*rev)]
-    c_id : float
-        Inertia coefficient C_id, [1/(rev*min)^0.5]
-    geometry : MotorGeometry
-        Motor geometry (m, H), [-]
+    k_p : float
+        C m^2 H from :func:`pressure_speed_coefficient`, [m^3/(Pa*rad)]
+    k_id : float
+        C_id m^2 H from :func:`inertia_coefficient`, [m^3/s / (rad/s)^0.5]
 
     Returns
     -------
-    ndarray
+    float or ndarray
         Delta q, [m^3/rad]; Delta Q_vl = Delta q * n, eq. (32).
 
     Examples
     --------
     >>> from satmotor_ros.model.config import load_motor
-    >>> from satmotor_ros.model.units import MPA, RPM
     >>> spec = load_motor()
     >>> coef = spec.sets['oil'].coefficients
-    >>> dq = displacement_change(2 * MPA, 100 * RPM, coef.c, coef.c_id, spec.geometry)
-    >>> round(float(dq) * 2 * 3.141592653589793 * 1e6, 4)  # cm^3/rev
+    >>> k_p = pressure_speed_coefficient(coef.c, spec.geometry)
+    >>> k_id = inertia_coefficient(coef.c_id, spec.geometry)
+    >>> dq = displacement_change(2 * MPA, 100 * RPM, k_p, k_id)
+    >>> round(dq * 2 * 3.141592653589793 * 1e6, 4)  # cm^3/rev
     2.0143
 
     """
-    n_rpm = np.asarray(speed, dtype=float) / RPM
-    dq_cm3 = (c * np.asarray(dp_i, dtype=float) / MPA + c_id / np.sqrt(n_rpm)) * geometry.m2h
-    return dq_cm3 * CM3_PER_REV
+    return k_p * dp_i + k_id / speed ** 0.5
 
 
-def displacement_loss(dp_i: ArrayLike, speed: ArrayLike, c: float, c_id: float,
-                      geometry: MotorGeometry) -> FloatArray:
+def displacement_loss(dp_i: Real, speed: Real, k_p: float, k_id: float) -> Real:
     r"""
     Compute the speed-dependent losses Delta Q_vl = Delta q * n, eqs. (32)-(33).
 
@@ -480,27 +398,25 @@ def displacement_loss(dp_i: ArrayLike, speed: ArrayLike, c: float, c_id: float,
     Parameters
     ----------
     dp_i : float or ndarray
-        Pressure drop in the working chambers, [Pa]
+        Chamber pressure drop, [Pa]
     speed : float or ndarray
-        Shaft speed n, [rad/s]
-    c : float
-        Lumped coefficient C = C_fc*beta_l + C_dch + C_b, [1/(MPa*rev)]
-    c_id : float
-        Inertia coefficient C_id, [1/(rev*min)^0.5]
-    geometry : MotorGeometry
-        Motor geometry (m, H), [-]
+        Shaft speed n, 0 included, [rad/s]
+    k_p : float
+        C m^2 H, the lumped pressure-speed coefficient, [m^3/(Pa*rad)]
+    k_id : float
+        C_id m^2 H, the inertia coefficient, [m^3/s / (rad/s)^0.5]
 
     Returns
     -------
-    ndarray
+    float or ndarray
         Delta Q_vl, [m^3/s]
 
     """
-    return _pressure_speed_loss(c, dp_i, speed, geometry) + inertia_loss(speed, c_id, geometry)
+    return k_p * dp_i * speed + k_id * speed ** 0.5
 
 
-def displacement_change_empirical(dp_i: ArrayLike, speed: ArrayLike,
-                                  coef: LossCoefficients) -> FloatArray:
+def displacement_change_empirical(dp_i: Real, speed: Real, c1: float,
+                                  c2: float) -> Real:
     r"""
     Compute the empirical change of displacement Delta q, eq. (39).
 
@@ -509,67 +425,49 @@ def displacement_change_empirical(dp_i: ArrayLike, speed: ArrayLike,
     Parameters
     ----------
     dp_i : float or ndarray
-        Pressure drop in the working chambers, [Pa]
+        Pressure drop in the working chambers, at least :data:`EMPIRICAL_DP_FLOOR`, [Pa]
     speed : float or ndarray
         Shaft speed n > 0, [rad/s]
-    coef : LossCoefficients
-        Coefficient set (C_1, C_2 of eq. 39), [-]
+    c1 : float
+        C_1 of eq. (39), [cm^3/rev (rev/min)^0.5]
+    c2 : float
+        C_2 of eq. (39), [(rev/min)^0.5]
 
     Returns
     -------
-    ndarray
-        Delta q, [m^3/rad]
+    float or ndarray
+        Delta q, [m^3/rad]; Delta Q_vl = Delta q * n, eq. (32).
 
     Notes
     -----
     Fitted with n in rpm, dp_i in MPa and Delta q in cm^3/rev. The paper
     allows it only for low load: it is nearly independent of dp_i and biased
     at high dp_i. For dp_i > 1 MPa its loss Delta q * n grows without bound
-    as n -> 0, so it is used only above ``(C_2 ln dp_i)^2`` rpm, where that
-    loss is increasing in n.
+    as n -> 0, so it is used only above ``(C_2 ln dp_i)^2`` rpm
+    (:func:`empirical_speed_floor`), where that loss is increasing in n.
 
-    Below :data:`EMPIRICAL_DP_FLOOR` (1 MPa) dp_i is taken as 1 MPa, so that
-    Delta q = C_1/sqrt(n) there. As printed, dp_i^(C_2/sqrt(n)) falls to 0^x = 0
-    at dp_i = 0 but only logarithmically slowly (it is still 0.9 at 1 Pa), so
-    the law would jump at an unloaded motor and eqs. (34)-(36) would have no
-    root near it. The paper fitted eq. (39) on 2-25 MPa; at 0 MPa the eq. (33)
+    Below :data:`EMPIRICAL_DP_FLOOR` (1 MPa) the model takes dp_i as 1 MPa
+    (:class:`~satmotor_ros.model.laws.EmpiricalLaw`), so that Delta q =
+    C_1/sqrt(n) there. As printed, dp_i^(C_2/sqrt(n)) falls to 0^x = 0 at
+    dp_i = 0 but only logarithmically slowly (it is still 0.9 at 1 Pa), so the
+    law would jump at an unloaded motor and eqs. (34)-(36) would have no root
+    near it. The paper fitted eq. (39) on 2-25 MPa; at 0 MPa the eq. (33)
     counterpart, C_id/sqrt(n), is pressure-independent as well.
 
-    """
-    inv_sqrt_n = 1.0 / np.sqrt(np.asarray(speed, dtype=float) / RPM)
-    dp_mpa = np.maximum(np.asarray(dp_i, dtype=float) / MPA, EMPIRICAL_DP_FLOOR / MPA)
-    return coef.c1_39 * inv_sqrt_n * dp_mpa ** (coef.c2_39 * inv_sqrt_n) * CM3_PER_REV
-
-
-def displacement_loss_empirical(dp_i: ArrayLike, speed: ArrayLike,
-                                coef: LossCoefficients) -> FloatArray:
-    r"""
-    Compute the speed-dependent losses with the empirical Delta q, eqs. (32), (39).
-
-    .. math:: \Delta Q_{vl} = C_1\,\sqrt{n}\,\Delta p_i^{C_2/\sqrt{n}}
-
-    Parameters
-    ----------
-    dp_i : float or ndarray
-        Pressure drop in the working chambers, [Pa]
-    speed : float or ndarray
-        Shaft speed n; 0 gives 0 (no revolution, no displacement loss), [rad/s]
-    coef : LossCoefficients
-        Coefficient set (C_1, C_2 of eq. 39), [-]
-
-    Returns
-    -------
-    ndarray
-        Delta Q_vl, [m^3/s]
+    Examples
+    --------
+    >>> from satmotor_ros.model.config import load_motor
+    >>> coef = load_motor().sets['oil'].coefficients
+    >>> dq = displacement_change_empirical(10 * MPA, 1000 * RPM, coef.c1_39, coef.c2_39)
+    >>> round(dq * 2 * 3.141592653589793 * 1e6, 4)  # cm^3/rev
+    0.3727
 
     """
-    speed = np.asarray(speed, dtype=float)
-    moving = speed > 0.0
-    safe = np.where(moving, speed, 1.0)
-    return np.where(moving, displacement_change_empirical(dp_i, safe, coef) * safe, 0.0)
+    inv_sqrt_n = 1.0 / (speed / RPM) ** 0.5
+    return c1 * inv_sqrt_n * (dp_i / MPA) ** (c2 * inv_sqrt_n) * CM3_PER_REV
 
 
-def empirical_speed_floor(dp_i: ArrayLike, coef: LossCoefficients) -> FloatArray:
+def empirical_speed_floor(dp_i: Real, c2: float) -> Real:
     r"""
     Compute the lowest speed at which eq. (39) is used.
 
@@ -581,20 +479,20 @@ def empirical_speed_floor(dp_i: ArrayLike, coef: LossCoefficients) -> FloatArray
     ----------
     dp_i : float or ndarray
         Pressure drop in the working chambers, [Pa]
-    coef : LossCoefficients
-        Coefficient set (C_2 of eq. 39), [-]
+    c2 : float
+        C_2 of eq. (39), [(rev/min)^0.5]
 
     Returns
     -------
-    ndarray
+    float or ndarray
         n_min, [rad/s]; 0 for dp_i <= 1 MPa.
 
     """
-    dp_mpa = np.maximum(np.asarray(dp_i, dtype=float) / MPA, 1.0)
-    return (coef.c2_39 * np.log(dp_mpa)) ** 2 * RPM
+    root = c2 * log(maximum(dp_i / MPA, 1.0))
+    return root * root * RPM
 
 
-def external_leakage(p_ex: ArrayLike, coef: LossCoefficients) -> FloatArray:
+def external_leakage(p_ex: Real, k_ex: float) -> Real:
     r"""
     Compute the external leakage Q_ex, eq. (24) in lumped form.
 
@@ -609,39 +507,36 @@ def external_leakage(p_ex: ArrayLike, coef: LossCoefficients) -> FloatArray:
     ----------
     p_ex : float or ndarray
         Pressure difference driving the external leak, [Pa]
-    coef : LossCoefficients
-        Coefficient set (external_leakage = k_ex), [-]
+    k_ex : float
+        Lumped coefficient k_ex (``coefficients.external_leakage``), [m^3/(s*Pa)]
 
     Returns
     -------
-    ndarray
+    float or ndarray
         External leakage Q_ex, [m^3/s]
 
     """
-    return coef.external_leakage * np.asarray(p_ex, dtype=float)
+    return k_ex * p_ex
 
 
-def channel_pressure_drop(flow: ArrayLike, nu: ArrayLike, rho: ArrayLike,
-                          coef: LossCoefficients) -> FloatArray:
+def channel_pressure_drop(flow: Real, turbulent: float, laminar: float) -> Real:
     r"""
     Compute the pressure drop in the internal channels Delta p_ich, eq. (35).
 
-    .. math:: \Delta p_{ich} = C_t\,\rho\,Q^2 + C_l\,\mu\,Q
+    .. math:: \Delta p_{ich} = C_t\,\rho\,Q^2 + C_l\,\mu\,Q = (a\,Q + b)\,Q
 
     Parameters
     ----------
     flow : float or ndarray
         Flow through the motor (absorbency) Q, [m^3/s]
-    nu : float or ndarray
-        Kinematic viscosity of the liquid, [m^2/s]
-    rho : float or ndarray
-        Density of the liquid, [kg/m^3]
-    coef : LossCoefficients
-        Coefficient set (C_t, C_l), [-]
+    turbulent : float
+        a = C_t rho from :func:`channel_coefficients`, [Pa/(m^3/s)^2]
+    laminar : float
+        b = C_l mu from :func:`channel_coefficients`, [Pa/(m^3/s)]
 
     Returns
     -------
-    ndarray
+    float or ndarray
         Delta p_ich, [Pa]
 
     Notes
@@ -652,21 +547,16 @@ def channel_pressure_drop(flow: ArrayLike, nu: ArrayLike, rho: ArrayLike,
     Examples
     --------
     >>> from satmotor_ros.model.config import load_motor
-    >>> spec = load_motor()
-    >>> oil = spec.sets['oil']
-    >>> dp = channel_pressure_drop(40 * LPM, oil.liquid.kinematic_viscosity,
-    ...                            oil.liquid.density, oil.coefficients)
-    >>> round(float(dp) / 1e6, 2)
+    >>> oil = load_motor().sets['oil']
+    >>> a, b = channel_coefficients(oil.liquid, oil.coefficients)
+    >>> round(channel_pressure_drop(40 * LPM, a, b) / 1e6, 2)
     1.76
 
     """
-    turbulent, laminar = channel_coefficients(nu, rho, coef)
-    flow = np.asarray(flow, dtype=float)
     return (turbulent * flow + laminar) * flow
 
 
-def channel_coefficients(nu: ArrayLike, rho: ArrayLike,
-                         coef: LossCoefficients) -> tuple[FloatArray, FloatArray]:
+def channel_coefficients(liquid: Liquid, coef: LossCoefficients) -> tuple[float, float]:
     r"""
     Compute the constants of eq. (35): Delta p_ich = (a Q + b) Q.
 
@@ -674,27 +564,25 @@ def channel_coefficients(nu: ArrayLike, rho: ArrayLike,
 
     Parameters
     ----------
-    nu : float or ndarray
-        Kinematic viscosity of the liquid, [m^2/s]
-    rho : float or ndarray
-        Density of the liquid, [kg/m^3]
+    liquid : Liquid
+        The liquid through the channels (rho, mu = rho nu), [-]
     coef : LossCoefficients
         Coefficient set (C_t, C_l), [-]
 
     Returns
     -------
-    turbulent : ndarray
+    turbulent : float
         a, for Q in m^3/s, [Pa/(m^3/s)^2]
-    laminar : ndarray
+    laminar : float
         b, for Q in m^3/s, [Pa/(m^3/s)]
 
     """
-    rho = np.asarray(rho, dtype=float)
-    mu_mpas = rho * np.asarray(nu, dtype=float) * 1.0e3
-    return (coef.c_t / (LPM * LPM)) * rho, (coef.c_l / LPM) * mu_mpas
+    rho = liquid.density
+    mu_mpas = rho * liquid.kinematic_viscosity * 1.0e3
+    return float((coef.c_t / (LPM * LPM)) * rho), float((coef.c_l / LPM) * mu_mpas)
 
 
-def chamber_pressure_drop(dp: ArrayLike, dp_ich: ArrayLike) -> FloatArray:
+def chamber_pressure_drop(dp: Real, dp_ich: Real) -> Real:
     r"""
     Compute the pressure drop in the working chambers Delta p_i, eq. (34).
 
@@ -709,8 +597,8 @@ def chamber_pressure_drop(dp: ArrayLike, dp_ich: ArrayLike) -> FloatArray:
 
     Returns
     -------
-    ndarray
+    float or ndarray
         Delta p_i, [Pa]
 
     """
-    return np.asarray(dp, dtype=float) - np.asarray(dp_ich, dtype=float)
+    return dp - dp_ich

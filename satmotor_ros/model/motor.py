@@ -22,20 +22,32 @@ from typing import Literal
 from satmotor_ros.model._typing import ArrayLike
 from satmotor_ros.model.coefficients import (CoefficientSet, Liquid, MotorGeometry,
                                              ValidRange)
-from satmotor_ros.model.composition import Equations
 from satmotor_ros.model.conditioned import ConditionedModel, map_points
 from satmotor_ros.model.config import load_motor, MotorSpec
-from satmotor_ros.model.derived import derive
+from satmotor_ros.model.core import ModelCore
 from satmotor_ros.model.effects import true_flow, true_speed
 from satmotor_ros.model.errors import ModelError
 from satmotor_ros.model.forward import absorbency_map
 from satmotor_ros.model.inverse import speed_map
-from satmotor_ros.model.laws import displacement_law as build_law
-from satmotor_ros.model.point import as_float, PointEvaluator
+from satmotor_ros.model.point import as_float
 from satmotor_ros.model.results import LossBreakdown, OperatingPoints, Point
 from satmotor_ros.model.screening import Errors
 
 DisplacementLaw = Literal['eq33', 'eq39']
+
+
+def _derived(name: str, doc: str) -> property:
+    """Return a read-only property that reads `name` off the model's derived constants."""
+    return property(lambda model: getattr(model.derived, name), doc=doc)
+
+
+def _point_dp(dp: object, dp_i: object) -> tuple[bool, float]:
+    """Return whether the drop is between the ports, and the drop as a float, [Pa]."""
+    if dp_i is None and dp is not None:
+        return True, dp if type(dp) is float else as_float('dp', dp)
+    if dp is None and dp_i is not None:
+        return False, dp_i if type(dp_i) is float else as_float('dp_i', dp_i)
+    raise ModelError('give exactly one of dp (between the ports) and dp_i (chambers)')
 
 
 class MotorModel:
@@ -79,44 +91,24 @@ class MotorModel:
         self.valid_range = valid_range
         self.liquid = liquid if liquid is not None else coefficient_set.liquid
         self.coef = coefficient_set.coefficients
-        self.derived = derive(geometry, coefficient_set, valid_range, self.liquid)
-        self.law = build_law(displacement_law, self.derived, geometry, self.coef)
         self.displacement_law = displacement_law
-        self._equations = Equations(geometry, self.coef, self.liquid, self.derived, self.law)
-        self._point = PointEvaluator(self.derived, not self.law.closed_form)
+        core = ModelCore(geometry, coefficient_set, valid_range, self.liquid, displacement_law)
+        self.derived, self.law = core.derived, core.eqs.law
+        self._equations, self._point = core.eqs, core.point
         self.effects = coefficient_set.effects
-        self._conditioned = ConditionedModel(self) if self.effects else None
+        self._conditioned = ConditionedModel(core) if self.effects else None
         self.channels = self._conditioned.channels if self._conditioned else ()
 
-    @property
-    def c_fc_beta(self) -> float:
-        """C_fc*beta_l of eq. (11) for this liquid, [1/(MPa*rev)]."""
-        return self.derived.c_fc_beta
-
-    @property
-    def c_dch(self) -> float:
-        """C_dch of eq. (12), [1/(MPa*rev)]."""
-        return self.derived.c_dch
-
-    @property
-    def c_b(self) -> float:
-        """C_b of eq. (13), [1/(MPa*rev)]."""
-        return self.derived.c_b
-
-    @property
-    def c_lumped(self) -> float:
-        """C of eq. (33) for this liquid (``coef.c`` is the fitted one), [1/(MPa*rev)]."""
-        return self.derived.c_lumped
-
-    @property
-    def c(self) -> float:
-        """Alias of :attr:`c_lumped`, kept for existing callers, [1/(MPa*rev)]."""
-        return self.derived.c_lumped
-
-    @property
-    def dp_limit(self) -> float:
-        """Chamber drop where eq. (1) would start to fall with pressure, [Pa]."""
-        return self.derived.dp_limit
+    # constants of the equations for this liquid, read from :attr:`derived`
+    c_fc_beta = _derived('c_fc_beta', 'C_fc*beta_l of eq. (11) for this liquid, [1/(MPa*rev)].')
+    c_dch = _derived('c_dch', 'C_dch of eq. (12), [1/(MPa*rev)].')
+    c_b = _derived('c_b', 'C_b of eq. (13), [1/(MPa*rev)].')
+    c_lumped = _derived('c_lumped', 'C of eq. (33) for this liquid (``coef.c`` is the fitted '
+                        'one), [1/(MPa*rev)].')
+    c = _derived('c_lumped', 'Alias of :attr:`c_lumped`, kept for existing callers, '
+                 '[1/(MPa*rev)].')
+    dp_limit = _derived('dp_limit', 'Chamber drop where eq. (1) would start to fall with '
+                        'pressure, [Pa].')
 
     @classmethod
     def from_spec(cls, spec: MotorSpec, coefficients: str = 'oil', liquid: Liquid | None = None,
@@ -214,7 +206,8 @@ class MotorModel:
                 lambda q, d, p, c: self.speed_point(q, **{dp_name: d}, p_ex=p, channels=c),
                 ('flow', flow), (dp_name, dp_value), p_ex, channels, self.geometry, errors)
         closed_form = self.law.closed_form and method == 'auto'
-        return speed_map(self._equations, flow, dp_name, dp_value, p_ex, errors, closed_form)
+        return speed_map(self._equations, self.geometry, flow, dp_name, dp_value, p_ex, errors,
+                         closed_form)
 
     def absorbency(self, speed: ArrayLike, dp: ArrayLike | None = None, *,
                    dp_i: ArrayLike | None = None, p_ex: ArrayLike = 0.0,
@@ -253,7 +246,8 @@ class MotorModel:
             return map_points(
                 lambda n, d, p, c: self.absorbency_point(n, **{dp_name: d}, p_ex=p, channels=c),
                 ('speed', speed), (dp_name, dp_value), p_ex, channels, self.geometry, errors)
-        return absorbency_map(self._equations, speed, dp_name, dp_value, p_ex, errors)
+        return absorbency_map(self._equations, self.geometry, speed, dp_name, dp_value, p_ex,
+                              errors)
 
     @staticmethod
     def _which_dp(dp: ArrayLike | None, dp_i: ArrayLike | None) -> tuple[str, ArrayLike]:
@@ -328,18 +322,9 @@ class MotorModel:
             number, or an effect's channel is missing.
 
         """
-        if dp is None:
-            if dp_i is None:
-                self._which_dp(dp, dp_i)
-            port, value = False, dp_i
-        elif dp_i is None:
-            port, value = True, dp
-        else:
-            self._which_dp(dp, dp_i)
+        port, value = _point_dp(dp, dp_i)
         if type(flow) is not float:
             flow = as_float('flow', flow)
-        if type(value) is not float:
-            value = as_float('dp' if port else 'dp_i', value)
         if type(p_ex) is not float:
             p_ex = as_float('p_ex', p_ex)
         if self._conditioned is not None:
@@ -384,18 +369,9 @@ class MotorModel:
             If not exactly one of `dp` and `dp_i` is given, or an argument is not a number.
 
         """
-        if dp is None:
-            if dp_i is None:
-                self._which_dp(dp, dp_i)
-            port, value = False, dp_i
-        elif dp_i is None:
-            port, value = True, dp
-        else:
-            self._which_dp(dp, dp_i)
+        port, value = _point_dp(dp, dp_i)
         if type(speed) is not float:
             speed = as_float('speed', speed)
-        if type(value) is not float:
-            value = as_float('dp' if port else 'dp_i', value)
         if type(p_ex) is not float:
             p_ex = as_float('p_ex', p_ex)
         if flow_guess is not None and type(flow_guess) is not float:

@@ -4,24 +4,22 @@ One operating point on Python floats: the model at a few microseconds a call.
 
 The array maps of :class:`~satmotor_ros.model.MotorModel` pay numpy's fixed
 cost per call (tens of microseconds), which a 1 kHz plant cannot afford. This
-module evaluates the same equations for a single point on Python floats. Every
-constant comes from :class:`~satmotor_ros.model.derived.DerivedCoefficients`,
-which reads it off the equation functions' own helpers; what is left here is
-the form of each equation (a product, a power), and the tests hold it equal to
-the equation functions and the array maps to 1e-12 on dense grids.
+module evaluates one point with the very equation functions, composed by
+:class:`~satmotor_ros.model.composition.Equations`, and the scalar form of the
+solver the array maps use; only the screening and the status flags are written
+for floats here.
 """
 
 from __future__ import annotations
 
 import math
 
-from satmotor_ros.model.derived import DerivedCoefficients
+from satmotor_ros.model.composition import Equations
 from satmotor_ros.model.errors import InvalidInputError
-from satmotor_ros.model.inverse import RTOL, SPEED_ATOL
-from satmotor_ros.model.losses import EMPIRICAL_DP_FLOOR
 from satmotor_ros.model.results import Point, PointStatus
-from satmotor_ros.model.screening import CHECK, FLOW_ATOL
-from satmotor_ros.model.units import CM3_PER_REV, MPA, RPM
+from satmotor_ros.model.screening import CHECK, FLOW_ATOL, FLOW_SOLVE, SPEED_SOLVE
+from satmotor_ros.model.solve import solve_increasing_scalar
+from satmotor_ros.model.speed import absorbency
 
 _NOT_FINITE = int(PointStatus.NOT_FINITE)
 _NEGATIVE = int(PointStatus.NEGATIVE)
@@ -29,10 +27,8 @@ _BEYOND_LIMIT = int(PointStatus.BEYOND_LIMIT)
 _STALLED = int(PointStatus.STALLED)
 _CHANNEL_LIMITED = int(PointStatus.CHANNEL_LIMITED)
 _EXTRAPOLATED = int(PointStatus.EXTRAPOLATED)
-_FLOOR_MPA = EMPIRICAL_DP_FLOOR / MPA
 _NO_ROOT = int(PointStatus.NO_ROOT)
 _NOT_CONVERGED = int(PointStatus.NOT_CONVERGED)
-_ROOT_ATOL = math.sqrt(SPEED_ATOL)  # the speed solve's resolution in x = sqrt(n)
 _INF = math.inf
 _NAN = math.nan
 _new_point = tuple.__new__
@@ -89,46 +85,16 @@ class PointEvaluator:
 
     Parameters
     ----------
-    derived : DerivedCoefficients
-        The model's constants, [-]
-    empirical : bool
-        True for Delta q from eq. (39), False for eq. (33), [-]
+    eqs : Equations
+        The model's equations, [-]
 
     """
 
-    def __init__(self, derived: DerivedCoefficients, empirical: bool) -> None:
-        """Keep the constants and the law."""
-        self.d = derived
-        self.empirical = empirical
-
-    # -- equations ------------------------------------------------------------------------
-
-    def leakage(self, dp_i: float, p_ex: float) -> tuple[float, float, float]:
-        """Return Q_Lfg, Q_C and Q_ex of eqs. (1), (2), (5) and (24), [m^3/s]."""
-        d = self.d
-        h = d.h0 - d.compliance * dp_i
-        q_ex = d.k_ex * p_ex if d.k_ex else 0.0
-        return d.lfg_k * (h * h * h * dp_i) ** d.lfg_e, d.com_k * dp_i ** d.com_e, q_ex
-
-    def empirical_loss(self, speed: float, dp_i: float) -> float:
-        """Return Delta Q_vl = Delta q * n with Delta q of eq. (39), [m^3/s]."""
-        if speed <= 0.0:
-            return 0.0
-        inv_sqrt_n = 1.0 / math.sqrt(speed / RPM)
-        d = self.d
-        dp_mpa = dp_i / MPA if dp_i > EMPIRICAL_DP_FLOOR else _FLOOR_MPA
-        return (d.c1_39 * inv_sqrt_n * dp_mpa ** (d.c2_39 * inv_sqrt_n) * CM3_PER_REV) * speed
-
-    def displacement_loss(self, speed: float, dp_i: float) -> float:
-        """Return Delta Q_vl of eq. (33) or (39), [m^3/s]."""
-        if self.empirical:
-            return self.empirical_loss(speed, dp_i)
-        d = self.d
-        return d.k_p * dp_i * speed + d.k_i * math.sqrt(speed)
-
-    def speed_floor(self, dp_i: float) -> float:
-        """Return the lowest speed at which eq. (39) is used, [rad/s]."""
-        return (self.d.c2_39 * math.log(max(dp_i / MPA, 1.0))) ** 2 * RPM
+    def __init__(self, eqs: Equations) -> None:
+        """Keep the equations."""
+        self.eqs = eqs
+        self.d = d = eqs.derived
+        self._range = (d.dp_max, d.speed_max, d.dp_min, d.speed_min, d.liquid_extrapolated)
 
     def _point(self, flow: float | None, speed: float, dp: float | None, dp_i: float,
                q_lfg: float, q_c: float, q_ex: float, status: int) -> Point:
@@ -138,254 +104,86 @@ class PointEvaluator:
         A `flow` of None is the absorbency of eq. (36); a `dp` of None is dp_i
         plus the channel drop of eq. (35) at that flow.
         """
-        d = self.d
-        fc = d.k_fc * dp_i * speed
-        dch = d.k_dch * dp_i * speed
-        bl = d.k_b * dp_i * speed
-        ine = d.k_i * math.sqrt(speed)
-        if self.empirical:
-            physical = fc + dch + bl + ine
-            scale = self.empirical_loss(speed, dp_i) / physical if physical > 0.0 else 0.0
-            fc, dch, bl, ine = fc * scale, dch * scale, bl * scale, ine * scale
-        total = q_lfg + q_c + q_ex + ((fc + dch) + (bl + ine))
-        if (dp_i > d.dp_max or speed > d.speed_max or dp_i < d.dp_min or speed < d.speed_min
-                or d.liquid_extrapolated):
+        fc, dch, bl, ine, total = self.eqs.breakdown(speed, dp_i, q_lfg + q_c + q_ex)
+        dp_max, speed_max, dp_min, speed_min, liquid_extrapolated = self._range
+        if (dp_i > dp_max or speed > speed_max or dp_i < dp_min or speed < speed_min
+                or liquid_extrapolated):
             status |= _EXTRAPOLATED
         if flow is None:
-            flow = d.qt * speed + total
+            flow = absorbency(speed, total, self.d.qt)
         if dp is None:
-            dp = dp_i + (d.ch_a * flow + d.ch_b) * flow
+            dp = dp_i + self.eqs.channel_drop(flow)
         return _new_point(Point, (flow, speed, dp, dp_i, q_lfg, q_c, fc, dch, bl, ine, q_ex,
                                   total, status))
 
-    # -- maps -----------------------------------------------------------------------------
+    def _chamber(self, dp: float, flow: float, port: bool) -> tuple[float, int]:
+        """Return dp_i of eqs. (34)-(35) clipped at 0, and CHANNEL_LIMITED or BEYOND_LIMIT."""
+        if not port:
+            return dp, (_BEYOND_LIMIT if dp > self.d.dp_limit else 0)
+        dp_i = self.eqs.chamber_drop(dp, flow)
+        if dp_i < 0.0:
+            return 0.0, _CHANNEL_LIMITED
+        return dp_i, (_BEYOND_LIMIT if dp_i > self.d.dp_limit else 0)
 
     def speed(self, flow: float, dp: float, port: bool, p_ex: float) -> Point:
-        """
-        Compute the inverse map n(Q, dp) at one point.
-
-        Parameters
-        ----------
-        flow : float
-            Flow into the motor Q, [m^3/s]
-        dp : float
-            Port drop if `port`, else chamber drop, [Pa]
-        port : bool
-            Whether `dp` is between the ports, [-]
-        p_ex : float
-            Pressure driving the external leakage, [Pa]
-
-        Returns
-        -------
-        Point
-            The operating point.
-
-        """
-        status = _screen(flow) | _screen(dp) | _screen(p_ex)
-        if status:
+        """Compute n(Q, dp) at one point: :meth:`MotorModel.speed_point` without effects."""
+        if not (0.0 <= flow < _INF and 0.0 <= dp < _INF and 0.0 <= p_ex < _INF):
+            return _invalid(_screen(flow) | _screen(dp) | _screen(p_ex))
+        eqs = self.eqs
+        dp_i, status = self._chamber(dp, flow, port)
+        if status & _BEYOND_LIMIT:
             return _invalid(status)
-        d = self.d
-        if port:
-            dp_i = dp - (d.ch_a * flow + d.ch_b) * flow
-            if dp_i < 0.0:
-                status = _CHANNEL_LIMITED
-                dp_i = 0.0
-        else:
-            dp_i = dp
-        if dp_i > d.dp_limit:
-            return _invalid(_BEYOND_LIMIT)
-        q_lfg, q_c, q_ex = self.leakage(dp_i, p_ex)
+        q_lfg, q_c, q_ex = eqs.leakage(dp_i, p_ex)
         leak = q_lfg + q_c + q_ex
-        if self.empirical:
+        if eqs.closed_form:
+            speed = eqs.closed_form_speed(flow, dp_i, leak)
+        else:
             speed, failed = self._solve_speed(flow, dp_i, leak)
             if failed:
                 return _invalid(failed)
-        else:
-            x = flow - leak
-            x = x * d.es_scale if x > 0.0 else 0.0
-            two_a = d.es_a0 + d.es_a1 * dp_i
-            if d.es_b == 0.0:
-                speed = x / two_a
-            else:
-                root = x / (math.sqrt(two_a * x + d.es_b * d.es_b) + d.es_b)
-                speed = root * root
         if speed == 0.0:
             status |= _STALLED
         point = self._point(flow, speed, dp if port else None, dp_i, q_lfg, q_c, q_ex, status)
-        if self.empirical and speed > 0.0 and not (
-                abs(d.qt * speed + point.total - flow) <= CHECK * flow + FLOW_ATOL):
+        if not eqs.closed_form and speed > 0.0 and not (
+                abs(absorbency(speed, point.total, self.d.qt) - flow)
+                <= CHECK * flow + FLOW_ATOL):
             return _invalid(_NO_ROOT)
         return point
 
     def _solve_speed(self, flow: float, dp_i: float, leak: float) -> tuple[float, int]:
-        """
-        Solve eq. (36) with eq. (39) for n at given flow and dp_i (Newton, bracketed).
-
-        Like the coupled solve, it stops without a confirming evaluation once
-        two Newton evaluations show that the error left is far below tolerance.
-        """
-        d = self.d
-        qt = d.qt
-        hi = max(flow - leak, 0.0) / qt
-        lo = self.speed_floor(dp_i)
-        if not (qt * lo + (self.empirical_loss(lo, dp_i) + leak) < flow and hi > lo):
+        """Solve eq. (36) for n at given flow and dp_i; return n and a status flag."""
+        lo, hi, residual = self.eqs.speed_problem(flow, dp_i, leak)
+        if not hi > lo:
             return 0.0, (_NO_ROOT if hi > 0.0 and lo > 0.0 else 0)
-        above = dp_i > EMPIRICAL_DP_FLOOR
-        dp_mpa = dp_i / MPA if above else _FLOOR_MPA
-        log_dp = math.log(dp_mpa)
-        c1, c2 = d.c1_39, d.c2_39
-        # solved in x = sqrt(n), where the loss is nearly linear at low speed
-        lo, hi = math.sqrt(lo), math.sqrt(hi)
-        x = hi
-        last_x = last_slope = _NAN
-        for _ in range(60):
-            n = x * x
-            inv_sqrt_n = 1.0 / math.sqrt(n / RPM)
-            loss = (c1 * inv_sqrt_n * dp_mpa ** (c2 * inv_sqrt_n) * CM3_PER_REV) * n
-            f = qt * n + (loss + leak) - flow
-            if f < 0.0:
-                lo = x
-            elif f > 0.0:
-                hi = x
-            else:
-                return n, 0
-            slope = (qt + loss * (1.0 - c2 * log_dp * inv_sqrt_n) / (2.0 * n)) * 2.0 * x
-            step = f / slope
-            newton = x - step
-            if lo <= newton <= hi:
-                size = abs(step)
-                if size <= (RTOL * x + _ROOT_ATOL):
-                    return newton * newton, 0
-                if (abs(slope - last_slope) * size * size
-                        <= 1e-3 * (RTOL * x + _ROOT_ATOL) * abs(x - last_x) * slope):
-                    return newton * newton, 0
-                last_x, last_slope, x = x, slope, newton
-            elif hi - lo <= (RTOL * x + _ROOT_ATOL):
-                return n, 0
-            else:
-                last_x, last_slope, x = x, _NAN, 0.5 * (lo + hi)
-        return x * x, _NOT_CONVERGED
+        if lo > 0.0 and not residual(lo)[0] < 0.0:
+            return 0.0, _NO_ROOT
+        return solve_increasing_scalar(residual, lo, hi, hi, SPEED_SOLVE, CHECK * flow + FLOW_ATOL)
 
     def absorbency(self, speed: float, dp: float, port: bool, p_ex: float,
                    flow_guess: float | None) -> Point:
-        """
-        Compute the forward map Q(n, dp) at one point.
-
-        Parameters
-        ----------
-        speed : float
-            Shaft speed n, [rad/s]
-        dp : float
-            Port drop if `port`, else chamber drop, [Pa]
-        port : bool
-            Whether `dp` is between the ports, [-]
-        p_ex : float
-            Pressure driving the external leakage, [Pa]
-        flow_guess : float or None
-            Starting estimate of Q for the coupled solve, [m^3/s]
-
-        Returns
-        -------
-        Point
-            The operating point.
-
-        """
-        status = _screen(speed) | _screen(dp) | _screen(p_ex)
-        if status:
-            return _invalid(status)
-        d = self.d
+        """Compute Q(n, dp) at one point: :meth:`MotorModel.absorbency_point` without effects."""
+        if not (0.0 <= speed < _INF and 0.0 <= dp < _INF and 0.0 <= p_ex < _INF):
+            return _invalid(_screen(speed) | _screen(dp) | _screen(p_ex))
+        eqs = self.eqs
+        root = speed  # not used without `port`
         if port:
-            root, failed = self._solve_flow(speed, dp, p_ex, flow_guess)
+            lo, upper, residual = eqs.flow_problem(speed, dp, p_ex)
+            if flow_guess is not None and lo < flow_guess < _INF:
+                hi, start = _INF, flow_guess
+            else:  # no useful guess: start at the upper bound
+                hi = start = upper()
+            root, failed = solve_increasing_scalar(residual, lo, hi, start, FLOW_SOLVE, FLOW_ATOL,
+                                                   True)
             if failed:
                 return _invalid(failed)
-            dp_i = dp - (d.ch_a * root + d.ch_b) * root
-            if dp_i < 0.0:
-                status = _CHANNEL_LIMITED
-                dp_i = 0.0
-        else:
-            dp_i = dp
-        if dp_i > d.dp_limit:
+        dp_i, status = self._chamber(dp, root, port)
+        if status & _BEYOND_LIMIT:
+            return _invalid(status)
+        law = eqs.law
+        if 0.0 < speed < law.max_floor and speed < law.floor(dp_i):
             return _invalid(_BEYOND_LIMIT)
-        if self.empirical and 0.0 < speed < self.speed_floor(dp_i):
-            return _invalid(_BEYOND_LIMIT)
-        q_lfg, q_c, q_ex = self.leakage(dp_i, p_ex)
+        q_lfg, q_c, q_ex = eqs.leakage(dp_i, p_ex)
         point = self._point(None, speed, dp if port else None, dp_i, q_lfg, q_c, q_ex, status)
         if port and not abs(point.flow - root) <= CHECK * root + FLOW_ATOL:
             return _invalid(_NO_ROOT)
         return point
-
-    def _solve_flow(self, speed: float, dp: float, p_ex: float,
-                    guess: float | None) -> tuple[float, int]:
-        """
-        Solve eqs. (34)-(36) together for Q at given n and port dp.
-
-        The flow absorbed, A(Q), falls as Q rises (more channel drop, less
-        chamber drop), so every evaluation brackets the root of f = Q - A(Q)
-        between Q and A(Q); Newton steps from `guess` stay inside the bracket.
-        Once two evaluations give the curvature, a step whose predicted error
-        (curvature * step^2) is far below the tolerance ends the solve without
-        one more evaluation to confirm it.
-        """
-        d = self.d
-        dp_cap = dp if dp < d.dp_limit else d.dp_limit
-        ch_a, ch_b, h0, compliance = d.ch_a, d.ch_b, d.h0, d.compliance
-        lfg_k, lfg_e, com_k, com_e = d.lfg_k, d.lfg_e, d.com_k, d.com_e
-        base = d.qt * speed + 0.0  # q_t n
-        q_ex = d.k_ex * p_ex if d.k_ex else 0.0
-        empirical = self.empirical
-        if empirical:
-            inv_sqrt_n = 1.0 / math.sqrt(speed / RPM) if speed > 0.0 else 0.0
-            c1, c2 = d.c1_39 * inv_sqrt_n, d.c2_39 * inv_sqrt_n
-        else:
-            k_pn, ine = d.k_p * speed, d.k_i * math.sqrt(speed)
-        lo, hi = base, _INF
-        x = guess if guess is not None and lo < guess < _INF else dp_cap * 0.0
-        last_x = last_slope = _NAN
-        for _ in range(60):
-            dp_i = dp_cap - (ch_a * x + ch_b) * x
-            if dp_i <= 0.0:
-                dp_i = 0.0
-            h = h0 - compliance * dp_i
-            q_lfg = lfg_k * (h * h * h * dp_i) ** lfg_e
-            q_c = com_k * dp_i ** com_e
-            if empirical:
-                above = dp_i > EMPIRICAL_DP_FLOOR
-                dp_mpa = dp_i / MPA if above else _FLOOR_MPA
-                loss = (c1 * dp_mpa ** c2 * CM3_PER_REV) * speed
-                d_loss = loss * c2 / dp_i if above else 0.0
-            else:
-                loss = k_pn * dp_i + ine
-                d_loss = k_pn
-            absorbed = base + (loss + q_lfg + q_c + q_ex)
-            f = x - absorbed
-            if f < 0.0:
-                lo = x if x > lo else lo
-                hi = absorbed if absorbed < hi else hi
-            elif f > 0.0:
-                hi = x if x < hi else hi
-                lo = absorbed if absorbed > lo else lo
-            else:
-                return x, 0
-            if dp_i > 0.0:
-                d_leak = (q_lfg * lfg_e * (1.0 / dp_i - 3.0 * compliance / h)
-                          + q_c * com_e / dp_i)
-                slope = 1.0 + (d_leak + d_loss) * (2.0 * ch_a * x + ch_b)
-            else:
-                slope = _NAN  # the kink at dp_i = 0: no curvature estimate across it
-            step = f / slope if dp_i > 0.0 else f
-            newton = x - step
-            if lo <= newton <= hi:
-                size = abs(step)
-                if size <= (RTOL * x + 0.01 * FLOW_ATOL):
-                    return newton, 0
-                # two Newton evaluations on the smooth side give the curvature, and with it
-                # the error left after this step
-                if (abs(slope - last_slope) * size * size
-                        <= 1e-3 * (RTOL * x + 0.01 * FLOW_ATOL) * abs(x - last_x) * slope):
-                    return newton, 0
-                last_x, last_slope, x = x, slope, newton
-            elif hi - lo <= (RTOL * x + 0.01 * FLOW_ATOL):
-                return x, 0
-            else:
-                last_x, last_slope, x = x, _NAN, 0.5 * (lo + hi)
-        return x, _NOT_CONVERGED

@@ -76,7 +76,7 @@ class OperatingPoints:
     @property
     def speed_loss(self) -> FloatArray:
         """Speed loss n_i against the theoretical speed Q/q_t, eq. (41), [rad/s]."""
-        return speed_loss(self.flow, self.speed, self.geometry)
+        return speed_loss(self.flow, self.speed, self.geometry.displacement)
 
     @property
     def invalid(self) -> npt.NDArray[np.bool_]:

@@ -20,6 +20,7 @@ from satmotor_ros.model.derived import DerivedCoefficients
 from satmotor_ros.model.errors import InvalidInputError, ModelError
 from satmotor_ros.model.laws import DisplacementLaw
 from satmotor_ros.model.results import INVALID, PointStatus
+from satmotor_ros.model.solve import Tolerance
 from satmotor_ros.model.units import MPA
 
 Errors = Literal['raise', 'mask']
@@ -36,6 +37,26 @@ CHECK = 1e-10
 
 FLOW_ATOL = 1e-20
 """Absolute resolution of flows in the solves and their check, [m^3/s] (6e-16 l/min)."""
+
+FLOW_XTOL = 0.01 * FLOW_ATOL
+"""Absolute resolution of the flow solve, [m^3/s]."""
+
+RTOL = 1e-11
+"""
+Relative tolerance of the iterative maps.
+
+A solve ends on a Newton step smaller than this and takes the step, which
+leaves an error of the order of its square; only a bisection ends at it.
+"""
+
+SPEED_ATOL = 1e-40
+"""Absolute resolution of n in the speed solve, [rad/s]; its loss is below 1e-24 m^3/s."""
+
+SPEED_SOLVE = Tolerance(SPEED_ATOL, RTOL)
+"""Tolerances of eq. (36) solved for n (its check is relative to the flow)."""
+
+FLOW_SOLVE = Tolerance(FLOW_XTOL, RTOL, CHECK)
+"""Tolerances of eqs. (34)-(36) solved for Q."""
 
 
 def numbers(name: str, value: object) -> FloatArray:
@@ -224,16 +245,16 @@ def check_floor(speed: FloatArray, law: DisplacementLaw, dp_i: FloatArray, statu
         status |= below * np.uint8(PointStatus.BEYOND_LIMIT)
 
 
-def check_solution(value: FloatArray, target: FloatArray, converged: npt.NDArray[np.bool_],
+def check_solution(value: FloatArray, target: FloatArray, solved: Status,
                    checked: npt.NDArray[np.bool_], status: Status, errors: Errors,
                    name: tuple[str, str, FloatArray, At], what: str) -> None:
     """
-    Flag the points where an iterative solve left a residual, or did not converge.
+    Flag the points where an iterative solve failed, or its point does not hold eq. (36).
 
-    A solve that converged yet leaves a residual has closed its bracket on a
-    jump: NO_ROOT. One that ran out of iterations is NOT_CONVERGED. Invalid
-    points keep their flags; with ``errors='raise'`` the first flagged point
-    raises, NO_ROOT (also flagged by the solve itself) first.
+    The solver's own flags (NOT_CONVERGED, NO_ROOT) come first; a point it
+    accepted whose composed flow still misses the target is NO_ROOT too.
+    Invalid points keep their flags; with ``errors='raise'`` the first flagged
+    point raises, NO_ROOT (also flagged before the solve) first.
 
     Parameters
     ----------
@@ -241,8 +262,8 @@ def check_solution(value: FloatArray, target: FloatArray, converged: npt.NDArray
         The flow eq. (36) gives at the solution, [m^3/s]
     target : ndarray
         The flow it had to match, [m^3/s]
-    converged : ndarray of bool
-        What the solver reported, [-]
+    solved : ndarray of uint8
+        The solver's status per point, [-]
     checked : ndarray of bool
         The points to check, [-]
     status : ndarray of uint8
@@ -257,17 +278,17 @@ def check_solution(value: FloatArray, target: FloatArray, converged: npt.NDArray
     """
     with np.errstate(invalid='ignore'):
         off = ~(np.abs(value - target) <= CHECK * np.abs(target) + FLOW_ATOL)
-    if (not (off & checked).any() and converged.all()
-            and not (status & np.uint8(PointStatus.NO_ROOT)).any()):
+    no_root = np.uint8(PointStatus.NO_ROOT)
+    if not (off & checked).any() and not solved.any() and not (status & no_root).any():
         return  # the usual case: every solution checks out
-    open_ = checked & ((status & int(INVALID)) == 0)
-    status |= (off & converged & open_) * np.uint8(PointStatus.NO_ROOT)
-    status |= (~converged & open_) * np.uint8(PointStatus.NOT_CONVERGED)
+    open_ = (status & int(INVALID)) == 0
+    status |= np.where(open_, solved, 0).astype(np.uint8)
+    status |= (off & checked & open_ & (solved == 0)) * no_root
     if errors == 'raise':
         arg, unit, values, at = name
-        no_root = (status & np.uint8(PointStatus.NO_ROOT)) != 0
-        if no_root.any():
-            raise_first(arg, unit, values, no_root, f'{what} has no root here', at)
+        flagged = (status & no_root) != 0
+        if flagged.any():
+            raise_first(arg, unit, values, flagged, f'{what} has no root here', at)
         not_converged = (status & np.uint8(PointStatus.NOT_CONVERGED)) != 0
         if not_converged.any():
             raise_first(arg, unit, values, not_converged, f'{what} did not converge', at)

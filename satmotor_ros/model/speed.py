@@ -1,18 +1,22 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Absorbency, effective speed and speed loss: eqs. (36), (40) and (41) of Śliwiński (2017)."""
+"""
+Absorbency, effective speed and speed loss: eqs. (36), (40) and (41) of Śliwiński (2017).
+
+Like :mod:`.losses`, each equation is one function of plain arithmetic, correct
+on Python floats and on numpy arrays.
+"""
 
 from __future__ import annotations
 
 import math
 
-import numpy as np
-
-from satmotor_ros.model._typing import ArrayLike, FloatArray
+from satmotor_ros.model._numeric import maximum
+from satmotor_ros.model._typing import Real
 from satmotor_ros.model.coefficients import MotorGeometry
 from satmotor_ros.model.units import CM3_PER_MIN, MPA, RPM
 
 
-def absorbency(speed: ArrayLike, losses: ArrayLike, geometry: MotorGeometry) -> FloatArray:
+def absorbency(speed: Real, losses: Real, qt: float) -> Real:
     r"""
     Compute the flow a motor absorbs at a given speed, eq. (36).
 
@@ -25,20 +29,20 @@ def absorbency(speed: ArrayLike, losses: ArrayLike, geometry: MotorGeometry) -> 
         Shaft speed n, [rad/s]
     losses : float or ndarray
         Volumetric losses Q_vl of eq. (31), [m^3/s]
-    geometry : MotorGeometry
-        Motor geometry (q_t), [-]
+    qt : float
+        Theoretical displacement q_t, [m^3/rad]
 
     Returns
     -------
-    ndarray
+    float or ndarray
         Absorbency Q, [m^3/s]
 
     """
-    return geometry.displacement * np.asarray(speed, dtype=float) + losses
+    return qt * speed + losses
 
 
-def effective_speed(flow: ArrayLike, dp_i: ArrayLike, leakage: ArrayLike, c: float,
-                    c_id: float, geometry: MotorGeometry) -> FloatArray:
+def effective_speed(flow: Real, dp_i: Real, leakage: Real, a0: float,
+                    a1: float, scale: float, b: float) -> Real:
     r"""
     Compute the effective shaft speed from flow and pressure, eq. (40).
 
@@ -46,6 +50,9 @@ def effective_speed(flow: ArrayLike, dp_i: ArrayLike, leakage: ArrayLike, c: flo
         n = \left(\frac{\sqrt{b^2 + 4ac} - b}{2a}\right)^2,\quad
         a = q_t + C\,\Delta p_i\,m^2 H,\ b = C_{id}\,m^2 H,\
         c = Q - Q_{Lfg} - Q_C - Q_{ex}
+
+    evaluated in the folded, cancellation-free form
+    ``n = (x / (sqrt((a_0 + a_1 dp_i) x + b^2) + b))^2`` with ``x = s c``.
 
     Parameters
     ----------
@@ -55,30 +62,26 @@ def effective_speed(flow: ArrayLike, dp_i: ArrayLike, leakage: ArrayLike, c: flo
         Pressure drop in the working chambers, [Pa]
     leakage : float or ndarray
         Speed-independent losses Q_Lfg + Q_C + Q_ex, [m^3/s]
-    c : float
-        Lumped coefficient C of eq. (33), [1/(MPa*rev)]
-    c_id : float
-        Inertia coefficient C_id, [1/(rev*min)^0.5]
-    geometry : MotorGeometry
-        Motor geometry (q_t, m, H), [-]
+    a0 : float
+        Folded 2a at dp_i = 0 from :func:`effective_speed_coefficients`, [cm^3/rev (rad/s)^-0.5]
+    a1 : float
+        Its growth with dp_i, [cm^3/rev (rad/s)^-0.5 / Pa]
+    scale : float
+        s, from m^3/s to the folded unit of c, [(cm^3/min)/(m^3/s) (rad/s)^0.5]
+    b : float
+        C_id m^2 H, [cm^3/rev (rev/min)^0.5]
 
     Returns
     -------
-    ndarray
+    float or ndarray
         Effective speed n >= 0, [rad/s]; 0 where the leakage takes all the flow.
 
-    Notes
-    -----
-    Evaluated in the paper's units (cm^3, rpm) and in the cancellation-free
-    form ``n = (2c / (sqrt(b^2 + 4ac) + b))^2``, which equals eq. (40).
-
     """
-    a0, a1, scale, b = effective_speed_coefficients(c, c_id, geometry)
-    two_a = a0 + a1 * np.asarray(dp_i, dtype=float)
-    x = np.maximum(np.asarray(flow, dtype=float) - leakage, 0.0) * scale
+    two_a = a0 + a1 * dp_i
+    x = maximum(flow - leakage, 0.0) * scale
     if b == 0.0:
         return x / two_a
-    root = x / (np.sqrt(two_a * x + b * b) + b)
+    root = x / ((two_a * x + b * b) ** 0.5 + b)
     return root * root
 
 
@@ -103,8 +106,7 @@ def effective_speed_coefficients(c: float, c_id: float,
     Returns
     -------
     tuple of float
-        a_0 [cm^3/rev (rad/s)^-0.5], a_1 [a_0/Pa], s [(cm^3/min)/(m^3/s) (rad/s)^0.5] and
-        b = C_id m^2 H [cm^3/rev (rev/min)^0.5].
+        a_0, a_1, s and b, the arguments of :func:`effective_speed`.
 
     """
     # n [rad/s] = RPM (2c / (sqrt(b^2 + 4ac) + b))^2 with c in cm^3/min. With x = 2 sqrt(RPM) c
@@ -115,7 +117,7 @@ def effective_speed_coefficients(c: float, c_id: float,
             4.0 / (k * CM3_PER_MIN), c_id * m2h)
 
 
-def speed_loss(flow: ArrayLike, speed: ArrayLike, geometry: MotorGeometry) -> FloatArray:
+def speed_loss(flow: Real, speed: Real, qt: float) -> Real:
     r"""
     Compute the loss of speed against the theoretical speed, eq. (41).
 
@@ -127,13 +129,13 @@ def speed_loss(flow: ArrayLike, speed: ArrayLike, geometry: MotorGeometry) -> Fl
         Flow into the motor Q, [m^3/s]
     speed : float or ndarray
         Effective shaft speed n, [rad/s]
-    geometry : MotorGeometry
-        Motor geometry (q_t), [-]
+    qt : float
+        Theoretical displacement q_t, [m^3/rad]
 
     Returns
     -------
-    ndarray
+    float or ndarray
         Speed loss n_i, [rad/s]
 
     """
-    return np.asarray(flow, dtype=float) / geometry.displacement - np.asarray(speed, dtype=float)
+    return flow / qt - speed

@@ -1,0 +1,45 @@
+# SPDX-License-Identifier: Apache-2.0
+"""
+One motor on one liquid without its effects: constants, equations and the single-point path.
+
+Both :class:`~satmotor_ros.model.MotorModel` and the effects
+(:mod:`.conditioned`, which builds a variant of the motor per temperature or
+wear) build their motors here, so neither needs the other.
+"""
+
+from __future__ import annotations
+
+from satmotor_ros.model.coefficients import CoefficientSet, Liquid, MotorGeometry, ValidRange
+from satmotor_ros.model.composition import Equations
+from satmotor_ros.model.derived import derive
+from satmotor_ros.model.laws import displacement_law
+from satmotor_ros.model.point import PointEvaluator
+
+
+class ModelCore:
+    """
+    The constants, equations and point evaluator of one motor, coefficient set and liquid.
+
+    Parameters
+    ----------
+    geometry : MotorGeometry
+        Motor geometry, [-]
+    coefficient_set : CoefficientSet
+        Loss coefficients and the liquid they were fitted on (its effects are ignored), [-]
+    valid_range : ValidRange
+        Range the coefficients were validated over, [-]
+    liquid : Liquid
+        Working liquid, [-]
+    law : {'eq33', 'eq39'}
+        Law of Delta q, [-]
+
+    """
+
+    def __init__(self, geometry: MotorGeometry, coefficient_set: CoefficientSet,
+                 valid_range: ValidRange, liquid: Liquid, law: str) -> None:
+        """Derive the constants and compose the equations."""
+        self.geometry, self.coefficient_set = geometry, coefficient_set
+        self.valid_range, self.liquid, self.law_name = valid_range, liquid, law
+        self.derived = derive(geometry, coefficient_set, valid_range, liquid)
+        self.eqs = Equations(self.derived, displacement_law(law, self.derived))
+        self.point = PointEvaluator(self.eqs)
