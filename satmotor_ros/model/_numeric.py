@@ -10,7 +10,9 @@ the array maps alike.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 import math
+from typing import cast
 
 import numpy as np
 
@@ -36,3 +38,14 @@ def minimum(x: Real, ceiling: float) -> Real:
     if type(x) is float:
         return ceiling if x > ceiling else x
     return np.minimum(x, ceiling)
+
+
+def maximum_for(like: Real) -> Callable[[Real, float], Real]:
+    """
+    Return the elementwise maximum for values of the kind of `like`, for a loop to reuse.
+
+    The builtin :func:`max` for a float (a C call, NaN kept as the first
+    argument), :func:`numpy.maximum` for an array: the choice of
+    :func:`maximum` made once instead of on every call.
+    """
+    return cast(Callable[[Real, float], Real], max if type(like) is float else np.maximum)

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from satmotor_ros.model._numeric import maximum, minimum
+from satmotor_ros.model._numeric import maximum, maximum_for, minimum
 from satmotor_ros.model._typing import Real
 from satmotor_ros.model.derived import DerivedCoefficients
 from satmotor_ros.model.laws import DisplacementLaw
@@ -169,6 +169,7 @@ class Equations:
         """
         ch_a, ch_b, h0, compliance, k_lfg, e_lfg, k_c, gamma, qt, k_ex, limit = self._coupled
         dp_cap = minimum(dp, limit)
+        clip = maximum_for(dp_cap)
         terms = self.law.at_speed(speed)
         base = absorbency(speed, external_leakage(p_ex, k_ex) if k_ex else 0.0 * p_ex, qt)
         channel, clearance = channel_pressure_drop, clearance_height
@@ -176,7 +177,7 @@ class Equations:
 
         def residual(flow: Real) -> tuple[Real, Real]:
             # eq. (34), clipped at 0 where the channels take the whole drop
-            dp_i = maximum(dp_cap - channel(flow, ch_a, ch_b), 0.0)
+            dp_i = clip(dp_cap - channel(flow, ch_a, ch_b), 0.0)
             h = clearance(dp_i, h0, compliance)
             q_lfg, q_c = flat(dp_i, h, k_lfg, e_lfg), commutation(dp_i, k_c, gamma)
             loss, d_loss = terms(dp_i)

@@ -14,7 +14,7 @@ from abc import ABC, abstractmethod
 from collections.abc import Callable
 
 from satmotor_ros.model import losses as eq
-from satmotor_ros.model._numeric import log, maximum
+from satmotor_ros.model._numeric import log, maximum, maximum_for
 from satmotor_ros.model._typing import Real
 from satmotor_ros.model.derived import DerivedCoefficients
 from satmotor_ros.model.errors import ModelError
@@ -147,9 +147,10 @@ class EmpiricalLaw(DisplacementLaw):
         safe = speed + (speed <= 0.0)  # at n = 0 the loss is 0 and flat: at n = 1, times 0
         c2_inv_s = moving * (c2 / (safe / RPM) ** 0.5)
         floor, change = eq.EMPIRICAL_DP_FLOOR, eq.displacement_change_empirical
+        clip = maximum_for(speed)
 
         def terms(dp_i: Real) -> tuple[Real, Real]:
-            dp = maximum(dp_i, floor)  # below the floor, eq. (39) is flat in dp_i
+            dp = clip(dp_i, floor)  # below the floor, eq. (39) is flat in dp_i
             loss = change(dp, safe, c1, c2) * speed
             return loss, (dp_i > floor) * (loss * c2_inv_s / dp)
         return terms
