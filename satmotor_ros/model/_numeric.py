@@ -48,4 +48,4 @@ def maximum_for(like: Real) -> Callable[[Real, float], Real]:
     argument), :func:`numpy.maximum` for an array: the choice of
     :func:`maximum` made once instead of on every call.
     """
-    return cast(Callable[[Real, float], Real], max if type(like) is float else np.maximum)
+    return cast('Callable[[Real, float], Real]', max if type(like) is float else np.maximum)

@@ -14,8 +14,9 @@ element) run the same algorithm step for step:
    from the curvature the last two Newton evaluations show, is a thousandth
    of the tolerance, provided that curvature also explains the residual here
    (a jump does not pass: its pieces are straight);
-3. otherwise take the Newton step if it lands strictly inside the bracket;
-   else stop if the bracket is narrower than the tolerance, accepted only if
+3. otherwise take the Newton step if it stays in the bracket and does not go
+   back to the point evaluated before (as it would across a jump); else stop
+   if the bracket is narrower than the tolerance, accepted only if
    ``|f| <= check`` there (else it closed on a jump: NO_ROOT), or bisect.
 
 Every result carries a status: 0, ``NOT_CONVERGED`` (the iterations ran out) or
@@ -120,7 +121,7 @@ def solve_increasing_scalar(func: Callable[[float], tuple[float, float]], lo: fl
                 if (size * bend * size <= margin * band * moved * slope
                         and (f if f > 0.0 else -f) <= bend * moved):
                     return newton, 0
-                if newton != lo and newton != hi:
+                if newton != last_x:  # not back to where it was: a jump's pieces are straight
                     last_x, last_slope, x = x, slope, newton
                     continue
         if hi - lo <= band:
@@ -200,7 +201,7 @@ def solve_increasing(func: Callable[[FloatArray], tuple[FloatArray, FloatArray]]
             explained = ((np.abs(f) <= bend * moved)
                          & (bend * size * size <= CURVATURE_MARGIN * band * moved * slope))
             small = (newton >= a) & (newton <= b) & ((size <= band) | explained)
-            inside = (newton > a) & (newton < b)
+            inside = (newton >= a) & (newton <= b) & (newton != last_x)
             exact = ~(below | above)  # f == 0, or NaN
             closed = ~exact & ~small & ~inside & (b - a <= band)
             accepted = np.abs(f) <= check + check_rtol * np.abs(x)
