@@ -175,11 +175,11 @@ def solve_increasing(func: Callable[[FloatArray], tuple[FloatArray, FloatArray]]
     xtol, rtol, check_rtol, maxiter = tol
     a, b = np.array(lo, dtype=float), np.array(hi, dtype=float)
     x = np.array(x0, dtype=float)
-    status = np.full(x.shape, _NOT_CONVERGED, dtype=np.uint8)
     done = b - a <= xtol + rtol * np.abs(x)
-    status[done] = 0
+    rejected = np.zeros(x.shape, dtype=bool)
     last_x = np.full(x.shape, np.nan)
     last_slope = np.full(x.shape, np.nan)
+    # a done element's bracket and estimate may change below: only `x` of the others is kept
     for _ in range(maxiter):
         if done.all():
             break
@@ -187,35 +187,39 @@ def solve_increasing(func: Callable[[FloatArray], tuple[FloatArray, FloatArray]]
         below, above = f < 0.0, f > 0.0
         if mirror:
             other = x - f
-            np.copyto(b, np.minimum(b, other), where=below & ~done)
-            np.copyto(a, np.maximum(a, other), where=above & ~done)
-        np.copyto(a, x, where=below & ~done)
-        np.copyto(b, x, where=above & ~done)
-        band = xtol + rtol * np.abs(x)
-        with np.errstate(divide='ignore', invalid='ignore'):
-            step = np.where(slope > 0.0, f / slope, np.inf)
+            np.minimum(b, other, out=b, where=below)
+            np.maximum(a, other, out=a, where=above)
+        np.copyto(a, x, where=below)
+        np.copyto(b, x, where=above)
+        band = np.abs(x)
+        band *= rtol
+        band += xtol
+        with np.errstate(divide='ignore', invalid='ignore', over='ignore'):
+            step = f / slope
+            np.copyto(step, np.inf, where=~(slope > 0.0))  # no usable slope: bisect
             newton = x - step
             size = np.abs(step)
             moved = np.abs(x - last_x)
             bend = np.abs(slope - last_slope)
-            explained = ((np.abs(f) <= bend * moved)
-                         & (bend * size * size <= CURVATURE_MARGIN * band * moved * slope))
-            small = (newton >= a) & (newton <= b) & ((size <= band) | explained)
-            inside = (newton >= a) & (newton <= b) & (newton != last_x)
+            bracketed = (newton >= a) & (newton <= b)
+            small = size <= band
+            small |= (np.abs(f) <= bend * moved) & (bend * size * size
+                                                     <= CURVATURE_MARGIN * band * moved * slope)
+            small &= bracketed
+            take = bracketed & (newton != last_x)
             exact = ~(below | above)  # f == 0, or NaN
-            closed = ~exact & ~small & ~inside & (b - a <= band)
-            accepted = np.abs(f) <= check + check_rtol * np.abs(x)
-            rejected = (exact & (f != 0.0)) | (closed & ~accepted)
-        stop = ~done & (exact | closed)
-        status[stop] = np.where(rejected[stop], _NO_ROOT, 0)
+            closed = (b - a <= band) & ~(exact | small | take)
+            stop = ~done & (exact | closed)
+            rejected |= stop & (np.isnan(f) | (closed & ~(np.abs(f) <= check
+                                                           + check_rtol * np.abs(x))))
         done |= stop
-        moving = ~done
-        np.copyto(last_x, x, where=moving & ~small)
-        np.copyto(last_slope, np.where(inside, slope, np.nan), where=moving & ~small)
-        np.copyto(x, np.where(small | inside, newton, 0.5 * (a + b)), where=moving)
-        ended = moving & small
-        status[ended] = 0
-        done |= ended
+        go = ~done & ~small
+        np.copyto(last_x, x, where=go)
+        np.copyto(last_slope, np.where(take, slope, np.nan), where=go)
+        np.copyto(x, np.where(small | take, newton, 0.5 * (a + b)), where=~done)
+        done |= small
+    status = np.where(done, np.where(rejected, np.uint8(_NO_ROOT), np.uint8(0)),
+                      np.uint8(_NOT_CONVERGED))
     return x, status
 
 
