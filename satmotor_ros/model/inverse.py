@@ -48,8 +48,9 @@ def solve_speed(eqs: Equations, flow: FloatArray, dp_i: FloatArray, leak: FloatA
     """
     lo, hi, residual = eqs.speed_problem(flow, dp_i, leak)
     with np.errstate(divide='ignore', invalid='ignore'):  # the stalled elements sit at n = 0
-        above_floor = residual(np.where(lo > 0.0, lo, hi))[0] < 0.0
-        moving = (hi > lo) & ((lo <= 0.0) | above_floor)
+        moving = hi > lo
+        if eqs.law.has_floor:  # the flow must exceed what eq. (36) takes at the floor
+            moving &= (lo <= 0.0) | (residual(np.where(lo > 0.0, lo, hi))[0] < 0.0)
         status |= (~moving & (hi > 0.0) & (lo > 0.0)) * np.uint8(PointStatus.NO_ROOT)
         lo, hi = np.where(moving, lo, 0.0), np.where(moving, hi, 0.0)
         n, solved = solve_increasing(residual, lo, hi, hi, SPEED_SOLVE, CHECK * flow + FLOW_ATOL)

@@ -210,13 +210,18 @@ def solve_increasing(func: Callable[[FloatArray], tuple[FloatArray, FloatArray]]
             exact = ~(below | above)  # f == 0, or NaN
             closed = (b - a <= band) & ~(exact | small | take)
             stop = ~done & (exact | closed)
-            rejected |= stop & (np.isnan(f) | (closed & ~(np.abs(f) <= check
-                                                           + check_rtol * np.abs(x))))
-        done |= stop
+            if stop.any():
+                rejected |= stop & (np.isnan(f) | (closed & ~(np.abs(f) <= check
+                                                               + check_rtol * np.abs(x))))
+                done |= stop
         go = ~done & ~small
         np.copyto(last_x, x, where=go)
-        np.copyto(last_slope, np.where(take, slope, np.nan), where=go)
-        np.copyto(x, np.where(small | take, newton, 0.5 * (a + b)), where=~done)
+        np.copyto(last_slope, slope, where=go)
+        np.copyto(x, newton, where=~done & (small | take))
+        halve = go & ~take
+        if halve.any():
+            np.copyto(last_slope, np.nan, where=halve)
+            np.copyto(x, 0.5 * (a + b), where=halve)
         done |= small
     status = np.where(done, np.where(rejected, np.uint8(_NO_ROOT), np.uint8(0)),
                       np.uint8(_NOT_CONVERGED))
