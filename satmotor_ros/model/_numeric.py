@@ -12,7 +12,6 @@ from __future__ import annotations
 
 from collections.abc import Callable
 import math
-from typing import cast
 
 import numpy as np
 
@@ -48,4 +47,4 @@ def maximum_for(like: Real) -> Callable[[Real, float], Real]:
     argument), :func:`numpy.maximum` for an array: the choice of
     :func:`maximum` made once instead of on every call.
     """
-    return cast('Callable[[Real, float], Real]', max if type(like) is float else np.maximum)
+    return max if type(like) is float else np.maximum

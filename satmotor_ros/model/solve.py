@@ -179,6 +179,7 @@ def solve_increasing(func: Callable[[FloatArray], tuple[FloatArray, FloatArray]]
     rejected = np.zeros(x.shape, dtype=bool)
     last_x = np.full(x.shape, np.nan)
     last_slope = np.full(x.shape, np.nan)
+    first = True
     # a done element's bracket and estimate may change below: only `x` of the others is kept
     for _ in range(maxiter):
         if done.all():
@@ -199,21 +200,22 @@ def solve_increasing(func: Callable[[FloatArray], tuple[FloatArray, FloatArray]]
             np.copyto(step, np.inf, where=~(slope > 0.0))  # no usable slope: bisect
             newton = x - step
             size = np.abs(step)
-            moved = np.abs(x - last_x)
-            bend = np.abs(slope - last_slope)
             bracketed = (newton >= a) & (newton <= b)
             small = size <= band
-            small |= (np.abs(f) <= bend * moved) & (bend * size * size
-                                                     <= CURVATURE_MARGIN * band * moved * slope)
+            if not first:  # the curvature needs two Newton evaluations
+                moved = np.abs(x - last_x)
+                bend = np.abs(slope - last_slope)
+                small |= ((np.abs(f) <= bend * moved)
+                          & (bend * size * size <= CURVATURE_MARGIN * band * moved * slope))
             small &= bracketed
             take = bracketed & (newton != last_x)
             exact = ~(below | above)  # f == 0, or NaN
-            closed = (b - a <= band) & ~(exact | small | take)
-            stop = ~done & (exact | closed)
-            if stop.any():
-                rejected |= stop & (np.isnan(f) | (closed & ~(np.abs(f) <= check
-                                                               + check_rtol * np.abs(x))))
-                done |= stop
+            settled = ~done & (exact | ((b - a <= band) & ~(small | take)))
+            if settled.any():  # an exact root, a NaN, or a closed bracket
+                accepted = np.abs(f) <= check + check_rtol * np.abs(x)
+                rejected |= settled & (np.isnan(f) | (~exact & ~accepted))
+                done |= settled
+        first = False
         go = ~done & ~small
         np.copyto(last_x, x, where=go)
         np.copyto(last_slope, slope, where=go)
