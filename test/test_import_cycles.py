@@ -31,9 +31,29 @@ def _imported(node: ast.AST, module: str, is_package: bool) -> list[str]:
     return [source] + [f'{source}.{alias.name}' for alias in node.names]
 
 
+def _is_type_checking(test: ast.expr) -> bool:
+    return (isinstance(test, ast.Name) and test.id == 'TYPE_CHECKING'
+            or isinstance(test, ast.Attribute) and test.attr == 'TYPE_CHECKING')
+
+
+def _runtime_nodes(tree: ast.AST) -> list[ast.AST]:
+    """Return every node of `tree` that can run: not under ``if TYPE_CHECKING:``."""
+    found, todo = [], [tree]
+    while todo:
+        node = todo.pop()
+        found.append(node)
+        if isinstance(node, ast.If) and _is_type_checking(node.test):
+            todo.extend(node.orelse)
+        else:
+            todo.extend(ast.iter_child_nodes(node))
+    return found
+
+
 def import_graph(package: str) -> dict[str, set[str]]:
     """
     Map each module of `package` to the modules of `package` it imports anywhere in its body.
+
+    Imports under ``if TYPE_CHECKING:`` never run and are left out.
 
     Parameters
     ----------
@@ -53,7 +73,7 @@ def import_graph(package: str) -> dict[str, set[str]]:
     for module, path in files.items():
         is_package = path.name == '__init__.py'
         targets: set[str] = set()
-        for node in ast.walk(ast.parse(path.read_text(encoding='utf-8'))):
+        for node in _runtime_nodes(ast.parse(path.read_text(encoding='utf-8'))):
             targets.update(t for t in _imported(node, module, is_package) if t in files)
         # Importing a.b.c runs a and a.b first; that parent edge is no cycle of the code.
         graph[module] = {t for t in targets if t != module and not module.startswith(t + '.')}
@@ -109,6 +129,14 @@ def test_the_cycle_finder_sees_a_cycle_through_a_lazy_import():
     graph = {'a': {'b'}, 'b': {'c'}, 'c': {'a'}, 'd': {'a'}}
     assert cycles(graph) == [['a', 'b', 'c']]
     assert cycles({'a': {'b'}, 'b': set()}) == []
+
+
+def test_the_graph_leaves_out_imports_only_for_type_checking():
+    tree = ast.parse('from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    import a\n'
+                     'else:\n    import b\ndef f():\n    import c\n')
+    names = {alias.name for node in _runtime_nodes(tree) if isinstance(node, ast.Import)
+             for alias in node.names}
+    assert names == {'b', 'c'}
 
 
 def test_the_graph_counts_imports_inside_functions():
