@@ -88,8 +88,8 @@ class CalibratedModel:
             Flowmeter reading, [m^3/s]
 
         """
-        speed = np.asarray(self.model.true_speed(np.asarray(speed, dtype=float)), dtype=float)
-        flow = self.absorbency(speed, dp, channels)
+        flow = self.absorbency(self.model.true_speed(np.asarray(speed, dtype=float)), dp,
+                               channels)
         return flow_reading(self.model.effects, flow)
 
     def describe(self) -> dict[str, Any]:

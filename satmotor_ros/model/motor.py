@@ -19,7 +19,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Literal
 
-from satmotor_ros.model._typing import ArrayLike
+from satmotor_ros.model._typing import ArrayLike, Real
 from satmotor_ros.model.coefficients import (CoefficientSet, Liquid, MotorGeometry,
                                              ValidRange)
 from satmotor_ros.model.conditioned import ConditionedModel, map_points
@@ -415,7 +415,7 @@ class MotorModel:
 
     # -- instruments -----------------------------------------------------------------------
 
-    def true_flow(self, reading: ArrayLike) -> ArrayLike:
+    def true_flow(self, reading: Real) -> Real:
         """
         Return the flow through the motor from a flowmeter reading (sensor effects).
 
@@ -432,7 +432,7 @@ class MotorModel:
         """
         return true_flow(self.effects, reading)
 
-    def true_speed(self, reading: ArrayLike) -> ArrayLike:
+    def true_speed(self, reading: Real) -> Real:
         """
         Return the shaft speed from a speed-sensor reading (sensor effects).
 

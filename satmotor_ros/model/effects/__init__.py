@@ -37,6 +37,7 @@ import importlib
 import pkgutil
 from typing import Any, TYPE_CHECKING
 
+from satmotor_ros.model._typing import Real
 from satmotor_ros.model.effects._base import (Candidate, CandidateData, Conditions,
                                               CORE_CHANNELS, DOCUMENTARY, Effect, EffectKind,
                                               KINDS, Modifier, PlantInjection, PlantParameter,
@@ -318,13 +319,13 @@ def sensor_error(effects: Iterable[Effect], channel: str) -> tuple[float, float]
     return gain, offset
 
 
-def flow_reading(effects: tuple[Effect, ...], flow: Any) -> Any:
+def flow_reading(effects: tuple[Effect, ...], flow: Real) -> Real:
     """Return what the flowmeter reads [m^3/s] at a flow through the motor (see true_flow)."""
     gain, offset = sensor_error(effects, 'flow')
     return flow if (gain, offset) == (1.0, 0.0) else gain * flow + offset
 
 
-def true_flow(effects: tuple[Effect, ...], reading: Any) -> Any:
+def true_flow(effects: tuple[Effect, ...], reading: Real) -> Real:
     """
     Return the flow through the motor from a flowmeter reading.
 
@@ -345,7 +346,7 @@ def true_flow(effects: tuple[Effect, ...], reading: Any) -> Any:
     return reading if (gain, offset) == (1.0, 0.0) else (reading - offset) / gain
 
 
-def true_speed(effects: tuple[Effect, ...], reading: Any) -> Any:
+def true_speed(effects: tuple[Effect, ...], reading: Real) -> Real:
     """Return the shaft speed [rad/s] from a speed-sensor reading, as :func:`true_flow`."""
     gain, offset = sensor_error(effects, 'speed')
     return reading if (gain, offset) == (1.0, 0.0) else (reading - offset) / gain

@@ -25,13 +25,21 @@ from typing import Any, NamedTuple, Protocol, TYPE_CHECKING
 
 import numpy as np
 
-from satmotor_ros.model._typing import FloatArray
+from satmotor_ros.model._typing import FloatArray, Real
 from satmotor_ros.model.errors import ConfigError
 from satmotor_ros.model.units import LPM
 
 if TYPE_CHECKING:
     from satmotor_ros.model.coefficients import LossCoefficients
     from satmotor_ros.model.viscosity import ViscosityLaw
+
+
+class Loss(Protocol):
+    """An extra loss f(n [rad/s], dp_i [Pa]) -> Q [m^3/s]: floats in, float out; arrays alike."""
+
+    def __call__(self, n: Real, dp_i: Real, /) -> Real:
+        """Evaluate the loss."""
+
 
 KINDS: dict[str, EffectKind] = {}
 """The registry: kind name -> kind, filled by :func:`satmotor_ros.model.effects.register`."""
@@ -329,7 +337,7 @@ class EffectKind:
         """Return the motor the effect asks for at its channel's value `x`."""
         return now
 
-    def loss(self, effect: Effect) -> Callable[[Any, Any], Any] | None:
+    def loss(self, effect: Effect) -> Loss | None:
         """Return f(n [rad/s], dp_i [Pa]) -> extra loss in Q_vl [m^3/s], or None."""
         return None
 

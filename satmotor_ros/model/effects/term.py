@@ -3,16 +3,17 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
 
+from satmotor_ros.model._typing import Real
 from satmotor_ros.model.effects._base import (additive, Candidate, CandidateData, Effect,
-                                              EffectKind, maker)
+                                              EffectKind, Loss, maker)
 from satmotor_ros.model.errors import ConfigError
 
-TERMS: Mapping[str, tuple[Callable[[Any, Any], Any], str]] = {
+TERMS: Mapping[str, tuple[Loss, str]] = {
     'n^2': (lambda n, dp: n ** 2, 'm^3/s/(rad/s)^2'),
     'n^1.5': (lambda n, dp: n ** 1.5, 'm^3/s/(rad/s)^1.5'),
     'dp^2': (lambda n, dp: dp ** 2, 'm^3/s/Pa^2'),
@@ -48,11 +49,11 @@ class Term(EffectKind):
             raise ConfigError(msg)
         return suffix
 
-    def loss(self, effect: Effect) -> Callable[[Any, Any], Any] | None:
+    def loss(self, effect: Effect) -> Loss | None:
         """Return k f(n, dp_i)."""
         f, k = TERMS[effect.suffix][0], effect.coefficient
 
-        def loss(n: Any, dp_i: Any) -> Any:
+        def loss(n: Real, dp_i: Real) -> Real:
             return k * f(n, dp_i)
         return loss
 
