@@ -171,9 +171,11 @@ class Harness:
                                and motor.p_in.get_subscription_count() > 0
                                and motor.joints.get_subscription_count() > 0
                                and self.node.count_publishers(
-                                   f'{motor.ns}/predicted_joint_state') > 0
-                               and self.node.count_publishers(
-                                   f'{motor.ns}/losses/total') > 0, timeout), \
+                                   f'{motor.ns}/{PREDICTED_JOINT_STATE}') > 0
+                               and (self.node.count_publishers(
+                                   f'{motor.ns}/{LOSSES_PREFIX}total') > 0
+                                    or self.node.count_publishers(
+                                        f'{motor.ns}/{LOSSES_ARRAY}') > 0), timeout), \
             f'node in {motor.ns} not connected within {timeout} s'
 
     def set_parameters(self, node_name, **values):

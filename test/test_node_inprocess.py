@@ -4,7 +4,7 @@
 from node_harness import Harness, unique_namespace
 import pytest
 from rclpy.parameter import Parameter
-from satmotor_ros.interface import LOSS_COMPONENTS
+from satmotor_ros.interface import LOSS_COMPONENTS, LOSSES_ARRAY, LOSSES_PREFIX
 from satmotor_ros.model import MotorModel
 from satmotor_ros.model.units import LPM, MPA
 from satmotor_ros.nodes.motor_model import MotorModelNode, PARAMETERS
@@ -129,4 +129,23 @@ def test_every_node_takes_the_same_motor_and_liquid_parameters(harness, module):
         assert model.liquid.kinematic_viscosity == 2.0e-6
         assert model.liquid.name == 'user liquid on the water set'
     finally:
+        node.destroy_node()
+
+
+def test_losses_format_changed_at_run_time_keeps_only_its_publishers(harness):
+    ns = unique_namespace('fmt')
+    node = MotorModelNode(context=harness.context, namespace=ns)
+    harness.executor.add_node(node)
+
+    def counts():
+        return (harness.node.count_publishers(f'{ns}/{LOSSES_PREFIX}total'),
+                harness.node.count_publishers(f'{ns}/{LOSSES_ARRAY}'))
+    try:
+        assert harness.spin_until(lambda: counts() == (1, 0), 5.0), counts()
+        for fmt, expected in (('array', (0, 1)), ('both', (1, 1)), ('topics', (1, 0))):
+            (result,) = node.set_parameters([Parameter('losses_format', value=fmt)])
+            assert result.successful
+            assert harness.spin_until(lambda: counts() == expected, 5.0), (fmt, counts())
+    finally:
+        harness.executor.remove_node(node)
         node.destroy_node()

@@ -22,8 +22,10 @@ from builtin_interfaces.msg import Time as TimeMsg
 from diagnostic_msgs.msg import DiagnosticArray
 from rcl_interfaces.msg import SetParametersResult
 import rclpy
+from rclpy.event_handler import PublisherEventCallbacks
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
+from rclpy.publisher import Publisher
 from rclpy.qos import qos_profile_sensor_data, QoSProfile
 from rclpy.time import Time
 from rclpy.timer import Timer
@@ -68,6 +70,7 @@ PARAMETERS = (
 """The node's parameters: name, default, description, unit and accepted values."""
 
 _SPECS = {spec.name: spec for spec in PARAMETERS}
+_QUIET = PublisherEventCallbacks(use_default_callbacks=False)
 _SPEED = OUTPUTS.index('speed')
 _LOSSES = slice(_SPEED + 1, _SPEED + 1 + len(LOSS_COMPONENTS))
 
@@ -125,18 +128,19 @@ class MotorModelNode(Node):
         sensor = QoSProfile(depth=depth, reliability=qos_profile_sensor_data.reliability,
                             durability=qos_profile_sensor_data.durability,
                             history=qos_profile_sensor_data.history)
-        self._pub_joint = self.create_publisher(JointState, PREDICTED_JOINT_STATE, depth)
-        self._pub_losses = [self.create_publisher(Float64, LOSSES_PREFIX + c, depth)
-                            for c in LOSS_COMPONENTS]
-        self._pub_losses_array = self.create_publisher(Float64MultiArray, LOSSES_ARRAY, depth)
-        self._pub_residual = self.create_publisher(Float64, SPEED_RESIDUAL, depth)
-        self._pub_diag = self.create_publisher(DiagnosticArray, '/diagnostics', depth)
+        self._depth = depth
+        self._pub_joint = self._publisher(JointState, PREDICTED_JOINT_STATE)
+        self._pub_residual = self._publisher(Float64, SPEED_RESIDUAL)
+        self._pub_diag = self._publisher(DiagnosticArray, '/diagnostics')
+        self._pub_losses: list[Publisher] = []
+        self._pub_losses_array: Publisher | None = None
         self._joint_msg = JointState(name=[self._joint])  # refilled per prediction
         self._losses_msg = Float64MultiArray()
         self._losses_msg.layout.dim = [MultiArrayDimension(
             label=','.join(LOSS_COMPONENTS), size=len(LOSS_COMPONENTS),
             stride=len(LOSS_COMPONENTS))]
-        self._losses_format, self._losses_every = values['losses_format'], values['losses_every']
+        self._losses_every = values['losses_every']
+        self._apply_losses_format(values['losses_format'])
         self.create_subscription(Float64, CHANNELS['flow'].topic, self._on_flow, depth)
         for name in ('p_in', 'p_out', 'p_case'):
             self.create_subscription(FluidPressure, CHANNELS[name].topic, self._pressure(name),
@@ -188,7 +192,29 @@ class MotorModelNode(Node):
             self._apply_mode()
         self._joint = values['joint_name']
         self._joint_msg.name = [self._joint]
-        self._losses_format, self._losses_every = values['losses_format'], values['losses_every']
+        self._losses_every = values['losses_every']
+        self._apply_losses_format(values['losses_format'])
+
+    def _publisher(self, kind: type, topic: str) -> Publisher:
+        # Without rclpy's default QoS-event handlers: each adds two entities to every wait
+        # of the executor, once per message (a subscriber's own handlers still report an
+        # incompatible QoS or type).
+        return self.create_publisher(kind, topic, self._depth, event_callbacks=_QUIET)
+
+    def _apply_losses_format(self, losses_format: str) -> None:
+        """Keep only the loss publishers the format uses: fewer entities in every wait."""
+        if losses_format == 'array':
+            for publisher in self._pub_losses:
+                self.destroy_publisher(publisher)
+            self._pub_losses = []
+        elif not self._pub_losses:
+            self._pub_losses = [self._publisher(Float64, LOSSES_PREFIX + c)
+                                for c in LOSS_COMPONENTS]
+        if losses_format == 'topics' and self._pub_losses_array is not None:
+            self.destroy_publisher(self._pub_losses_array)
+            self._pub_losses_array = None
+        elif losses_format != 'topics' and self._pub_losses_array is None:
+            self._pub_losses_array = self._publisher(Float64MultiArray, LOSSES_ARRAY)
 
     def _apply_mode(self) -> None:
         if self._rate_timer is not None:
@@ -271,12 +297,11 @@ class MotorModelNode(Node):
             self._pub_residual.publish(Float64(data=out[-1]))
 
     def _publish_losses(self, losses: tuple[float, ...]) -> None:
-        if self._losses_format != 'topics':
+        if self._pub_losses_array is not None:
             self._losses_msg.data = losses
             self._pub_losses_array.publish(self._losses_msg)
-        if self._losses_format != 'array':
-            for publisher, value in zip(self._pub_losses, losses):
-                publisher.publish(Float64(data=value))
+        for publisher, value in zip(self._pub_losses, losses):
+            publisher.publish(Float64(data=value))
 
     # -- diagnostics ------------------------------------------------------------------------
 
