@@ -69,6 +69,7 @@ def test_stalled_point_warns(capsys):
     (['--flow', '5', '--dp', '80'], 'dp = 80000000.0 Pa: chamber pressure drop beyond'),
     (['--flow', '5', '--dp', '2', '--liquid', 'glycol'], "--liquid 'glycol': not a coefficient"),
     (['--flow', '5', '--dp', '2', '--viscosity', '0'], "--viscosity '0': must be a finite value"),
+    (['--flow', '5', '--dp', '2', '--density', 'heavy'], "--density 'heavy'"),
     (['--flow', '5', '--dp', '2', '--motor', '/nonexistent.yaml'], 'cannot read motor config'),
 ])
 def test_bad_input_exits_1_with_one_line_naming_the_field(capsys, argv, message):
@@ -108,3 +109,20 @@ def test_usage_errors_exit_2(capsys):
     with pytest.raises(SystemExit) as exc:
         main(['operating-point', '--flow', '5'])
     assert exc.value.code == 2
+
+
+def test_every_model_subcommand_takes_the_same_motor_options_as_the_nodes(capsys, tmp_path):
+    """--law and a user liquid reach the model, as the node parameters of the same names."""
+    from satmotor_ros.interface import MotorOptions
+    code, out, _ = _run(capsys, 'operating-point', '--flow', '10', '--dp', '10', '--json',
+                        '--law', 'eq39', '--viscosity', '15', '--liquid', 'water')
+    assert code == 0
+    result = json.loads(out)
+    model = MotorOptions('water', displacement_law='eq39', viscosity=15e-6).build_model()
+    assert result['displacement_law'] == 'eq39' == model.displacement_law
+    assert result['liquid'] == model.liquid.name == 'user liquid on the water set'
+    assert result['speed_rad_s'] == pytest.approx(float(model.speed(10 / 60000, 10e6).speed),
+                                                  rel=1e-12)
+    code, _, _ = _run(capsys, 'characteristics', '--out', str(tmp_path), '--points', '3',
+                      '--law', 'eq39', '--density', '900')
+    assert code == 0

@@ -20,7 +20,7 @@ import numpy.typing as npt
 from satmotor_ros.bags.decode import decode, FIELDS
 from satmotor_ros.bags.errors import BagError
 from satmotor_ros.bags.storage import open_bag, TopicInfo
-from satmotor_ros.interface import TOPIC_TYPES
+from satmotor_ros.interface import JOINT_NAME, TOPIC_TYPES
 
 
 @dataclass(frozen=True)
@@ -156,7 +156,7 @@ def list_topics(path: str | Path) -> dict[str, TopicInfo]:
 
 
 def read_series(path: str | Path, topics: Iterable[str],
-                topic_map: Mapping[str, str] | None = None, joint: str | None = 'motor_shaft',
+                topic_map: Mapping[str, str] | None = None, joint: str | None = JOINT_NAME,
                 keep_raw: bool = False) -> dict[str, Series]:
     """
     Read topics of a bag into time series.

@@ -16,7 +16,7 @@ from rclpy.parameter import Parameter
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock
 from satmotor_ros.cli._demo_report import RunResult, write_run_bag
-from satmotor_ros.interface import (CLOCK, DIAGNOSTIC_ARRAY, FLOAT64, MODEL_OUTPUTS,
+from satmotor_ros.interface import (CHANNELS, CLOCK, DIAGNOSTIC_ARRAY, FLOAT64, MODEL_OUTPUTS,
                                     TOPIC_TYPES)
 from satmotor_ros.nodes.motor_model import MotorModelNode
 from satmotor_ros.nodes.speed_controller import SpeedControllerNode
@@ -33,7 +33,7 @@ _TYPES = {'std_msgs/msg/Float64': Float64, 'sensor_msgs/msg/FluidPressure': Flui
 CONTROL_RATE = 100.0
 """Rate of the controller and of the set-point script, [Hz]."""
 
-_RELIABLE = {'flow_command', 'load_torque',
+_RELIABLE = {CHANNELS['flow'].topic, CHANNELS['torque'].topic,
              *(t for t in TOPIC_TYPES if t.startswith(MODEL_OUTPUTS))}
 RECORDED = (  # topic relative to the run's namespace, type, reliable publisher?
     *((topic, msgtype, topic in _RELIABLE) for topic, msgtype in TOPIC_TYPES.items()),
@@ -51,7 +51,7 @@ class Script(Node):
         super().__init__('demo_script', **kwargs)
         self.cycle = cycle
         self._setpoint = self.create_publisher(Float64, 'speed_setpoint', 10)
-        self._load = self.create_publisher(Float64, 'load_torque', 10)
+        self._load = self.create_publisher(Float64, CHANNELS['torque'].topic, 10)
         self.create_timer(1.0 / CONTROL_RATE, self._tick)
 
     def _tick(self) -> None:

@@ -329,7 +329,8 @@ def _write_bag(path: Path, series: dict[str, Series], batch: PredictionBatch,
                joint: str) -> None:
     """Write the recorded inputs and the predictions (what the node publishes) to a bag."""
     flow_topic = series[TOPICS['flow']].topic
-    prefix = flow_topic[:-len('flow_command')] if flow_topic.endswith('flow_command') else '/'
+    flow = CHANNELS['flow'].topic
+    prefix = flow_topic[:-len(flow)] if flow_topic.endswith(flow) else '/'
     prefix = prefix if prefix.startswith('/') else '/' + prefix
     topics = [OutTopic(s.topic if s.topic.startswith('/') else '/' + s.topic, s.msgtype,
                        s.t_ns, s.raw) for s in series.values() if len(s) and s.raw is not None]

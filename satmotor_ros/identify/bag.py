@@ -24,7 +24,7 @@ from satmotor_ros.bags import (BagError, describe_topics, FIELDS, list_topics, r
                                Series)
 from satmotor_ros.identify.errors import DataError
 from satmotor_ros.identify.table import BenchTable, table_from_columns
-from satmotor_ros.interface import CHANNELS, MODEL_OUTPUTS
+from satmotor_ros.interface import CHANNELS, JOINT_NAME, MODEL_OUTPUTS
 from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.units import ATMOSPHERE
 
@@ -69,7 +69,7 @@ def _extra_topics(path: Path) -> dict[str, str]:
     return out
 
 
-def read_bag(path: str | Path, joint: str | None = 'motor_shaft',
+def read_bag(path: str | Path, joint: str | None = JOINT_NAME,
              topic_map: Mapping[str, str] | None = None) -> BenchTable:
     """
     Read a calibration recording into a time-series :class:`BenchTable`.

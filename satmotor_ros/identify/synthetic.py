@@ -22,6 +22,7 @@ import re
 import numpy as np
 
 from satmotor_ros.identify.table import BenchTable
+from satmotor_ros.interface import CHANNELS, JOINT_NAME
 from satmotor_ros.model import load_motor, MotorModel
 from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.effects import Effect, kind_of, sensor_error, Synthetic, with_effects
@@ -364,18 +365,19 @@ def write_bag_of(path: str | Path, table: BenchTable, storage: str = 'mcap',
     atm = 101325.0  # FluidPressure is absolute
 
     def pressure(name: str, p: FloatArray) -> OutTopic:
-        return OutTopic(f'/{name}', FLUID_PRESSURE, t_ns + 1000,
+        return OutTopic(f'/{CHANNELS[name].topic}', FLUID_PRESSURE, t_ns + 1000,
                         encode_many(FLUID_PRESSURE, {'fluid_pressure': p + atm}, t_ns))
 
     topics = [OutTopic(f'/{flow_topic}', FLOAT64, t_ns + 2000,
                        encode_many(FLOAT64, {'data': table.flow})),
-              pressure('inlet_pressure', table.p_in), pressure('outlet_pressure', table.p_out),
-              pressure('case_pressure', table.channels['p_case']),
-              OutTopic('/fluid_temperature', TEMPERATURE, t_ns + 3000, encode_many(
-                  TEMPERATURE, {'temperature': table.channels['temperature']}, t_ns)),
-              OutTopic('/joint_states', JOINT_STATE, t_ns, encode_many(
+              pressure('p_in', table.p_in), pressure('p_out', table.p_out),
+              pressure('p_case', table.channels['p_case']),
+              OutTopic(f'/{CHANNELS["temperature"].topic}', TEMPERATURE, t_ns + 3000,
+                       encode_many(TEMPERATURE, {'temperature': table.channels['temperature']},
+                                   t_ns)),
+              OutTopic(f'/{CHANNELS["measured_speed"].topic}', JOINT_STATE, t_ns, encode_many(
                   JOINT_STATE, {'position': np.cumsum(table.speed) * 0.01,
-                                'velocity': table.speed}, t_ns, joint='motor_shaft'))]
+                                'velocity': table.speed}, t_ns, joint=JOINT_NAME))]
     for name, values in table.channels.items():
         if name not in ('time', 'revolutions', 'temperature', 'p_case'):
             topics.append(OutTopic(f'/{name}', FLOAT64, t_ns + 4000,
