@@ -14,7 +14,7 @@ is a drop, not a shifted pairing. Reported: p50/p99 latency, the ratio to the re
 drops, and the node process's CPU time per input message (/proc).
 
 Run: ``ROS_DOMAIN_ID=.. python bench/bench_node.py [--seconds 30] [--rate 1000]
-[--losses-format topics|array|both]``.
+[--param losses_format:=array]``.
 """
 
 from __future__ import annotations
@@ -181,14 +181,13 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--seconds', type=float, default=30.0)
     parser.add_argument('--rate', type=float, default=1000.0)
-    parser.add_argument('--losses-format', choices=('topics', 'array', 'both'),
-                        default='topics', help="motor_model's losses_format parameter")
+    parser.add_argument('--param', action='append', default=[], metavar='NAME:=VALUE',
+                        help='a motor_model parameter, e.g. losses_format:=array (repeatable)')
     args = parser.parse_args()
     ns = f'/bench_{uuid.uuid4().hex[:8]}'
     relay = measure('relay', args.seconds, args.rate, ns + '/relay')
-    model = measure('motor_model', args.seconds, args.rate, ns + '/motor',
-                    (f'losses_format:={args.losses_format}',))
-    print(f'{args.rate:g} Hz for {args.seconds:g} s, losses_format {args.losses_format}, '
+    model = measure('motor_model', args.seconds, args.rate, ns + '/motor', tuple(args.param))
+    print(f'{args.rate:g} Hz for {args.seconds:g} s, {" ".join(args.param) or "defaults"}, '
           f'ROS_DOMAIN_ID '
           f'{os.environ.get("ROS_DOMAIN_ID", "0")}, load {os.getloadavg()[0]:.1f}')
     print(f'{"node":12s} {"p50 [ms]":>9s} {"p99 [ms]":>9s} {"sent":>7s} {"drops":>6s} '

@@ -15,14 +15,14 @@ The node holds no physics: the combination rule and the model call are
 
 from __future__ import annotations
 
+from array import array
 from collections.abc import Callable
 from typing import Any
 
-from builtin_interfaces.msg import Time as TimeMsg
 from diagnostic_msgs.msg import DiagnosticArray
 from rcl_interfaces.msg import SetParametersResult
 import rclpy
-from rclpy.event_handler import PublisherEventCallbacks
+from rclpy.event_handler import PublisherEventCallbacks, SubscriptionEventCallbacks
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.publisher import Publisher
@@ -71,6 +71,7 @@ PARAMETERS = (
 
 _SPECS = {spec.name: spec for spec in PARAMETERS}
 _QUIET = PublisherEventCallbacks(use_default_callbacks=False)
+_QUIET_SUBSCRIPTION = SubscriptionEventCallbacks(use_default_callbacks=False)
 _SPEED = OUTPUTS.index('speed')
 _LOSSES = slice(_SPEED + 1, _SPEED + 1 + len(LOSS_COMPONENTS))
 
@@ -142,13 +143,17 @@ class MotorModelNode(Node):
         self._losses_every = values['losses_every']
         self._apply_losses_format(values['losses_format'])
         self.create_subscription(Float64, CHANNELS['flow'].topic, self._on_flow, depth)
-        for name in ('p_in', 'p_out', 'p_case'):
-            self.create_subscription(FluidPressure, CHANNELS[name].topic, self._pressure(name),
-                                     sensor)
-        self.create_subscription(Temperature, CHANNELS['temperature'].topic,
-                                 self._on_temperature, sensor)
-        self.create_subscription(JointState, CHANNELS['measured_speed'].topic,
-                                 self._on_joint_states, sensor)
+        # The best-effort sensor subscriptions go without the default QoS-event handlers
+        # too: no publisher's QoS can be incompatible with them, a publisher of a wrong type
+        # reports it on its side, and the diagnostics say 'no message received'.
+        for kind, name, callback in (
+                (FluidPressure, 'p_in', self._pressure('p_in')),
+                (FluidPressure, 'p_out', self._pressure('p_out')),
+                (FluidPressure, 'p_case', self._pressure('p_case')),
+                (Temperature, 'temperature', self._on_temperature),
+                (JointState, 'measured_speed', self._on_joint_states)):
+            self.create_subscription(kind, CHANNELS[name].topic, callback, sensor,
+                                     event_callbacks=_QUIET_SUBSCRIPTION)
         self._rate_timer: Timer | None = None
         self._apply_mode()
         self.create_timer(1.0, self._publish_diagnostics)
@@ -288,8 +293,8 @@ class MotorModelNode(Node):
         self._published += 1
         out = pred.outputs
         joint = self._joint_msg
-        joint.velocity = [out[_SPEED]]
-        joint.header.stamp = TimeMsg(sec=t_ns // 1_000_000_000, nanosec=t_ns % 1_000_000_000)
+        joint.velocity = array('d', (out[_SPEED],))  # an array is taken without a check
+        joint.header.stamp.sec, joint.header.stamp.nanosec = divmod(t_ns, 1_000_000_000)
         self._pub_joint.publish(joint)
         if self._published % self._losses_every == 0:
             self._publish_losses(out[_LOSSES])
@@ -298,7 +303,7 @@ class MotorModelNode(Node):
 
     def _publish_losses(self, losses: tuple[float, ...]) -> None:
         if self._pub_losses_array is not None:
-            self._losses_msg.data = losses
+            self._losses_msg.data = array('d', losses)
             self._pub_losses_array.publish(self._losses_msg)
         for publisher, value in zip(self._pub_losses, losses):
             publisher.publish(Float64(data=value))
