@@ -12,7 +12,6 @@ messages the node published, and its numbers to 1e-12 (the two model paths agree
 
 from __future__ import annotations
 
-import contextlib
 import math
 from typing import Any, NamedTuple, overload
 
@@ -50,11 +49,6 @@ _OK, _WARN, _ERROR = int(Level.OK), int(Level.WARN), int(Level.ERROR)
 
 def _is_array(x: Any) -> bool:
     return isinstance(x, np.ndarray)
-
-
-def _quiet(batch: bool) -> contextlib.AbstractContextManager[Any]:
-    """Silence numpy's NaN and inf warnings on arrays (floats never warn; errstate costs)."""
-    return np.errstate(invalid='ignore', over='ignore') if batch else contextlib.nullcontext()
 
 
 class Progress:
@@ -402,9 +396,8 @@ def predict(model: MotorModel, snap: Snapshot | SnapshotBatch, timeout: float,
         p_ex = channels[leak]  # the pressure the effect drove eq. (24) with
     status = pick(usable, status, 0)
     level = _worst([level, pick(status & _INVALID, _ERROR, pick(status & _NOTED, _WARN, _OK))])
-    with _quiet(_is_array(speed)):  # NaN where the speed is not measured
-        residual = pick(states[_I_SPEED] == _FRESH,
-                        model.true_speed(values[_I_SPEED]) - speed, math.nan)
+    residual = pick(states[_I_SPEED] == _FRESH, model.true_speed(values[_I_SPEED]) - speed,
+                    math.nan)
     outputs = _masked(level < _ERROR, [dp, dp_i, p_ex, speed, *losses, residual], math.nan)
     return _result(model, snap, timeout, outputs, status, level)
 
