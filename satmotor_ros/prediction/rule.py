@@ -132,9 +132,13 @@ def pick(condition: Any, if_true: Any, if_false: Any) -> Any:
         The choice; an array when `condition` is one.
 
     """
+    if condition is True:  # the usual scalar case first: the node calls this per message
+        return if_true
+    if condition is False:
+        return if_false
     if isinstance(condition, np.ndarray):
         return np.where(condition, if_true, if_false)
-    return if_true if condition else if_false
+    return if_true if condition else if_false  # numpy's scalar bool
 
 
 def input_state(name: str, value: Any, age_ns: Any, timeout_ns: int) -> Any:
