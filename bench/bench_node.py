@@ -14,7 +14,7 @@ is a drop, not a shifted pairing. Reported: p50/p99 latency, the ratio to the re
 drops, and the node process's CPU time per input message (/proc).
 
 Run: ``ROS_DOMAIN_ID=.. python bench/bench_node.py [--seconds 30] [--rate 1000]
-[--param losses_format:=array]``.
+[--param losses_format:=array] [--rounds 5]``.
 """
 
 from __future__ import annotations
@@ -183,21 +183,30 @@ def main() -> None:
     parser.add_argument('--rate', type=float, default=1000.0)
     parser.add_argument('--param', action='append', default=[], metavar='NAME:=VALUE',
                         help='a motor_model parameter, e.g. losses_format:=array (repeatable)')
+    parser.add_argument('--rounds', type=int, default=1,
+                        help='relay and node measured in turn this many times; the ratios of '
+                             'each round and their median (a shared machine drifts)')
     args = parser.parse_args()
     ns = f'/bench_{uuid.uuid4().hex[:8]}'
-    relay = measure('relay', args.seconds, args.rate, ns + '/relay')
-    model = measure('motor_model', args.seconds, args.rate, ns + '/motor', tuple(args.param))
     print(f'{args.rate:g} Hz for {args.seconds:g} s, {" ".join(args.param) or "defaults"}, '
-          f'ROS_DOMAIN_ID '
-          f'{os.environ.get("ROS_DOMAIN_ID", "0")}, load {os.getloadavg()[0]:.1f}')
+          f'ROS_DOMAIN_ID {os.environ.get("ROS_DOMAIN_ID", "0")}')
     print(f'{"node":12s} {"p50 [ms]":>9s} {"p99 [ms]":>9s} {"sent":>7s} {"drops":>6s} '
           f'{"CPU/msg [us]":>13s}')
-    for name, r in (('relay', relay), ('motor_model', model)):
-        print(f'{name:12s} {r["p50"]:9.3f} {r["p99"]:9.3f} {r["sent"]:7d} {r["drops"]:6d} '
-              f'{r["cpu_us"]:13.1f}')
-    print(f'ratio motor_model/relay: p50 {model["p50"] / relay["p50"]:.2f}x, '
-          f'p99 {model["p99"] / relay["p99"]:.2f}x, '
-          f'CPU/msg {model["cpu_us"] / relay["cpu_us"]:.2f}x')
+    ratios = []
+    for k in range(args.rounds):
+        relay = measure('relay', args.seconds, args.rate, f'{ns}/relay{k}')
+        model = measure('motor_model', args.seconds, args.rate, f'{ns}/motor{k}',
+                        tuple(args.param))
+        for name, r in (('relay', relay), ('motor_model', model)):
+            print(f'{name:12s} {r["p50"]:9.3f} {r["p99"]:9.3f} {r["sent"]:7d} {r["drops"]:6d} '
+                  f'{r["cpu_us"]:13.1f}')
+        ratios.append([model[key] / relay[key] for key in ('p50', 'p99', 'cpu_us')])
+        print(f'ratio motor_model/relay: p50 {ratios[-1][0]:.2f}x, p99 {ratios[-1][1]:.2f}x, '
+              f'CPU/msg {ratios[-1][2]:.2f}x (load {os.getloadavg()[0]:.1f})')
+    if args.rounds > 1:
+        p50, p99, cpu = np.median(ratios, axis=0)
+        print(f'median of {args.rounds} rounds: p50 {p50:.2f}x, p99 {p99:.2f}x, '
+              f'CPU/msg {cpu:.2f}x')
 
 
 if __name__ == '__main__':
