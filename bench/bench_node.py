@@ -105,7 +105,7 @@ def measure(kind: str, seconds: float, rate: float, namespace: str,
     proc = subprocess.Popen([sys.executable, '-c', code, '--ros-args', '-r',
                              f'__ns:={namespace}', *extra], env=env)
     context = Context()
-    context.init()
+    context.init(args=[])  # not this script's own options (rcl would read NAME:=VALUE)
     node = Node(f'bench_{uuid.uuid4().hex[:8]}', context=context)
     executor = SingleThreadedExecutor(context=context)
     executor.add_node(node)
@@ -162,7 +162,11 @@ def measure(kind: str, seconds: float, rate: float, namespace: str,
         node.destroy_node()
         context.try_shutdown()
         proc.send_signal(2)
-        proc.wait(10)
+        try:
+            proc.wait(10)
+        except subprocess.TimeoutExpired:  # stuck in its shutdown: its numbers are taken
+            proc.kill()
+            proc.wait()
     if kind == 'relay':
         keys = flows
     else:
