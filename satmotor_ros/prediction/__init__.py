@@ -7,12 +7,12 @@ timeout, value checks naming the field), :mod:`.predict` the model call and its 
 each is written once for one message (floats) and a whole recording (arrays).
 """
 
-from satmotor_ros.prediction.predict import (CHANNELS, describe, OUTPUTS, predict, Prediction,
-                                             PredictionBatch, Progress)
+from satmotor_ros.prediction.predict import (CHANNELS, describe, OUTPUTS, pick, predict,
+                                             Prediction, PredictionBatch, Progress)
 from satmotor_ros.prediction.rule import (combine_batch, Combiner, describe_input,
                                           driving_times, FIELDS, input_state, input_states,
-                                          INPUTS, InputState, Level, MODES, pick, REQUIRED,
-                                          Rule, Snapshot, SnapshotBatch, TOPICS, UNITS)
+                                          INPUTS, InputState, Level, MODES, REQUIRED, Rule,
+                                          Snapshot, SnapshotBatch, TOPICS, UNITS)
 
 __all__ = [
     'CHANNELS', 'Combiner', 'FIELDS', 'INPUTS', 'InputState', 'Level', 'MODES', 'OUTPUTS',

@@ -6,7 +6,7 @@ The prediction: inputs -> model call -> speed, losses, residual and status.
 message, the model's single-point path ``speed_point``, a few microseconds) and bag replay
 (a :class:`SnapshotBatch` of arrays, every driving time at once, the array path ``speed``)
 both drive: its body is written once on values that may be floats or arrays
-(:func:`~satmotor_ros.prediction.rule.pick`). A bag replayed gives the levels, statuses and
+(:func:`pick`). A bag replayed gives the levels, statuses and
 messages the node published, and its numbers to 1e-12 (the two model paths agree to that).
 """
 
@@ -22,7 +22,7 @@ from satmotor_ros.model import COMPONENTS, describe_status, INVALID, MotorModel,
 from satmotor_ros.model.revolutions import revolutions
 from satmotor_ros.model.units import ATMOSPHERE
 from satmotor_ros.prediction.rule import (describe_input, FIELDS, input_level, INPUTS,
-                                          InputState, Level, pick, Snapshot, SnapshotBatch)
+                                          InputState, Level, Snapshot, SnapshotBatch)
 
 OUTPUTS = ('dp', 'dp_i', 'p_ex', 'speed', *COMPONENTS, 'residual')
 """Computed fields of a prediction (SI: Pa, rad/s, m^3/s), after the inputs."""
@@ -45,6 +45,35 @@ and shaft revolutions [rev] since the first prediction (see :class:`Progress`), 
 # plain ints: an enum member looked up on its class costs a microsecond per message
 _FRESH = int(InputState.FRESH)
 _OK, _WARN, _ERROR = int(Level.OK), int(Level.WARN), int(Level.ERROR)
+
+
+def pick(condition: Any, if_true: Any, if_false: Any) -> Any:
+    """
+    Choose element by element: a conditional expression on scalars, ``np.where`` on arrays.
+
+    What lets one body of code serve one message (floats, the node) and a whole
+    recording (arrays, replay).
+
+    Parameters
+    ----------
+    condition : bool or ndarray of bool
+        Where to take `if_true`, [-]
+    if_true, if_false : float, int or ndarray
+        The choices, [any]
+
+    Returns
+    -------
+    float, int or ndarray
+        The choice; an array when `condition` is one.
+
+    """
+    if condition is True:  # the usual scalar case first: the node calls this per message
+        return if_true
+    if condition is False:
+        return if_false
+    if isinstance(condition, np.ndarray):
+        return np.where(condition, if_true, if_false)
+    return if_true if condition else if_false  # numpy's scalar bool
 
 
 def _is_array(x: Any) -> bool:

@@ -8,7 +8,7 @@ latest value of each input, provided it arrived no longer than the input timeout
 the driving time and its value is valid. The live node (:class:`Combiner`, one message
 at a time) and bag replay (:func:`combine_batch`, whole arrays at once) apply the same
 rule: both hold the latest value and age of each input and rate them with
-:func:`input_states`, one body of code for floats and arrays (:func:`pick`).
+:func:`input_states`, one body of code for floats and arrays.
 """
 
 from __future__ import annotations
@@ -112,35 +112,6 @@ _FRESH, _MISSING, _STALE, _NOT_FINITE, _NEGATIVE, _REVERSED = (int(s) for s in I
 _I_IN, _I_OUT = INPUTS.index('p_in'), INPUTS.index('p_out')
 
 
-def pick(condition: Any, if_true: Any, if_false: Any) -> Any:
-    """
-    Choose element by element: a conditional expression on scalars, ``np.where`` on arrays.
-
-    What lets one body of code serve one message (floats, the node) and a whole
-    recording (arrays, replay).
-
-    Parameters
-    ----------
-    condition : bool or ndarray of bool
-        Where to take `if_true`, [-]
-    if_true, if_false : float, int or ndarray
-        The choices, [any]
-
-    Returns
-    -------
-    float, int or ndarray
-        The choice; an array when `condition` is one.
-
-    """
-    if condition is True:  # the usual scalar case first: the node calls this per message
-        return if_true
-    if condition is False:
-        return if_false
-    if isinstance(condition, np.ndarray):
-        return np.where(condition, if_true, if_false)
-    return if_true if condition else if_false  # numpy's scalar bool
-
-
 def input_state(name: str, value: Any, age_ns: Any, timeout_ns: int) -> Any:
     """
     Rate an input at a driving time: one value (float) or many (array) alike.
@@ -163,11 +134,13 @@ def input_state(name: str, value: Any, age_ns: Any, timeout_ns: int) -> Any:
         needs both pressures, see :func:`input_states`).
 
     """
-    state = pick(abs(value) <= _FLOAT_MAX, _FRESH, _NOT_FINITE)
-    if name in NON_NEGATIVE:
-        state = pick((value < 0.0) & (state == _FRESH), _NEGATIVE, state)
-    state = pick(age_ns > timeout_ns, _STALE, state)
-    return pick(age_ns != age_ns, _MISSING, state)  # NaN age: never arrived
+    # Operators only, so that Python's bools and numpy's bool arrays go through alike:
+    # state + condition * (new - state) is `new` where the condition holds, later ones win.
+    state = ((value < 0.0) & (name in NON_NEGATIVE)) * _NEGATIVE
+    state += ((value != value) | (abs(value) > _FLOAT_MAX)) * (_NOT_FINITE - state)
+    state += (age_ns > timeout_ns) * (_STALE - state)
+    state += (age_ns != age_ns) * (_MISSING - state)  # NaN age: never arrived
+    return state
 
 
 def input_states(values: Sequence[float] | npt.NDArray[np.float64],
@@ -196,7 +169,7 @@ def input_states(values: Sequence[float] | npt.NDArray[np.float64],
               for name, value, age in zip(INPUTS, values, ages_ns)]
     reversed_ = (states[_I_IN] == _FRESH) & (states[_I_OUT] == _FRESH) \
         & (values[_I_OUT] > values[_I_IN])
-    states[_I_OUT] = pick(reversed_, _REVERSED, states[_I_OUT])
+    states[_I_OUT] += reversed_ * (_REVERSED - states[_I_OUT])
     return states
 
 
