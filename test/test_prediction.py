@@ -13,7 +13,7 @@ from satmotor_ros.model import CoefficientSet, MotorModel, PointStatus
 from satmotor_ros.model.effects import effect_from_mapping
 from satmotor_ros.model.units import ATMOSPHERE, LPM, MPA
 from satmotor_ros.prediction import (combine_batch, Combiner, driving_times, input_state,
-                                     INPUTS, Level, predict, Progress, Rule)
+                                     INPUTS, InputState, Level, predict, Progress, Rule)
 
 OIL = MotorModel.default('oil')
 RULE = Rule(timeout=0.5)
@@ -298,3 +298,21 @@ def test_p_ex_output_is_the_pressure_the_leakage_effect_read():
               'p_case': (t[:1], np.array([0.5 * MPA + ATMOSPHERE]))}
     batch = predict(model, combine_batch(RULE, t[1:], series), RULE.timeout)
     assert batch.output('p_ex')[0] == pred.output('p_ex')
+
+
+@pytest.mark.parametrize('name', INPUTS)
+def test_input_state_follows_the_rule_priority_on_floats_and_arrays(name):
+    """Missing before stale before not finite before negative (flow and absolute pressures)."""
+    non_negative = name in ('flow', 'p_in', 'p_out', 'p_case')
+    values = [0.0, 1.0, -1.0, math.nan, math.inf, -math.inf]
+    ages = [math.nan, 0.0, float(RULE.timeout_ns), RULE.timeout_ns + 1.0]
+    for value in values:
+        for age in ages:
+            expected = (InputState.MISSING if math.isnan(age) else
+                        InputState.STALE if age > RULE.timeout_ns else
+                        InputState.NOT_FINITE if not math.isfinite(value) else
+                        InputState.NEGATIVE if value < 0.0 and non_negative else
+                        InputState.FRESH)
+            one = input_state(name, value, age, RULE.timeout_ns)
+            many = input_state(name, np.array([value]), np.array([age]), RULE.timeout_ns)
+            assert one == expected == many[0], (value, age)
