@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from array import array
 from collections.abc import Callable
-from typing import Any
+from typing import Any, TypeVar
 
 from diagnostic_msgs.msg import DiagnosticArray
 from rcl_interfaces.msg import SetParametersResult
@@ -70,6 +70,7 @@ PARAMETERS = (
 """The node's parameters: name, default, description, unit and accepted values."""
 
 _SPECS = {spec.name: spec for spec in PARAMETERS}
+MsgT = TypeVar('MsgT')
 _QUIET = PublisherEventCallbacks(use_default_callbacks=False)
 _QUIET_SUBSCRIPTION = SubscriptionEventCallbacks(use_default_callbacks=False)
 _SPEED = OUTPUTS.index('speed')
@@ -133,8 +134,8 @@ class MotorModelNode(Node):
         self._pub_joint = self._publisher(JointState, PREDICTED_JOINT_STATE)
         self._pub_residual = self._publisher(Float64, SPEED_RESIDUAL)
         self._pub_diag = self._publisher(DiagnosticArray, '/diagnostics')
-        self._pub_losses: list[Publisher] = []
-        self._pub_losses_array: Publisher | None = None
+        self._pub_losses: list[Publisher[Float64]] = []
+        self._pub_losses_array: Publisher[Float64MultiArray] | None = None
         self._joint_msg = JointState(name=[self._joint])  # refilled per prediction
         self._losses_msg = Float64MultiArray()
         self._losses_msg.layout.dim = [MultiArrayDimension(
@@ -200,7 +201,7 @@ class MotorModelNode(Node):
         self._losses_every = values['losses_every']
         self._apply_losses_format(values['losses_format'])
 
-    def _publisher(self, kind: type, topic: str) -> Publisher:
+    def _publisher(self, kind: type[MsgT], topic: str) -> Publisher[MsgT]:
         # Without rclpy's default QoS-event handlers: each adds two entities to every wait
         # of the executor, once per message (a subscriber's own handlers still report an
         # incompatible QoS or type).
