@@ -433,13 +433,21 @@ def test_pip_wheel_ships_config_as_package_data(wheel):
 
 
 def _runtime_nodes(tree):
-    """Yield the nodes of a module except those under ``if TYPE_CHECKING:`` (never run)."""
+    """
+    Yield the nodes of a module that this interpreter runs.
+
+    Left out: the body of ``if TYPE_CHECKING:`` (never run) and, of an ``if`` on
+    ``sys.version_info``, the branch this Python version does not take.
+    """
     todo = [tree]
     while todo:
         node = todo.pop()
         yield node
-        if isinstance(node, ast.If) and 'TYPE_CHECKING' in ast.unparse(node.test):
+        test = ast.unparse(node.test) if isinstance(node, ast.If) else ''
+        if 'TYPE_CHECKING' in test:
             todo.extend(node.orelse)
+        elif test.startswith('sys.version_info'):
+            todo.extend(node.body if eval(test, {'sys': sys}) else node.orelse)
         else:
             todo.extend(ast.iter_child_nodes(node))
 

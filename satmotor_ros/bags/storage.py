@@ -25,10 +25,10 @@ import re
 import shutil
 import sqlite3
 import struct
+import sys
 import tempfile
 from typing import cast, NamedTuple, TYPE_CHECKING
 
-from backports import zstd
 import numpy as np
 import numpy.typing as npt
 
@@ -38,6 +38,11 @@ import yaml
 
 if TYPE_CHECKING:
     from rosbags.interfaces import ConnectionExtRosbag2
+
+if sys.version_info >= (3, 14):  # PEP 784; setup.py installs the backport only below 3.14
+    from compression import zstd
+else:
+    from backports import zstd
 
 
 STORAGES = ('sqlite3', 'mcap')
