@@ -6,8 +6,8 @@ The prediction: inputs -> model call -> speed, losses, residual and status.
 message, the model's single-point path ``speed_point``, a few microseconds) and bag replay
 (a :class:`SnapshotBatch` of arrays, every driving time at once, the array path ``speed``)
 both drive: its body is written once on values that may be floats or arrays
-(:func:`pick`). A bag replayed gives the levels, statuses and
-messages the node published, and its numbers to 1e-12 (the two model paths agree to that).
+(:func:`pick`). A bag replayed gives the levels, statuses and messages the node published,
+and its numbers to 1e-12 (the two model paths agree to that).
 """
 
 from __future__ import annotations
