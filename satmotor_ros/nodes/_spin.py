@@ -1,12 +1,22 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Spin a node until shutdown, as every node's ``main`` does."""
+"""Run a node until shutdown: every node's ``main``."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 import sys
+from typing import Protocol
 
 import rclpy
+from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
+
+
+class NodeMain(Protocol):
+    """A node's console-script ``main``."""
+
+    def __call__(self, args: list[str] | None = None) -> None:
+        """Run the node; `args` is the command line (ROS arguments included)."""
 
 
 _INTERRUPTED_TAKE = 'Unable to convert call argument'
@@ -37,3 +47,45 @@ def spin(node: Node) -> None:
             raise
         if node.context.ok():  # SIGINT's KeyboardInterrupt, swallowed by pybind's argument cast
             print(f'{node.get_name()}: stopped while taking a message ({err})', file=sys.stderr)
+
+
+def node_main(make_node: Callable[[], Node], name: str) -> NodeMain:
+    """
+    Make a node's ``main`` (its console script): run the node until shut down.
+
+    The ``main`` initialises rclpy, builds the node and spins it. Ctrl-C and an
+    external shutdown end the run quietly. Bad start-up parameters (a ValueError or
+    OSError from `make_node`) print one line and exit with status 1, without a
+    traceback. The node is destroyed and rclpy shut down in every case.
+
+    Parameters
+    ----------
+    make_node : callable
+        Builds the node in the initialised default context, [-]
+    name : str
+        The executable's name, which prefixes the one-line error, [-]
+
+    Returns
+    -------
+    NodeMain
+        ``main(args=None)``, `args` being the command line (ROS arguments included).
+
+    """
+    def main(args: list[str] | None = None) -> None:
+        rclpy.init(args=args)
+        node = None
+        try:
+            node = make_node()
+            spin(node)
+        except (KeyboardInterrupt, ExternalShutdownException):
+            pass
+        except (ValueError, OSError) as err:  # bad start-up parameters: one line, no traceback
+            print(f'{name}: {err}')
+            raise SystemExit(1) from None
+        finally:
+            if node is not None:
+                node.destroy_node()
+            rclpy.try_shutdown()
+
+    main.__doc__ = f'Run ``{name}`` until shut down; `args` is the command line.'
+    return main

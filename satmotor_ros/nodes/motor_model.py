@@ -21,9 +21,7 @@ from typing import Any, TypeVar
 
 from diagnostic_msgs.msg import DiagnosticArray
 from rcl_interfaces.msg import SetParametersResult
-import rclpy
 from rclpy.event_handler import PublisherEventCallbacks, SubscriptionEventCallbacks
-from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.publisher import Publisher
 from rclpy.qos import qos_profile_sensor_data, QoSProfile
@@ -35,7 +33,7 @@ from satmotor_ros.model import describe_status, ModelError, MotorModel
 from satmotor_ros.nodes import _diagnostics as diag
 from satmotor_ros.nodes import _parameters as params
 from satmotor_ros.nodes._parameters import ParamSpec, RosParameter
-from satmotor_ros.nodes._spin import spin
+from satmotor_ros.nodes._spin import node_main
 from satmotor_ros.prediction import (Combiner, FIELDS, INPUTS, Level, MODES, OUTPUTS, predict,
                                      Prediction, Progress, Rule, TOPICS, UNITS)
 from sensor_msgs.msg import FluidPressure, JointState, Temperature
@@ -353,27 +351,7 @@ class MotorModelNode(Node):
         return pred
 
 
-def main(args: list[str] | None = None) -> None:
-    """
-    Run the node (the ``motor_model`` console script).
-
-    Parameters
-    ----------
-    args : list of str, optional
-        Command-line arguments, including ROS arguments, [-]
-
-    """
-    rclpy.init(args=args)
-    node = None
-    try:
-        node = MotorModelNode()
-        spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
+main = node_main(MotorModelNode, 'motor_model')
 
 
 if __name__ == '__main__':

@@ -17,8 +17,6 @@ from typing import Any
 
 from diagnostic_msgs.msg import DiagnosticArray
 from rcl_interfaces.msg import SetParametersResult
-import rclpy
-from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.qos import qos_profile_sensor_data
 from rclpy.time import Time
@@ -27,7 +25,7 @@ from satmotor_ros.model.units import RPM
 from satmotor_ros.nodes import _diagnostics as diag
 from satmotor_ros.nodes import _parameters as params
 from satmotor_ros.nodes._parameters import ParamSpec, RosParameter
-from satmotor_ros.nodes._spin import spin
+from satmotor_ros.nodes._spin import node_main
 from satmotor_ros.plant.controller import ControllerParams, FEEDFORWARDS, SpeedController
 from satmotor_ros.plant.errors import PlantError
 from sensor_msgs.msg import FluidPressure, JointState
@@ -230,30 +228,7 @@ class SpeedControllerNode(Node):
         return dataclasses.replace(self.law.params)
 
 
-def main(args: list[str] | None = None) -> None:
-    """
-    Run the node until shut down.
-
-    Parameters
-    ----------
-    args : list of str, optional
-        Command-line arguments (ROS arguments included), [-]
-
-    """
-    rclpy.init(args=args)
-    node = None
-    try:
-        node = SpeedControllerNode()
-        spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    except (ValueError, OSError) as err:  # bad start-up parameters: one line, no traceback
-        print(f'speed_controller: {err}')
-        raise SystemExit(1) from None
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
+main = node_main(SpeedControllerNode, 'speed_controller')
 
 
 if __name__ == '__main__':

@@ -23,11 +23,9 @@ from typing import Any
 from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticArray
 from rcl_interfaces.msg import SetParametersResult
-import rclpy
 from rclpy.clock import Clock
 from rclpy.clock_type import ClockType
 from rclpy.event_handler import PublisherEventCallbacks
-from rclpy.executors import ExternalShutdownException
 from rclpy.guard_condition import GuardCondition
 from rclpy.node import Node
 from rclpy.qos import qos_profile_sensor_data, QoSProfile
@@ -40,7 +38,7 @@ from satmotor_ros.model.units import LPM
 from satmotor_ros.nodes import _diagnostics as diag
 from satmotor_ros.nodes import _parameters as params
 from satmotor_ros.nodes._parameters import ParamSpec, RosParameter
-from satmotor_ros.nodes._spin import spin
+from satmotor_ros.nodes._spin import node_main
 from satmotor_ros.plant import make_load, Plant
 from satmotor_ros.plant.config import parameter_specs, params_from_flat
 from satmotor_ros.plant.load import LOAD_KINDS
@@ -357,30 +355,7 @@ class VirtualMotorNode(Node):
         self._diag_pub.publish(diag.array(RosTime.from_msg(stamp), [status]))
 
 
-def main(args: list[str] | None = None) -> None:
-    """
-    Run the node until shut down.
-
-    Parameters
-    ----------
-    args : list of str, optional
-        Command-line arguments (ROS arguments included), [-]
-
-    """
-    rclpy.init(args=args)
-    node = None
-    try:
-        node = VirtualMotorNode()
-        spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    except (ValueError, OSError) as err:  # bad start-up parameters: one line, no traceback
-        print(f'virtual_motor: {err}')
-        raise SystemExit(1) from None
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
+main = node_main(VirtualMotorNode, 'virtual_motor')
 
 
 __all__ = ['VirtualMotorNode', 'all_parameters', 'main']
