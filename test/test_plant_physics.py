@@ -12,7 +12,9 @@ from satmotor_ros.model.effects import Effect, effect_from_mapping
 from satmotor_ros.model.units import ATMOSPHERE, LPM, MPA
 from satmotor_ros.plant import (ConstantLoad, LineParams, Plant, PlantError,
                                 PlantParams, ShaftParams, SpeedProportionalLoad, StepLoad)
+from satmotor_ros.plant import params as records
 from satmotor_ros.plant.config import params_from_flat
+from satmotor_ros.plant.controller import ControllerParams
 
 MODELS = {name: MotorModel.default(name) for name in ('oil', 'water')}
 
@@ -197,6 +199,22 @@ def test_parameter_records_reject_bad_values_naming_the_field():
     with pytest.raises(PlantError, match=r'PlantParams.step'):
         PlantParams(step=math.nan)
     assert dataclasses.replace(PlantParams(), step=2e-3).step == 2e-3
+
+
+RECORDS = (records.LineParams, records.ReliefParams, records.ShaftParams, records.ThermalParams,
+           records.CaseParams, records.SensorParams, records.PlantParams, ControllerParams)
+
+
+@pytest.mark.parametrize('record', RECORDS, ids=lambda r: r.__name__)
+def test_every_ranged_field_of_every_record_refuses_a_value_beyond_its_range(record):
+    """Each record is Bounded: above its range or NaN, every ranged field is refused by name."""
+    ranged = [(f.name, f.metadata['range']) for f in dataclasses.fields(record)
+              if f.metadata.get('range') is not None]
+    assert ranged
+    for name, (_, high) in ranged:
+        for bad in (2.0 * abs(high) + 1.0, math.nan):
+            with pytest.raises(PlantError, match=rf'{record.__name__}\.{name} = '):
+                record(**{name: bad})
 
 
 @settings(max_examples=25, deadline=None, derandomize=True)

@@ -27,14 +27,14 @@ import math
 from satmotor_ros.model import MotorModel
 from satmotor_ros.model.units import LPM
 from satmotor_ros.plant.errors import PlantError
-from satmotor_ros.plant.params import check_bounds, parameter
+from satmotor_ros.plant.params import Bounded, parameter
 
 FEEDFORWARDS = ('model', 'naive', 'none')
 """The feed-forward choices."""
 
 
 @dataclass(frozen=True)
-class ControllerParams:
+class ControllerParams(Bounded):
     """Gains and limits of the speed controller."""
 
     kp: float = parameter(
@@ -51,7 +51,7 @@ class ControllerParams:
 
     def __post_init__(self) -> None:
         """Reject values outside their range and an unknown feed-forward, naming the field."""
-        check_bounds(self)
+        super().__post_init__()
         if self.feedforward not in FEEDFORWARDS:
             msg = (f'ControllerParams.feedforward = {self.feedforward!r}: use one of '
                    f'{", ".join(FEEDFORWARDS)}')

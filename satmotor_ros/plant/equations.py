@@ -6,7 +6,7 @@ The motor's volumetric losses are not here: they come from
 :class:`satmotor_ros.model.MotorModel` (Śliwiński 2017, eqs. (31)-(36)). The
 equations below are the standard lumped forms for a hydrostatic drive; the
 paper gives none of them. Equation tags (P1)-(P8) are this package's own and
-are listed in the README. The line pressures (P1) and the relief valve (P2) are
+are listed in doc/plant.md. The line pressures (P1) and the relief valve (P2) are
 solved implicitly with the shaft in :meth:`satmotor_ros.plant.Plant._solve`; the
 viscosity follows the liquid's law (:mod:`satmotor_ros.model.viscosity`) through
 the ``viscosity_temperature`` effect.

@@ -6,7 +6,7 @@ Every record is frozen and checks its fields on construction; an error names the
 field and the value. Each field carries its description, unit and closed range as
 dataclass field metadata (:func:`parameter`), which the node's parameter
 descriptors and ``config/virtual_motor.yaml`` are made from. Defaults describe a
-small test rig around the SM-0,75/25 (README, "The plant"); no effect is injected
+small test rig around the SM-0,75/25 (doc/plant.md); no effect is injected
 by default.
 """
 
@@ -49,14 +49,12 @@ def parameter(default: Any, description: str, unit: str = '-', low: float | None
                  metadata={'description': description, 'unit': unit, 'range': span})
 
 
-def check_bounds(record: object) -> None:
+class Bounded:
     """
-    Check every field of a record that has a ``range`` in its metadata (closed ranges).
+    Base of the parameter records: construction checks each field's closed range.
 
-    Parameters
-    ----------
-    record : object
-        A dataclass whose fields were declared with :func:`parameter`, [-]
+    Every field declared with a ``range`` in its metadata (:func:`parameter`) must
+    hold a finite number inside it.
 
     Raises
     ------
@@ -64,21 +62,25 @@ def check_bounds(record: object) -> None:
         Naming the first field outside its range and its value.
 
     """
-    for f in fields(record):  # type: ignore[arg-type]
-        span = f.metadata.get('range')
-        if span is None:
-            continue
-        low, high = span
-        value = getattr(record, f.name)
-        ok = (isinstance(value, (int, float)) and not isinstance(value, bool)
-              and math.isfinite(value) and low <= value <= high)
-        if not ok:
-            msg = f'{type(record).__name__}.{f.name} = {value!r} is outside [{low:g}, {high:g}]'
-            raise PlantError(msg)
+
+    def __post_init__(self) -> None:
+        """Reject values outside their range, naming the field."""
+        for f in fields(self):  # type: ignore[arg-type]
+            span = f.metadata.get('range')
+            if span is None:
+                continue
+            low, high = span
+            value = getattr(self, f.name)
+            ok = (isinstance(value, (int, float)) and not isinstance(value, bool)
+                  and math.isfinite(value) and low <= value <= high)
+            if not ok:
+                msg = (f'{type(self).__name__}.{f.name} = {value!r} is outside '
+                       f'[{low:g}, {high:g}]')
+                raise PlantError(msg)
 
 
 @dataclass(frozen=True)
-class LineParams:
+class LineParams(Bounded):
     """Inlet and outlet lines, tank and return line."""
 
     inlet_volume: float = parameter(
@@ -93,13 +95,9 @@ class LineParams:
     vapour_pressure: float = parameter(
         2.0e3, 'absolute floor of both lines (cavitation)', 'Pa', 0.0, 1.0e5)
 
-    def __post_init__(self) -> None:
-        """Reject values outside their range, naming the field."""
-        check_bounds(self)
-
 
 @dataclass(frozen=True)
-class ReliefParams:
+class ReliefParams(Bounded):
     """Relief valve from the inlet line to the tank, a proportional characteristic."""
 
     cracking_pressure: float = parameter(
@@ -107,13 +105,9 @@ class ReliefParams:
     conductance: float = parameter(
         40.0 * LPM / (2.0 * MPA), 'k_rv, flow per override', 'm^3/(s*Pa)', 1.0e-13, 1.0e-5)
 
-    def __post_init__(self) -> None:
-        """Reject values outside their range, naming the field."""
-        check_bounds(self)
-
 
 @dataclass(frozen=True)
-class ShaftParams:
+class ShaftParams(Bounded):
     """Shaft, its inertia and the hydro-mechanical (torque) losses."""
 
     inertia: float = parameter(0.01, 'J, motor and coupled load', 'kg*m^2', 1.0e-6, 1.0e3)
@@ -124,13 +118,9 @@ class ShaftParams:
         0.04, 'c_p, share of q_t*dp_i lost to friction', '-', 0.0, 0.9)
     locked: bool = parameter(False, 'shaft blocked by a brake: speed held at 0')
 
-    def __post_init__(self) -> None:
-        """Reject values outside their range, naming the field."""
-        check_bounds(self)
-
 
 @dataclass(frozen=True)
-class ThermalParams:
+class ThermalParams(Bounded):
     """Lumped heat balance of the liquid: every watt of loss heats it."""
 
     heat_capacity: float = parameter(4.0e4, 'C_th, liquid and metal', 'J/K', 1.0, 1.0e9)
@@ -141,26 +131,18 @@ class ThermalParams:
     reference: float = parameter(
         40.0, "temperature of the liquid's nominal viscosity", 'degC', -50.0, 200.0)
 
-    def __post_init__(self) -> None:
-        """Reject values outside their range, naming the field."""
-        check_bounds(self)
-
 
 @dataclass(frozen=True)
-class CaseParams:
+class CaseParams(Bounded):
     """Case pressure: the drain's back pressure plus a share of the outlet pressure."""
 
     offset: float = parameter(
         0.05 * MPA, 'case pressure above tank at zero outlet pressure', 'Pa', 0.0, 1.0e7)
     outlet_share: float = parameter(0.1, 'd p_case / d p_out', '-', 0.0, 1.0)
 
-    def __post_init__(self) -> None:
-        """Reject values outside their range, naming the field."""
-        check_bounds(self)
-
 
 @dataclass(frozen=True)
-class SensorParams:
+class SensorParams(Bounded):
     """One sensor: reading = gain*value + bias + noise, sampled and held at `rate`."""
 
     noise: float = parameter(
@@ -169,10 +151,6 @@ class SensorParams:
     gain: float = parameter(1.0, 'factor on the true value', '-', 1.0e-3, 10.0)
     rate: float = parameter(
         0.0, 'samples per second; 0 samples at every read', 'Hz', 0.0, 1.0e6)
-
-    def __post_init__(self) -> None:
-        """Reject values outside their range, naming the field."""
-        check_bounds(self)
 
 
 SENSOR_CHANNELS = ('inlet_pressure', 'outlet_pressure', 'case_pressure', 'flow', 'speed',
@@ -193,7 +171,7 @@ class SensorSet:
 
 
 @dataclass(frozen=True)
-class PlantParams:
+class PlantParams(Bounded):
     """
     Everything the plant needs besides the motor model.
 
@@ -221,7 +199,7 @@ class PlantParams:
 
     def __post_init__(self) -> None:
         """Reject values outside their range and unknown or repeated effects, naming them."""
-        check_bounds(self)
+        super().__post_init__()
         try:
             for effect in check_effects(self.effects, 'PlantParams.effects'):
                 kind_of(effect)
