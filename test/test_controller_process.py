@@ -8,6 +8,7 @@ set-point given as a parameter, then to one given on ``speed_setpoint``.
 """
 
 import os
+import select
 import time
 
 import pytest
@@ -31,6 +32,19 @@ def _start(env, cwd, name, *ros_args):
 
 
 _stop = build.stop_process
+
+
+def _read_until(process, text, timeout=30.0):
+    """Read the process's output until `text` appears, the output ends or the deadline."""
+    fd, seen = process.stdout.fileno(), ''
+    deadline = time.monotonic() + timeout
+    while text not in seen and time.monotonic() < deadline:
+        if select.select([fd], [], [], 0.1)[0]:
+            chunk = os.read(fd, 4096)
+            if not chunk:
+                break
+            seen += chunk.decode(errors='replace')
+    return seen
 
 
 def test_installed_controller_drives_the_installed_virtual_motor_on_sim_time(
@@ -77,10 +91,13 @@ def test_installed_controller_falls_back_to_defaults_on_bad_parameters(
         sourced_install, tmp_path, bad):
     """A bad parameter override is reported in one line and the default used; it runs on."""
     process = _start(sourced_install, tmp_path, 'speed_controller', '-p', bad)
+    seen = ''
     try:
-        time.sleep(3.0)
+        seen = _read_until(process, 'using the default')  # start-up takes long under load
+        time.sleep(1.0)
         assert process.poll() is None, 'the controller died on a bad parameter'
     finally:
-        code, output = _stop(process)
+        code, rest = _stop(process)
+    output = seen + rest
     assert code == 0, output
     assert bad.split(':=')[0] in output and 'using the default' in output
