@@ -53,6 +53,10 @@ TOPIC_TYPES = {
 }
 """Each DESIGN.md topic (relative name) and its message type."""
 
+VALUE_FIELD = {FLOAT64: 'data', FLUID_PRESSURE: 'fluid_pressure', TEMPERATURE: 'temperature',
+               JOINT_STATE: 'velocity'}
+"""The number a message of each single-value type carries (JointState: the joint's velocity)."""
+
 MODEL_OUTPUTS = (PREDICTED_JOINT_STATE, SPEED_RESIDUAL, LOSSES_PREFIX, LOSSES_ARRAY)
 """What ``motor_model`` publishes (``losses/`` as a prefix): predictions, not measurements."""
 
@@ -209,5 +213,5 @@ __all__ = [
     'FLOAT64_ARRAY', 'FLUID_PRESSURE', 'JOINT_NAME', 'JOINT_STATE', 'LIQUID_PROPERTIES',
     'LOSSES_ARRAY', 'LOSSES_PREFIX', 'LOSS_COMPONENTS', 'MODEL_OUTPUTS', 'MotorOptions',
     'OptionError', 'PREDICTED_JOINT_STATE', 'PREDICTION_INPUTS', 'PRESSURE_TOPICS',
-    'SPEED_RESIDUAL', 'TEMPERATURE', 'TOPIC_TYPES',
+    'SPEED_RESIDUAL', 'TEMPERATURE', 'TOPIC_TYPES', 'VALUE_FIELD',
 ]

@@ -6,7 +6,7 @@ import dataclasses
 import pytest
 
 from satmotor_ros.interface import (CHANNELS, JOINT_NAME, LOSS_COMPONENTS, MotorOptions,
-                                    OptionError, PREDICTION_INPUTS, TOPIC_TYPES)
+                                    OptionError, PREDICTION_INPUTS, TOPIC_TYPES, VALUE_FIELD)
 from satmotor_ros.model import COMPONENTS, MotorModel
 
 DESIGN_TABLE = {  # DESIGN.md's topic table, as written there
@@ -33,6 +33,7 @@ def test_every_channel_is_a_design_topic_with_a_field_of_its_type():
     fields = {'std_msgs/msg/Float64': 'data', 'sensor_msgs/msg/FluidPressure': 'fluid_pressure',
               'sensor_msgs/msg/Temperature': 'temperature',
               'sensor_msgs/msg/JointState': 'velocity'}
+    assert VALUE_FIELD == fields
     for name, channel in CHANNELS.items():
         assert fields[TOPIC_TYPES[channel.topic]] == channel.field, name
     assert set(PREDICTION_INPUTS) <= set(CHANNELS)

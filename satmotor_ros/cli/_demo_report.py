@@ -10,7 +10,9 @@ import matplotlib
 import numpy as np
 
 from satmotor_ros.bags import OutTopic, read_series, write_bag
-from satmotor_ros.model import COMPONENTS, MotorModel
+from satmotor_ros.interface import (CHANNELS, LOSS_COMPONENTS, LOSSES_PREFIX,
+                                    PREDICTED_JOINT_STATE, VALUE_FIELD)
+from satmotor_ros.model import MotorModel
 from satmotor_ros.model.units import LPM, RPM
 from satmotor_ros.plant.scenario import Cycle, step_metrics, StepMetrics
 
@@ -82,11 +84,16 @@ def hold(t_from: np.ndarray, v_from: np.ndarray, t_to: np.ndarray) -> np.ndarray
     return v_from[index]
 
 
-_FIELD = {'/joint_states': 'velocity', '/predicted_joint_state': 'velocity',
-          '/inlet_pressure': 'fluid_pressure', '/outlet_pressure': 'fluid_pressure'}
-_PLOTTED = ('/joint_states', '/speed_setpoint', '/load_torque', '/flow_command',
-            '/inlet_pressure', '/outlet_pressure', '/flow_measured', '/predicted_joint_state',
-            *(f'/losses/{c}' for c in COMPONENTS))
+def _topic(name: str) -> str:
+    """Return the absolute topic of a channel (interface.CHANNELS) or of another topic."""
+    return '/' + (CHANNELS[name].topic if name in CHANNELS else name)
+
+
+_SPEED, _TORQUE, _FLOW, _P_IN, _P_OUT, _FLOW_MEASURED, _PREDICTED = (_topic(name) for name in (
+    'measured_speed', 'torque', 'flow', 'p_in', 'p_out', 'flow_measured', PREDICTED_JOINT_STATE))
+_LOSSES = {c: _topic(LOSSES_PREFIX + c) for c in LOSS_COMPONENTS}
+_PLOTTED = (_SPEED, '/speed_setpoint', _TORQUE, _FLOW, _P_IN, _P_OUT, _FLOW_MEASURED, _PREDICTED,
+            *_LOSSES.values())
 
 
 def read_run(bag: Path) -> dict[str, tuple[np.ndarray, np.ndarray]]:
@@ -105,8 +112,7 @@ def read_run(bag: Path) -> dict[str, tuple[np.ndarray, np.ndarray]]:
 
     """
     found = read_series(bag, _PLOTTED)
-    return {name: (s.t_ns * 1e-9, s.fields[_FIELD.get(name, 'data')])
-            for name, s in found.items()}
+    return {name: (s.t_ns * 1e-9, s.fields[VALUE_FIELD[s.msgtype]]) for name, s in found.items()}
 
 
 class Tracking:
@@ -117,16 +123,15 @@ class Tracking:
         self.run = run
         self.data = data = read_run(run.bag)
         empty = (np.zeros(0), np.zeros(0))
-        self.t, self.speed = data['/joint_states']
+        self.t, self.speed = data[_SPEED]
         t_sp, sp = data.get('/speed_setpoint', empty)
         keep = self.t >= (t_sp[0] if len(t_sp) else np.inf)
         self.t, self.speed = self.t[keep], self.speed[keep]
         self.setpoint = hold(t_sp, sp, self.t)
-        self.load = hold(*data.get('/load_torque', empty), self.t)
-        self.command = hold(*data.get('/flow_command', empty), self.t)
-        self.dp = (hold(*data['/inlet_pressure'], self.t)
-                   - hold(*data['/outlet_pressure'], self.t))
-        self.flow = hold(*data['/flow_measured'], self.t)
+        self.load = hold(*data.get(_TORQUE, empty), self.t)
+        self.command = hold(*data.get(_FLOW, empty), self.t)
+        self.dp = hold(*data[_P_IN], self.t) - hold(*data[_P_OUT], self.t)
+        self.flow = hold(*data[_FLOW_MEASURED], self.t)
 
     def metrics(self) -> list[StepMetrics]:
         """Measure every step of the run."""
@@ -228,10 +233,10 @@ def predicted(tr: Tracking) -> tuple[np.ndarray, dict[str, np.ndarray], str]:
 
     """
     data = tr.data
-    if '/predicted_joint_state' in data:
-        losses = {c: np.nan_to_num(hold(*data[f'/losses/{c}'], tr.t)) if f'/losses/{c}' in data
-                  else np.zeros_like(tr.t) for c in COMPONENTS}
-        return (hold(*data['/predicted_joint_state'], tr.t), losses,
+    if _PREDICTED in data:
+        losses = {c: np.nan_to_num(hold(*data[topic], tr.t)) if topic in data
+                  else np.zeros_like(tr.t) for c, topic in _LOSSES.items()}
+        return (hold(*data[_PREDICTED], tr.t), losses,
                 'the motor_model node (its recorded topics)')
     model = MotorModel.default(tr.run.liquid)
     op = model.speed(np.maximum(tr.flow, 0.0), np.maximum(tr.dp, 0.0), errors='mask')
@@ -260,7 +265,7 @@ def _plot_prediction(out: Path, liquid: str, tr: Tracking,
     plt.close(fig)
 
     fig, ax = plt.subplots(figsize=(10, 4.5))
-    parts = [c for c in COMPONENTS if c != 'total']
+    parts = [c for c in LOSS_COMPONENTS if c != 'total']
     stack = [np.nan_to_num(losses[c]) / LPM for c in parts]
     ax.stackplot(tr.t, *stack, labels=parts, alpha=0.85)
     ax.plot(tr.t, np.nan_to_num(losses['total']) / LPM, 'k', lw=0.8, label='total')
