@@ -3,18 +3,18 @@
 The equations of one motor on one liquid, composed: leakage, breakdown, drops, residuals.
 
 :class:`Equations` is what the single-point path (:mod:`.point`) and the array
-maps (:mod:`.inverse`, :mod:`.forward`) share: every method calls the equation
+maps (:mod:`.inverse`, :mod:`.forward`) share: every composition calls the equation
 functions of :mod:`.losses`, :mod:`.speed` and the displacement law with the
 model's constants, and works on Python floats and on arrays alike. The maps
 add only screening, status flags and the solver (:mod:`.solve`); a motor family
-with other equations provides another object with these methods.
+with other equations provides another object with these callables.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
 
-from satmotor_ros.model._numeric import maximum, maximum_for, minimum
+from satmotor_ros.model._numeric import maximum, minimum
 from satmotor_ros.model._typing import Real
 from satmotor_ros.model.derived import DerivedCoefficients
 from satmotor_ros.model.laws import DisplacementLaw
@@ -42,64 +42,101 @@ class Equations:
 
     """
 
+    channel_drop: Callable[[Real], Real]
+    """Q -> the channel drop of eq. (35), [Pa]."""
+    chamber_drop: Callable[[Real, Real], Real]
+    """(dp, Q) -> dp_i of eqs. (34)-(35), unclipped (negative where the channels take it all)."""
+    leakage: Callable[[Real, Real], tuple[Real, Real, Real | float]]
+    """(dp_i, p_ex) -> Q_Lfg, Q_C and Q_ex of eqs. (1), (2), (5) and (24), [m^3/s]."""
+    breakdown: Callable[[Real, Real, Real], tuple[Real, Real, Real, Real, Real]]
+    """
+    (n, dp_i, leak) -> Delta Q_fc, Delta Q_dch, Delta Q_b, Delta Q_id and Q_vl of eq. (31).
+
+    `leak` is Q_Lfg + Q_C + Q_ex; the law shares its loss among eqs. (11)-(14).
+    """
+    closed_form_speed: Callable[[Real, Real, Real], Real]
+    """(Q, dp_i, leak) -> n of eq. (40), for the law of eq. (33), [rad/s]."""
+
+    speed_problem: Callable[[Real, Real, Real], tuple[Real, Real, Residual[Real]]]
+    """(Q, dp_i, leak) -> eq. (36) at fixed dp_i posed for the solver: lo, hi, residual."""
+    flow_problem: Callable[[Real, Real, Real], tuple[Real, Callable[[], Real], Residual[Real]]]
+    """(n, dp, p_ex) -> eqs. (34)-(36) at fixed n and port dp for the solver: lo, upper, residual."""
+
     def __init__(self, derived: DerivedCoefficients, law: DisplacementLaw) -> None:
-        """Keep the parts."""
+        """Keep the parts and bind the constants into the compositions, once per model."""
         self.derived, self.law = derived, law
         self.closed_form = law.closed_form
-        d = derived
-        # the constants each composition needs, unpacked in one step on the float path
-        self._channel = (d.ch_a, d.ch_b)
-        self._leakage = (d.h0, d.compliance, d.lfg_k, d.lfg_e, d.com_k, d.com_e, d.k_ex)
-        self._parts = (d.k_fc, d.k_dch, d.k_b, d.k_i)
-        self._coupled = (d.ch_a, d.ch_b, d.h0, d.compliance, d.lfg_k, d.lfg_e, d.com_k, d.com_e,
-                         d.qt, d.k_ex, d.dp_limit)
+        self.channel_drop, self.chamber_drop = _drops(derived)
+        self.leakage = _leakage(derived)
+        self.breakdown = _breakdown(derived, law)
+        self.closed_form_speed = _closed_form_speed(derived)
+        self.speed_problem = _speed_problem(derived, law)
+        self.flow_problem = _flow_problem(derived, law)
 
-    # -- pressure drops --------------------------------------------------------------------
 
-    def channel_drop(self, flow: Real) -> Real:
-        """Return the channel drop of eq. (35), [Pa]."""
-        return channel_pressure_drop(flow, *self._channel)
+# The builders below bind a model's constants and the equation functions into closures once,
+# so that a call reads them from its own cells: on a Python float, looking them up on every
+# call (attributes, tuples, globals) would cost as much as the arithmetic.
 
-    def chamber_drop(self, dp: Real, flow: Real) -> Real:
-        """Return dp_i of eqs. (34)-(35), unclipped (negative where the channels take it all)."""
-        return chamber_pressure_drop(dp, channel_pressure_drop(flow, *self._channel))
+def _drops(d: DerivedCoefficients) -> tuple[Callable[[Real], Real], Callable[[Real, Real], Real]]:
+    """Return the channel drop Q -> dp_ich of eq. (35) and (dp, Q) -> dp_i of eq. (34)."""
+    ch_a, ch_b = d.ch_a, d.ch_b
+    channel, chamber = channel_pressure_drop, chamber_pressure_drop
 
-    # -- losses ----------------------------------------------------------------------------
+    def channel_drop(flow: Real) -> Real:
+        return channel(flow, ch_a, ch_b)
 
-    def leakage(self, dp_i: Real,
-                p_ex: Real) -> tuple[Real, Real, Real | float]:
-        """Return Q_Lfg, Q_C and Q_ex of eqs. (1), (2), (5) and (24), [m^3/s]."""
-        h0, compliance, k_lfg, e_lfg, k_c, gamma, k_ex = self._leakage
-        h = clearance_height(dp_i, h0, compliance)
-        return (flat_clearance_leakage(dp_i, h, k_lfg, e_lfg),
-                commutation_leakage(dp_i, k_c, gamma),
-                external_leakage(p_ex, k_ex) if k_ex else 0.0)
+    def chamber_drop(dp: Real, flow: Real) -> Real:
+        return chamber(dp, channel(flow, ch_a, ch_b))
+    return channel_drop, chamber_drop
 
-    def breakdown(self, speed: Real, dp_i: Real,
-                  leak: Real) -> tuple[Real, ...]:
-        """
-        Return Delta Q_fc, Delta Q_dch, Delta Q_b, Delta Q_id and Q_vl of eq. (31), [m^3/s].
 
-        `leak` is Q_Lfg + Q_C + Q_ex; the law shares its loss among eqs. (11)-(14).
-        """
-        k_fc, k_dch, k_b, k_i = self._parts
-        fc, dch, bl, ine = (pressure_speed_loss(dp_i, speed, k_fc),
-                            pressure_speed_loss(dp_i, speed, k_dch),
-                            pressure_speed_loss(dp_i, speed, k_b), inertia_loss(speed, k_i))
-        if self.law.shares:
-            fc, dch, bl, ine = self.law.share((fc, dch, bl, ine), speed, dp_i)
+def _leakage(d: DerivedCoefficients) -> Callable[[Real, Real], tuple[Real, Real, Real | float]]:
+    """Return (dp_i, p_ex) -> Q_Lfg, Q_C, Q_ex of eqs. (1), (2), (5) and (24)."""
+    h0, compliance, k_lfg, e_lfg, k_c, gamma, k_ex = (d.h0, d.compliance, d.lfg_k, d.lfg_e,
+                                                      d.com_k, d.com_e, d.k_ex)
+    clearance, flat, commutation = clearance_height, flat_clearance_leakage, commutation_leakage
+    external = external_leakage
+
+    def leakage(dp_i: Real, p_ex: Real) -> tuple[Real, Real, Real | float]:
+        return (flat(dp_i, clearance(dp_i, h0, compliance), k_lfg, e_lfg),
+                commutation(dp_i, k_c, gamma), external(p_ex, k_ex) if k_ex else 0.0)
+    return leakage
+
+
+def _breakdown(d: DerivedCoefficients, law: DisplacementLaw) -> Callable[
+        [Real, Real, Real], tuple[Real, Real, Real, Real, Real]]:
+    """Return (n, dp_i, leak) -> the components of eq. (31) and Q_vl, as the law shares them."""
+    k_fc, k_dch, k_b, k_i = d.k_fc, d.k_dch, d.k_b, d.k_i
+    linear, inertia = pressure_speed_loss, inertia_loss
+    share = law.share if law.shares else None
+
+    def breakdown(speed: Real, dp_i: Real, leak: Real) -> tuple[Real, Real, Real, Real, Real]:
+        fc, dch, bl, ine = (linear(dp_i, speed, k_fc), linear(dp_i, speed, k_dch),
+                            linear(dp_i, speed, k_b), inertia(speed, k_i))
+        if share is not None:
+            fc, dch, bl, ine = share((fc, dch, bl, ine), speed, dp_i)
         return fc, dch, bl, ine, leak + ((fc + dch) + (bl + ine))
+    return breakdown
 
-    # -- the inverse map n(Q, dp_i) --------------------------------------------------------
 
-    def closed_form_speed(self, flow: Real, dp_i: Real,
-                          leak: Real) -> Real:
-        """Return n of eq. (40), for the law of eq. (33), [rad/s]."""
-        d = self.derived
-        return effective_speed(flow, dp_i, leak, d.es_a0, d.es_a1, d.es_scale, d.es_b)
+def _closed_form_speed(d: DerivedCoefficients) -> Callable[[Real, Real, Real], Real]:
+    """Return (Q, dp_i, leak) -> n of eq. (40)."""
+    a0, a1, scale, b = d.es_a0, d.es_a1, d.es_scale, d.es_b
+    speed = effective_speed
 
-    def speed_problem(self, flow: Real, dp_i: Real,
-                      leak: Real) -> tuple[Real, Real, Residual[Real]]:
+    def closed_form_speed(flow: Real, dp_i: Real, leak: Real) -> Real:
+        return speed(flow, dp_i, leak, a0, a1, scale, b)
+    return closed_form_speed
+
+
+def _speed_problem(d: DerivedCoefficients, law: DisplacementLaw) -> Callable[
+        [Real, Real, Real], tuple[Real, Real, Residual[Real]]]:
+    """Return :meth:`Equations.speed_problem` for one model."""
+    qt, at_pressure = d.qt, law.at_pressure
+    absorbed = absorbency
+
+    def speed_problem(flow: Real, dp_i: Real, leak: Real) -> tuple[Real, Real, Residual[Real]]:
         """
         Return eq. (36) at fixed dp_i posed for the solver: a bracket of n and the residual.
 
@@ -127,17 +164,26 @@ class Equations:
             n -> (Q(n) - flow [m^3/s], its slope [m^3/rad]), n > 0.
 
         """
-        qt = self.derived.qt
-        floor, terms = self.law.at_pressure(dp_i)
+        floor, terms = at_pressure(dp_i)
 
         def residual(speed: Real) -> tuple[Real, Real]:
             loss, slope = terms(speed)
-            return absorbency(speed, loss + leak, qt) - flow, qt + slope
+            return absorbed(speed, loss + leak, qt) - flow, qt + slope
         return floor, maximum(flow - leak, 0.0) / qt, residual
+    return speed_problem
 
-    # -- the forward map Q(n, dp) with the channel drop coupled -----------------------------
 
-    def flow_problem(self, speed: Real, dp: Real,
+def _flow_problem(d: DerivedCoefficients, law: DisplacementLaw) -> Callable[
+        [Real, Real, Real], tuple[Real, Callable[[], Real], Residual[Real]]]:
+    """Return :meth:`Equations.flow_problem` for one model."""
+    ch_a, ch_b, h0, compliance, k_lfg, e_lfg, k_c, gamma, qt, k_ex, limit = (
+        d.ch_a, d.ch_b, d.h0, d.compliance, d.lfg_k, d.lfg_e, d.com_k, d.com_e, d.qt, d.k_ex,
+        d.dp_limit)
+    at_speed, absorbed, external = law.at_speed, absorbency, external_leakage
+    channel, chamber, clearance = channel_pressure_drop, chamber_pressure_drop, clearance_height
+    flat, commutation = flat_clearance_leakage, commutation_leakage
+
+    def flow_problem(speed: Real, dp: Real,
                      p_ex: Real) -> tuple[Real, Callable[[], Real], Residual[Real]]:
         """
         Return eqs. (34)-(36) at fixed n and port dp posed for the solver (``mirror=True``).
@@ -167,17 +213,15 @@ class Equations:
             Q -> (Q - A(Q) [m^3/s], its slope [-]).
 
         """
-        ch_a, ch_b, h0, compliance, k_lfg, e_lfg, k_c, gamma, qt, k_ex, limit = self._coupled
         dp_cap = minimum(dp, limit)
-        clip = maximum_for(dp_cap)
-        terms = self.law.at_speed(speed)
-        base = absorbency(speed, external_leakage(p_ex, k_ex) if k_ex else 0.0 * p_ex, qt)
-        channel, clearance = channel_pressure_drop, clearance_height
-        flat, commutation = flat_clearance_leakage, commutation_leakage
+        terms = at_speed(speed)
+        base = absorbed(speed, external(p_ex, k_ex) if k_ex else 0.0 * p_ex, qt)
 
         def residual(flow: Real) -> tuple[Real, Real]:
-            # eq. (34), clipped at 0 where the channels take the whole drop
-            dp_i = clip(dp_cap - channel(flow, ch_a, ch_b), 0.0)
+            # eq. (34), clipped at 0 where the channels take the whole drop: x (x > 0) is
+            # max(x, 0) for a float (-0.0 is 0) and an array alike, without a call
+            dp_i = chamber(dp_cap, channel(flow, ch_a, ch_b))
+            dp_i *= dp_i > 0.0
             h = clearance(dp_i, h0, compliance)
             q_lfg, q_c = flat(dp_i, h, k_lfg, e_lfg), commutation(dp_i, k_c, gamma)
             loss, d_loss = terms(dp_i)
@@ -192,3 +236,4 @@ class Equations:
             return base + (terms(dp_cap)[0] + flat(dp_cap, h, k_lfg, e_lfg)
                            + commutation(dp_cap, k_c, gamma))
         return qt * speed, upper, residual
+    return flow_problem

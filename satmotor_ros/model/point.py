@@ -91,10 +91,17 @@ class PointEvaluator:
     """
 
     def __init__(self, eqs: Equations) -> None:
-        """Keep the equations."""
+        """Keep the equations, and the parts each point reads, in its own attributes."""
         self.eqs = eqs
         self.d = d = eqs.derived
+        self._qt, self._dp_limit, self._closed_form = d.qt, d.dp_limit, eqs.closed_form
         self._range = (d.dp_max, d.speed_max, d.dp_min, d.speed_min, d.liquid_extrapolated)
+        self._leakage, self._breakdown = eqs.leakage, eqs.breakdown
+        self._chamber_drop, self._channel_drop = eqs.chamber_drop, eqs.channel_drop
+        self._speed_problem, self._flow_problem = eqs.speed_problem, eqs.flow_problem
+        self._closed_form_speed = eqs.closed_form_speed
+        law = eqs.law
+        self._max_floor, self._floor = law.max_floor, law.floor
 
     def _point(self, flow: float | None, speed: float, dp: float | None, dp_i: float,
                q_lfg: float, q_c: float, q_ex: float, status: int) -> Point:
@@ -104,55 +111,51 @@ class PointEvaluator:
         A `flow` of None is the absorbency of eq. (36); a `dp` of None is dp_i
         plus the channel drop of eq. (35) at that flow.
         """
-        fc, dch, bl, ine, total = self.eqs.breakdown(speed, dp_i, q_lfg + q_c + q_ex)
+        fc, dch, bl, ine, total = self._breakdown(speed, dp_i, q_lfg + q_c + q_ex)
         dp_max, speed_max, dp_min, speed_min, liquid_extrapolated = self._range
         if (dp_i > dp_max or speed > speed_max or dp_i < dp_min or speed < speed_min
                 or liquid_extrapolated):
             status |= _EXTRAPOLATED
         if flow is None:
-            flow = absorbency(speed, total, self.d.qt)
+            flow = absorbency(speed, total, self._qt)
         if dp is None:
-            dp = dp_i + self.eqs.channel_drop(flow)
+            dp = dp_i + self._channel_drop(flow)
         return _new_point(Point, (flow, speed, dp, dp_i, q_lfg, q_c, fc, dch, bl, ine, q_ex,
                                   total, status))
 
     def _chamber(self, dp: float, flow: float, port: bool) -> tuple[float, int]:
         """Return dp_i of eqs. (34)-(35) clipped at 0, and CHANNEL_LIMITED or BEYOND_LIMIT."""
-        if not port:
-            return dp, (_BEYOND_LIMIT if dp > self.d.dp_limit else 0)
-        dp_i = self.eqs.chamber_drop(dp, flow)
+        dp_i = self._chamber_drop(dp, flow) if port else dp
         if dp_i < 0.0:
             return 0.0, _CHANNEL_LIMITED
-        return dp_i, (_BEYOND_LIMIT if dp_i > self.d.dp_limit else 0)
+        return dp_i, (_BEYOND_LIMIT if dp_i > self._dp_limit else 0)
 
     def speed(self, flow: float, dp: float, port: bool, p_ex: float) -> Point:
         """Compute n(Q, dp) at one point: :meth:`MotorModel.speed_point` without effects."""
         if not (0.0 <= flow < _INF and 0.0 <= dp < _INF and 0.0 <= p_ex < _INF):
             return _invalid(_screen(flow) | _screen(dp) | _screen(p_ex))
-        eqs = self.eqs
         dp_i, status = self._chamber(dp, flow, port)
         if status & _BEYOND_LIMIT:
             return _invalid(status)
-        q_lfg, q_c, q_ex = eqs.leakage(dp_i, p_ex)
-        leak = q_lfg + q_c + q_ex
-        if eqs.closed_form:
-            speed = eqs.closed_form_speed(flow, dp_i, leak)
+        q_lfg, q_c, q_ex = self._leakage(dp_i, p_ex)
+        if self._closed_form:
+            speed = self._closed_form_speed(flow, dp_i, q_lfg + q_c + q_ex)
         else:
-            speed, failed = self._solve_speed(flow, dp_i, leak)
+            speed, failed = self._solve_speed(flow, dp_i, q_lfg + q_c + q_ex)
             if failed:
                 return _invalid(failed)
         if speed == 0.0:
             status |= _STALLED
         point = self._point(flow, speed, dp if port else None, dp_i, q_lfg, q_c, q_ex, status)
-        if not eqs.closed_form and speed > 0.0 and not (
-                abs(absorbency(speed, point.total, self.d.qt) - flow)
+        if not self._closed_form and speed > 0.0 and not (
+                abs(absorbency(speed, point.total, self._qt) - flow)
                 <= CHECK * flow + FLOW_ATOL):
             return _invalid(_NO_ROOT)
         return point
 
     def _solve_speed(self, flow: float, dp_i: float, leak: float) -> tuple[float, int]:
         """Solve eq. (36) for n at given flow and dp_i; return n and a status flag."""
-        lo, hi, residual = self.eqs.speed_problem(flow, dp_i, leak)
+        lo, hi, residual = self._speed_problem(flow, dp_i, leak)
         if not hi > lo:
             return 0.0, (_NO_ROOT if hi > 0.0 and lo > 0.0 else 0)
         if lo > 0.0 and not residual(lo)[0] < 0.0:
@@ -164,10 +167,9 @@ class PointEvaluator:
         """Compute Q(n, dp) at one point: :meth:`MotorModel.absorbency_point` without effects."""
         if not (0.0 <= speed < _INF and 0.0 <= dp < _INF and 0.0 <= p_ex < _INF):
             return _invalid(_screen(speed) | _screen(dp) | _screen(p_ex))
-        eqs = self.eqs
         root = speed  # not used without `port`
         if port:
-            lo, upper, residual = eqs.flow_problem(speed, dp, p_ex)
+            lo, upper, residual = self._flow_problem(speed, dp, p_ex)
             if flow_guess is not None and lo < flow_guess < _INF:
                 hi, start = _INF, flow_guess
             else:  # no useful guess: start at the upper bound
@@ -179,10 +181,9 @@ class PointEvaluator:
         dp_i, status = self._chamber(dp, root, port)
         if status & _BEYOND_LIMIT:
             return _invalid(status)
-        law = eqs.law
-        if 0.0 < speed < law.max_floor and speed < law.floor(dp_i):
+        if 0.0 < speed < self._max_floor and speed < self._floor(dp_i):
             return _invalid(_BEYOND_LIMIT)
-        q_lfg, q_c, q_ex = eqs.leakage(dp_i, p_ex)
+        q_lfg, q_c, q_ex = self._leakage(dp_i, p_ex)
         point = self._point(None, speed, dp if port else None, dp_i, q_lfg, q_c, q_ex, status)
         if port and not abs(point.flow - root) <= CHECK * root + FLOW_ATOL:
             return _invalid(_NO_ROOT)
