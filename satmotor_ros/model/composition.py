@@ -14,6 +14,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
+from satmotor_ros.model._inline import inline_equations
 from satmotor_ros.model._numeric import maximum, minimum
 from satmotor_ros.model._typing import Real
 from satmotor_ros.model.derived import DerivedCoefficients
@@ -60,7 +61,7 @@ class Equations:
     speed_problem: Callable[[Real, Real, Real], tuple[Real, Real, Residual[Real]]]
     """(Q, dp_i, leak) -> eq. (36) at fixed dp_i posed for the solver: lo, hi, residual."""
     flow_problem: Callable[[Real, Real, Real], tuple[Real, Callable[[], Real], Residual[Real]]]
-    """(n, dp, p_ex) -> eqs. (34)-(36) at fixed n and port dp for the solver: lo, upper, residual."""
+    """(n, dp, p_ex) -> eqs. (34)-(36) at fixed n and port dp for the solver: lo, upper, f."""
 
     def __init__(self, derived: DerivedCoefficients, law: DisplacementLaw) -> None:
         """Keep the parts and bind the constants into the compositions, once per model."""
@@ -74,46 +75,48 @@ class Equations:
         self.flow_problem = _flow_problem(derived, law)
 
 
-# The builders below bind a model's constants and the equation functions into closures once,
-# so that a call reads them from its own cells: on a Python float, looking them up on every
-# call (attributes, tuples, globals) would cost as much as the arithmetic.
+# The builders below bind a model's constants into closures once, so that a call reads them
+# from its own cells, and @inline_equations puts the equation functions' expressions in place
+# of their calls: on a Python float, lookups and calls would cost as much as the arithmetic.
 
+@inline_equations
 def _drops(d: DerivedCoefficients) -> tuple[Callable[[Real], Real], Callable[[Real, Real], Real]]:
     """Return the channel drop Q -> dp_ich of eq. (35) and (dp, Q) -> dp_i of eq. (34)."""
     ch_a, ch_b = d.ch_a, d.ch_b
-    channel, chamber = channel_pressure_drop, chamber_pressure_drop
 
     def channel_drop(flow: Real) -> Real:
-        return channel(flow, ch_a, ch_b)
+        return channel_pressure_drop(flow, ch_a, ch_b)
 
     def chamber_drop(dp: Real, flow: Real) -> Real:
-        return chamber(dp, channel(flow, ch_a, ch_b))
+        return chamber_pressure_drop(dp, channel_pressure_drop(flow, ch_a, ch_b))
     return channel_drop, chamber_drop
 
 
+@inline_equations
 def _leakage(d: DerivedCoefficients) -> Callable[[Real, Real], tuple[Real, Real, Real | float]]:
     """Return (dp_i, p_ex) -> Q_Lfg, Q_C, Q_ex of eqs. (1), (2), (5) and (24)."""
     h0, compliance, k_lfg, e_lfg, k_c, gamma, k_ex = (d.h0, d.compliance, d.lfg_k, d.lfg_e,
                                                       d.com_k, d.com_e, d.k_ex)
-    clearance, flat, commutation = clearance_height, flat_clearance_leakage, commutation_leakage
-    external = external_leakage
 
     def leakage(dp_i: Real, p_ex: Real) -> tuple[Real, Real, Real | float]:
-        return (flat(dp_i, clearance(dp_i, h0, compliance), k_lfg, e_lfg),
-                commutation(dp_i, k_c, gamma), external(p_ex, k_ex) if k_ex else 0.0)
+        h = clearance_height(dp_i, h0, compliance)
+        return (flat_clearance_leakage(dp_i, h, k_lfg, e_lfg),
+                commutation_leakage(dp_i, k_c, gamma),
+                external_leakage(p_ex, k_ex) if k_ex else 0.0)
     return leakage
 
 
+@inline_equations
 def _breakdown(d: DerivedCoefficients, law: DisplacementLaw) -> Callable[
         [Real, Real, Real], tuple[Real, Real, Real, Real, Real]]:
     """Return (n, dp_i, leak) -> the components of eq. (31) and Q_vl, as the law shares them."""
     k_fc, k_dch, k_b, k_i = d.k_fc, d.k_dch, d.k_b, d.k_i
-    linear, inertia = pressure_speed_loss, inertia_loss
     share = law.share if law.shares else None
 
     def breakdown(speed: Real, dp_i: Real, leak: Real) -> tuple[Real, Real, Real, Real, Real]:
-        fc, dch, bl, ine = (linear(dp_i, speed, k_fc), linear(dp_i, speed, k_dch),
-                            linear(dp_i, speed, k_b), inertia(speed, k_i))
+        fc, dch, bl, ine = (pressure_speed_loss(dp_i, speed, k_fc),
+                            pressure_speed_loss(dp_i, speed, k_dch),
+                            pressure_speed_loss(dp_i, speed, k_b), inertia_loss(speed, k_i))
         if share is not None:
             fc, dch, bl, ine = share((fc, dch, bl, ine), speed, dp_i)
         return fc, dch, bl, ine, leak + ((fc + dch) + (bl + ine))
@@ -130,11 +133,11 @@ def _closed_form_speed(d: DerivedCoefficients) -> Callable[[Real, Real, Real], R
     return closed_form_speed
 
 
+@inline_equations
 def _speed_problem(d: DerivedCoefficients, law: DisplacementLaw) -> Callable[
         [Real, Real, Real], tuple[Real, Real, Residual[Real]]]:
     """Return :meth:`Equations.speed_problem` for one model."""
     qt, at_pressure = d.qt, law.at_pressure
-    absorbed = absorbency
 
     def speed_problem(flow: Real, dp_i: Real, leak: Real) -> tuple[Real, Real, Residual[Real]]:
         """
@@ -168,20 +171,19 @@ def _speed_problem(d: DerivedCoefficients, law: DisplacementLaw) -> Callable[
 
         def residual(speed: Real) -> tuple[Real, Real]:
             loss, slope = terms(speed)
-            return absorbed(speed, loss + leak, qt) - flow, qt + slope
+            return absorbency(speed, loss + leak, qt) - flow, qt + slope
         return floor, maximum(flow - leak, 0.0) / qt, residual
     return speed_problem
 
 
+@inline_equations
 def _flow_problem(d: DerivedCoefficients, law: DisplacementLaw) -> Callable[
         [Real, Real, Real], tuple[Real, Callable[[], Real], Residual[Real]]]:
     """Return :meth:`Equations.flow_problem` for one model."""
     ch_a, ch_b, h0, compliance, k_lfg, e_lfg, k_c, gamma, qt, k_ex, limit = (
         d.ch_a, d.ch_b, d.h0, d.compliance, d.lfg_k, d.lfg_e, d.com_k, d.com_e, d.qt, d.k_ex,
         d.dp_limit)
-    at_speed, absorbed, external = law.at_speed, absorbency, external_leakage
-    channel, chamber, clearance = channel_pressure_drop, chamber_pressure_drop, clearance_height
-    flat, commutation = flat_clearance_leakage, commutation_leakage
+    at_speed = law.at_speed
 
     def flow_problem(speed: Real, dp: Real,
                      p_ex: Real) -> tuple[Real, Callable[[], Real], Residual[Real]]:
@@ -215,15 +217,16 @@ def _flow_problem(d: DerivedCoefficients, law: DisplacementLaw) -> Callable[
         """
         dp_cap = minimum(dp, limit)
         terms = at_speed(speed)
-        base = absorbed(speed, external(p_ex, k_ex) if k_ex else 0.0 * p_ex, qt)
+        base = absorbency(speed, external_leakage(p_ex, k_ex) if k_ex else 0.0 * p_ex, qt)
 
         def residual(flow: Real) -> tuple[Real, Real]:
             # eq. (34), clipped at 0 where the channels take the whole drop: x (x > 0) is
             # max(x, 0) for a float (-0.0 is 0) and an array alike, without a call
-            dp_i = chamber(dp_cap, channel(flow, ch_a, ch_b))
+            dp_i = chamber_pressure_drop(dp_cap, channel_pressure_drop(flow, ch_a, ch_b))
             dp_i *= dp_i > 0.0
-            h = clearance(dp_i, h0, compliance)
-            q_lfg, q_c = flat(dp_i, h, k_lfg, e_lfg), commutation(dp_i, k_c, gamma)
+            h = clearance_height(dp_i, h0, compliance)
+            q_lfg = flat_clearance_leakage(dp_i, h, k_lfg, e_lfg)
+            q_c = commutation_leakage(dp_i, k_c, gamma)
             loss, d_loss = terms(dp_i)
             # d(Q_Lfg + Q_C)/d(dp_i); the leakages are 0 at dp_i = 0, and so is their slope
             inv_dp = 1.0 / (dp_i + _TINY_DROP)
@@ -232,8 +235,8 @@ def _flow_problem(d: DerivedCoefficients, law: DisplacementLaw) -> Callable[
                     1.0 + (dp_i > 0.0) * ((d_leak + d_loss) * (2.0 * ch_a * flow + ch_b)))
 
         def upper() -> Real:
-            h = clearance(dp_cap, h0, compliance)
-            return base + (terms(dp_cap)[0] + flat(dp_cap, h, k_lfg, e_lfg)
-                           + commutation(dp_cap, k_c, gamma))
+            h = clearance_height(dp_cap, h0, compliance)
+            return base + (terms(dp_cap)[0] + flat_clearance_leakage(dp_cap, h, k_lfg, e_lfg)
+                           + commutation_leakage(dp_cap, k_c, gamma))
         return qt * speed, upper, residual
     return flow_problem

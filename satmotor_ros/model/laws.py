@@ -14,6 +14,7 @@ from abc import ABC, abstractmethod
 from collections.abc import Callable
 
 from satmotor_ros.model import losses as eq
+from satmotor_ros.model._inline import inline_equations
 from satmotor_ros.model._numeric import log, maximum, maximum_for
 from satmotor_ros.model._typing import Real
 from satmotor_ros.model.derived import DerivedCoefficients
@@ -83,6 +84,7 @@ class PhysicalLaw(DisplacementLaw):
         d = self.derived
         return eq.displacement_loss(dp_i, speed, d.k_p, d.k_i)
 
+    @inline_equations
     def at_pressure(self, dp_i: Real) -> tuple[Real, Terms[Real]]:
         """Return the floor speed [rad/s] and n -> (Delta Q_vl, its slope in n) at fixed dp_i."""
         k_p, k_i = self.derived.k_p, self.derived.k_i
@@ -92,6 +94,7 @@ class PhysicalLaw(DisplacementLaw):
                     k_p * dp_i + 0.5 * k_i / speed ** 0.5)
         return 0.0 * dp_i, terms
 
+    @inline_equations
     def at_speed(self, speed: Real) -> Terms[Real]:
         """Return dp_i -> (Delta Q_vl [m^3/s], its slope in dp_i [m^3/(s*Pa)]) at a fixed n."""
         k_p, k_i = self.derived.k_p, self.derived.k_i

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import math
 
+from satmotor_ros.model._inline import inline_equations
 from satmotor_ros.model.composition import Equations
 from satmotor_ros.model.errors import InvalidInputError
 from satmotor_ros.model.results import Point, PointStatus
@@ -103,6 +104,7 @@ class PointEvaluator:
         law = eqs.law
         self._max_floor, self._floor = law.max_floor, law.floor
 
+    @inline_equations
     def _point(self, flow: float | None, speed: float, dp: float | None, dp_i: float,
                q_lfg: float, q_c: float, q_ex: float, status: int) -> Point:
         """
@@ -130,6 +132,7 @@ class PointEvaluator:
             return 0.0, _CHANNEL_LIMITED
         return dp_i, (_BEYOND_LIMIT if dp_i > self._dp_limit else 0)
 
+    @inline_equations
     def speed(self, flow: float, dp: float, port: bool, p_ex: float) -> Point:
         """Compute n(Q, dp) at one point: :meth:`MotorModel.speed_point` without effects."""
         if not (0.0 <= flow < _INF and 0.0 <= dp < _INF and 0.0 <= p_ex < _INF):
@@ -162,6 +165,7 @@ class PointEvaluator:
             return 0.0, _NO_ROOT
         return solve_increasing_scalar(residual, lo, hi, hi, SPEED_SOLVE, CHECK * flow + FLOW_ATOL)
 
+    @inline_equations
     def absorbency(self, speed: float, dp: float, port: bool, p_ex: float,
                    flow_guess: float | None) -> Point:
         """Compute Q(n, dp) at one point: :meth:`MotorModel.absorbency_point` without effects."""

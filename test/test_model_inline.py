@@ -1,0 +1,103 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The inlined compositions compute bitwise what the equation functions compute, calls gone."""
+
+import dis
+
+import numpy as np
+import pytest
+
+from satmotor_ros.model import composition, MotorModel
+from satmotor_ros.model._inline import inline_equations
+from satmotor_ros.model.units import LPM, MPA, RPM
+
+KERNELS = {'channel_pressure_drop', 'chamber_pressure_drop', 'clearance_height',
+           'flat_clearance_leakage', 'commutation_leakage', 'pressure_speed_loss',
+           'inertia_loss', 'absorbency', 'displacement_loss', 'external_leakage'}
+
+
+def _loaded_names(func):
+    return {i.argval for i in dis.get_instructions(func)
+            if i.opname in ('LOAD_GLOBAL', 'LOAD_ATTR', 'LOAD_METHOD', 'LOAD_NAME')}
+
+
+def _same(a, b):
+    """Whether two results (a value or a tuple of values) are bitwise equal, NaN as NaN."""
+    if isinstance(a, tuple):
+        return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b))
+    return np.array_equal(np.asarray(a), np.asarray(b), equal_nan=True) and (
+        np.signbit(a) == np.signbit(b)).all()
+
+
+def _both(builder, *args):
+    """Return the compositions of the inlined builder and of the original one."""
+    return builder(*args), builder.__wrapped__(*args)
+
+
+@pytest.mark.parametrize('law', ['eq33', 'eq39'])
+def test_inlined_compositions_equal_the_called_equations_bitwise(law):
+    model = MotorModel.default('water', law)
+    d, law_ = model.derived, model.law
+    dp_i = np.array([0.0, 1e-3, 0.5, 3.0, 14.0, 25.0]) * MPA
+    speed = np.array([0.0, 1e-3, 5.0, 300.0, 1000.0, 2000.0]) * RPM
+    flow = np.array([0.0, 1e-6, 2.0, 10.0, 30.0, 45.0]) * LPM
+    for args in [(dp_i, speed, flow), *zip(dp_i.tolist(), speed.tolist(), flow.tolist())]:
+        p, n, q = args
+        (channel, chamber), (channel0, chamber0) = _both(composition._drops, d)
+        assert _same(channel(q), channel0(q))
+        assert _same(chamber(p, q), chamber0(p, q))
+        leakage, leakage0 = _both(composition._leakage, d)
+        assert _same(leakage(p, 1e5), leakage0(p, 1e5))
+        breakdown, breakdown0 = _both(composition._breakdown, d, law_)
+        assert _same(breakdown(n, p, 1e-6), breakdown0(n, p, 1e-6))
+        flow_problem, flow_problem0 = _both(composition._flow_problem, d, law_)
+        (lo, upper, res), (lo0, upper0, res0) = flow_problem(n, p, 0.0), flow_problem0(n, p, 0.0)
+        assert _same(lo, lo0) and _same(upper(), upper0())
+        assert _same(res(q + lo), res0(q + lo0))
+        speed_problem, speed_problem0 = _both(composition._speed_problem, d, law_)
+        (lo, hi, res), (lo0, hi0, res0) = speed_problem(q, p, 1e-7), speed_problem0(q, p, 1e-7)
+        assert _same(lo, lo0) and _same(hi, hi0)
+        with np.errstate(divide='ignore', invalid='ignore'):
+            assert _same(res(n + 1.0), res0(n + 1.0))
+
+
+def test_the_point_path_calls_no_equation_function_it_can_inline():
+    model = MotorModel.default('water')
+    eqs = model._point.eqs
+    _, upper, residual = eqs.flow_problem(100.0, 10 * MPA, 0.0)
+    for func in (residual, upper, eqs.leakage, eqs.breakdown, eqs.chamber_drop,
+                 model.law.at_speed(100.0), model._point._point):
+        assert not _loaded_names(func) & KERNELS, func
+
+
+def _square(x):
+    return x * x
+
+
+def _scaled(x):
+    return _SCALE * x
+
+
+_SCALE = 2.0
+
+
+def _twice_read():
+    return _square(float('3'))  # an argument that is not a plain name: evaluated once
+
+
+def _rebound():
+    _square = abs  # noqa: N806
+    return _square(-3.0)
+
+
+def _inlined():
+    x = 3.0
+    return _square(x) + _scaled(x)
+
+
+def test_a_call_is_inlined_only_where_the_same_operations_run():
+    assert '_square' in _loaded_names(inline_equations(_twice_read))
+    assert inline_equations(_twice_read)() == 9.0
+    assert inline_equations(_rebound)() == 3.0
+    inlined = inline_equations(_inlined)
+    assert not _loaded_names(inlined) & {'_square', '_scaled'} and inlined() == 15.0
+    assert inline_equations(len) is len  # no source: unchanged
