@@ -14,7 +14,10 @@ callee, named as ``function`` or ``module.function``, is a function whose body
 is one ``return`` expression, neither name is rebound in the builder, each
 parameter used more than once gets a plain name or constant (so nothing is
 evaluated twice), and the globals that expression reads are the same objects
-in the builder's module. Tracebacks still point at the builder's lines.
+in the builder's module (upper-case numbers, units, are put in as their values).
+A body of ``x = ...`` lines before the ``return`` folds in as ``(x := ...)`` where
+x is first read, if nothing in it is evaluated conditionally. Tracebacks
+still point at the builder's lines.
 """
 
 from __future__ import annotations
@@ -39,9 +42,48 @@ def _parse(func: Callable[..., Any]) -> ast.FunctionDef | None:
     return node if isinstance(node, ast.FunctionDef) else None
 
 
+_STRAIGHT = (ast.BinOp, ast.UnaryOp, ast.Name, ast.Constant, ast.Attribute, ast.Call,
+             ast.expr_context, ast.operator, ast.unaryop)
+"""Nodes whose operands Python evaluates unconditionally, in field order."""
+
+
+def _first_use(expr: ast.AST, name: str) -> ast.Name | None:
+    """Return the `name` that `expr` reads first (depth first, in field order), or None."""
+    for node in ast.iter_child_nodes(expr):
+        if isinstance(node, ast.Name) and node.id == name:
+            return node
+        found = _first_use(node, name)
+        if found is not None:
+            return found
+    return None
+
+
+class _Bind(ast.NodeTransformer):
+    """Fold ``name = value`` into an expression: ``(local := value)`` where it is read first."""
+
+    def __init__(self, name: str, value: ast.expr, local: str, first: ast.Name) -> None:
+        self.name, self.value, self.local, self.first = name, value, local, first
+
+    def visit_Name(self, node: ast.Name) -> ast.expr:  # noqa: N802 (ast's name)
+        if node.id != self.name:
+            return node
+        if node is self.first:
+            return ast.NamedExpr(ast.Name(self.local, ast.Store()), self.value)
+        return ast.Name(self.local, ast.Load())
+
+
+def _bind(expr: ast.expr, name: str, value: ast.expr, local: str) -> ast.expr | None:
+    """Return `expr` with ``name = value`` folded in, or None where the order is not plain."""
+    first = _first_use(expr, name)
+    if first is None or not all(isinstance(n, _STRAIGHT) for n in ast.walk(expr)):
+        return None
+    folded: ast.expr = _Bind(name, value, local, first).visit(expr)
+    return folded
+
+
 @functools.lru_cache(maxsize=None)
 def _expression(func: Callable[..., Any]) -> tuple[tuple[str, ...], ast.expr] | None:
-    """Return the parameters and the return expression of a one-expression function."""
+    """Return the parameters and the return expression of a function of plain expressions."""
     node = _parse(func)
     if node is None or node.args.vararg or node.args.kwarg or node.args.kwonlyargs:
         return None
@@ -49,9 +91,16 @@ def _expression(func: Callable[..., Any]) -> tuple[tuple[str, ...], ast.expr] | 
         return None
     body = [s for s in node.body
             if not (isinstance(s, ast.Expr) and isinstance(s.value, ast.Constant))]
-    if len(body) != 1 or not isinstance(body[0], ast.Return) or body[0].value is None:
+    if not isinstance(body[-1], ast.Return) or body[-1].value is None:
         return None
-    return tuple(a.arg for a in node.args.args), body[0].value
+    expr: ast.expr | None = body[-1].value
+    for statement in reversed(body[:-1]):  # x = e; return f(x)  ->  f((x' := e))
+        if not (isinstance(statement, ast.Assign) and len(statement.targets) == 1
+                and isinstance(statement.targets[0], ast.Name) and expr is not None):
+            return None
+        name = statement.targets[0].id
+        expr = _bind(expr, name, statement.value, f'_{func.__name__}_{name}')
+    return None if expr is None else (tuple(a.arg for a in node.args.args), expr)
 
 
 class _Substitute(ast.NodeTransformer):
@@ -93,10 +142,15 @@ class _Inliner(ast.NodeTransformer):
             return node
         params, expr = found
         names = [n.id for n in ast.walk(expr) if isinstance(n, ast.Name)]
-        for name in set(names) - set(params):
-            if callee.__globals__.get(name, self) is not self.namespace.get(name, None):
-                return node  # it reads a global the builder's module does not share
         values = dict(zip(params, node.args))
+        local = {n.target.id for n in ast.walk(expr) if isinstance(n, ast.NamedExpr)
+                 and isinstance(n.target, ast.Name)}
+        for name in set(names) - set(params) - local:
+            value = callee.__globals__.get(name, self)
+            if name.isupper() and type(value) in (float, int):
+                values[name] = ast.Constant(value)  # a unit or constant: its value
+            elif value is not self.namespace.get(name, None):
+                return node  # it reads a global the builder's module does not share
         for param, value in values.items():
             if names.count(param) > 1 and not isinstance(value, (ast.Name, ast.Constant)):
                 return node  # the argument would be evaluated more than once

@@ -123,6 +123,7 @@ class EmpiricalLaw(DisplacementLaw):
     has_floor = True
     shares = True
 
+    @inline_equations
     def loss(self, speed: Real, dp_i: Real) -> Real:
         """Return Delta Q_vl of eqs. (32), (39), [m^3/s]."""
         d = self.derived
@@ -131,6 +132,7 @@ class EmpiricalLaw(DisplacementLaw):
                                                 speed + (speed <= 0.0), d.c1_39,
                                                 d.c2_39) * speed
 
+    @inline_equations
     def at_pressure(self, dp_i: Real) -> tuple[Real, Terms[Real]]:
         """Return the floor speed [rad/s] and n -> (Delta Q_vl, its slope in n) at fixed dp_i."""
         # Delta Q_vl = C_1 s exp(a / s) with s = sqrt(n [rpm]), a = C_2 ln(dp_i [MPa])
@@ -143,25 +145,28 @@ class EmpiricalLaw(DisplacementLaw):
             return loss, loss * (1.0 - c2_log_dp / (speed / RPM) ** 0.5) / (2.0 * speed)
         return eq.empirical_speed_floor(dp, c2), terms
 
+    @inline_equations
     def at_speed(self, speed: Real) -> Terms[Real]:
         """Return dp_i -> (Delta Q_vl [m^3/s], its slope in dp_i [m^3/(s*Pa)]) at a fixed n."""
         c1, c2 = self.derived.c1_39, self.derived.c2_39
         moving = speed > 0.0
         safe = speed + (speed <= 0.0)  # at n = 0 the loss is 0 and flat: at n = 1, times 0
         c2_inv_s = moving * (c2 / (safe / RPM) ** 0.5)
-        floor, change = eq.EMPIRICAL_DP_FLOOR, eq.displacement_change_empirical
+        floor = eq.EMPIRICAL_DP_FLOOR
         clip = maximum_for(speed)
 
         def terms(dp_i: Real) -> tuple[Real, Real]:
             dp = clip(dp_i, floor)  # below the floor, eq. (39) is flat in dp_i
-            loss = change(dp, safe, c1, c2) * speed
+            loss = eq.displacement_change_empirical(dp, safe, c1, c2) * speed
             return loss, (dp_i > floor) * (loss * c2_inv_s / dp)
         return terms
 
+    @inline_equations
     def floor(self, dp_i: Real) -> Real:
         """Return the lowest speed eq. (39) is used at, (C_2 ln dp_i)^2 rpm, [rad/s]."""
         return eq.empirical_speed_floor(dp_i, self.derived.c2_39)
 
+    @inline_equations
     def share(self, parts: Parts[Real], speed: Real, dp_i: Real) -> Parts[Real]:
         """Scale the components of eqs. (11)-(14) so that they add up to eq. (39)'s loss."""
         fc, dch, bl, ine = parts
