@@ -16,8 +16,8 @@ parameter used more than once gets a plain name or constant (so nothing is
 evaluated twice), and the globals that expression reads are the same objects
 in the builder's module (upper-case numbers, units, are put in as their values).
 A body of ``x = ...`` lines before the ``return`` folds in as ``(x := ...)`` where
-x is first read, if nothing in it is evaluated conditionally. Tracebacks
-still point at the builder's lines.
+x is first read, if nothing in it is evaluated conditionally. A traceback
+points at the builder's line of the call.
 """
 
 from __future__ import annotations
@@ -27,19 +27,29 @@ import copy
 import functools
 import inspect
 import sys
-import textwrap
 from typing import Any, Callable, cast, TypeVar
 
 Builder = TypeVar('Builder', bound=Callable[..., Any])
 
 
+@functools.lru_cache(maxsize=None)
+def _definitions(filename: str) -> dict[int, ast.FunctionDef]:
+    """Return the function definitions of a source file by first line (a decorator's, if any)."""
+    with open(filename, encoding='utf-8') as source:
+        tree = ast.parse(source.read(), filename)
+    return {min([n.lineno, *(d.lineno for d in n.decorator_list)]): n
+            for n in ast.walk(tree) if isinstance(n, ast.FunctionDef)}
+
+
 def _parse(func: Callable[..., Any]) -> ast.FunctionDef | None:
-    """Return the syntax tree of a function defined in a source file, or None."""
+    """Return a copy of the syntax tree of a function defined in a source file, or None."""
+    code = getattr(func, '__code__', None)
     try:
-        node = ast.parse(textwrap.dedent(inspect.getsource(func))).body[0]
-    except (OSError, TypeError, SyntaxError):  # no source, or a lambda inside an expression
+        filename = inspect.getsourcefile(func)
+        node = _definitions(filename).get(code.co_firstlineno) if filename and code else None
+    except (OSError, TypeError, SyntaxError, UnicodeDecodeError):  # no source to read
         return None
-    return node if isinstance(node, ast.FunctionDef) else None
+    return copy.deepcopy(node) if node is not None and node.name == func.__name__ else None
 
 
 _STRAIGHT = (ast.BinOp, ast.UnaryOp, ast.Name, ast.Constant, ast.Attribute, ast.Call,
@@ -154,8 +164,11 @@ class _Inliner(ast.NodeTransformer):
         for param, value in values.items():
             if names.count(param) > 1 and not isinstance(value, (ast.Name, ast.Constant)):
                 return node  # the argument would be evaluated more than once
-        inlined = _Substitute(values).visit(copy.deepcopy(expr))
-        return ast.copy_location(inlined, node)
+        inlined: ast.expr = _Substitute(values).visit(copy.deepcopy(expr))
+        for part in ast.walk(inlined):  # the equation's lines are not the builder's: the call's
+            if isinstance(part, ast.expr):
+                ast.copy_location(part, node)
+        return inlined
 
 
 def inline_equations(builder: Builder) -> Builder:
@@ -184,7 +197,6 @@ def inline_equations(builder: Builder) -> Builder:
                 for a in (*n.posonlyargs, *n.args, *n.kwonlyargs)}
     module = sys.modules[builder.__module__]
     tree = ast.Module(body=[_Inliner(vars(module), rebound).visit(node)], type_ignores=[])
-    ast.increment_lineno(tree, builder.__code__.co_firstlineno - 1)
     ast.fix_missing_locations(tree)
     namespace: dict[str, Any] = {}
     code = compile(tree, inspect.getsourcefile(builder) or '<inlined>', 'exec',
