@@ -20,10 +20,10 @@ def test_calibrated_yaml_with_its_effect_reproduces_the_data(tmp_path, liquid, e
     cal = calibrate(table, liquid)
     path = tmp_path / 'coefficients.yaml'
     write_yaml(cal, path)
-    calibrated = CalibratedModel(path, liquid)
+    calibrated = CalibratedModel.load(path, liquid)
     assert calibrated.effect == (cal.chosen.effect if cal.chosen else 'none')
     channels = {**table.channels, 'p_out': table.p_out}
-    predicted = calibrated.measured_flow(table.speed, table.dp, channels)
+    predicted = calibrated.measured_flow(table.speed, channels, dp=table.dp)
     packaged = MotorModel.default(liquid).absorbency(table.speed, dp=table.dp).flow
     noise = float(np.sqrt(np.mean(plan.noise_lpm(table.flow, cal.model) ** 2)))
     rmse = float(np.sqrt(np.mean((table.flow - predicted) ** 2))) / LPM

@@ -8,7 +8,8 @@ from collections.abc import Sequence
 import sys
 
 from satmotor_ros import __version__
-from satmotor_ros.cli import calibrate, characteristics, demo, operating_point, replay
+from satmotor_ros.cli import (calibrate, characteristics, demo, operating_point, replay,
+                              validate)
 from satmotor_ros.cli._common import CliError, fail, take_motor_options
 
 
@@ -28,7 +29,7 @@ def build_parser() -> argparse.ArgumentParser:
                     '(Śliwiński 2017 model).')
     parser.add_argument('--version', action='version', version=f'%(prog)s {__version__}')
     sub = parser.add_subparsers(dest='subcommand', required=True, metavar='COMMAND')
-    for module in (demo, operating_point, characteristics, replay, calibrate):
+    for module in (demo, operating_point, characteristics, replay, calibrate, validate):
         module.add_parser(sub)
     return parser
 

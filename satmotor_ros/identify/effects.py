@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: Apache-2.0
 """
-A calibrated ``coefficients.yaml`` as the bench sees it: motor, effect and instruments.
+A calibrated ``coefficients.yaml`` as the bench sees it: motor, effects and instruments.
 
 :class:`~satmotor_ros.model.MotorModel` evaluates the ``effects:`` block
 (:mod:`satmotor_ros.model.effects`); :class:`CalibratedModel` adds what the
@@ -15,7 +15,6 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from satmotor_ros.identify.errors import DataError
 from satmotor_ros.model import load_motor, MotorModel
 from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.effects import flow_reading
@@ -23,40 +22,56 @@ from satmotor_ros.model.effects import flow_reading
 
 class CalibratedModel:
     """
-    A calibrated motor: the fitted coefficient set plus its effect.
+    A calibrated motor: the fitted coefficient set plus its effects.
 
     Parameters
     ----------
-    path : str or pathlib.Path
-        A ``coefficients.yaml`` written by ``satmotor calibrate``, [-]
-    liquid : str
-        The coefficient set in it, [-]
+    model : MotorModel
+        The model of a coefficient set, its ``effects:`` block included, [-]
 
     """
 
-    def __init__(self, path: str | Path, liquid: str) -> None:
-        """Load the set and its effects block."""
-        self.model = MotorModel.from_spec(load_motor(path), liquid)
-        effects = self.model.effects
-        if len(effects) > 1:
-            msg = f'{path}: effects has {len(effects)} entries; one is supported'
-            raise DataError(msg)
-        self.effect = effects[0].name if effects else 'none'
+    def __init__(self, model: MotorModel) -> None:
+        """Hold the model and name its effects."""
+        self.model = model
+        self.effect = ', '.join(e.name for e in model.effects) or 'none'
 
-    def absorbency(self, speed: FloatArray, dp: FloatArray,
-                   channels: Mapping[str, FloatArray]) -> FloatArray:
+    @classmethod
+    def load(cls, path: str | Path, liquid: str) -> CalibratedModel:
         """
-        Compute the flow the motor absorbs, with the physical effect applied.
+        Load a ``coefficients.yaml`` written by ``satmotor calibrate``.
+
+        Parameters
+        ----------
+        path : str or pathlib.Path
+            The file, [-]
+        liquid : str
+            The coefficient set in it, [-]
+
+        Returns
+        -------
+        CalibratedModel
+            The set with its effects.
+
+        """
+        return cls(MotorModel.from_spec(load_motor(path), liquid))
+
+    def absorbency(self, speed: FloatArray, channels: Mapping[str, FloatArray], *,
+                   dp: FloatArray | None = None, dp_i: FloatArray | None = None) -> FloatArray:
+        """
+        Compute the flow the motor absorbs, with the physical effects applied.
 
         Parameters
         ----------
         speed : ndarray
             True shaft speed, [rad/s]
-        dp : ndarray
-            Port pressure drop, [Pa]
         channels : mapping of str to ndarray
             Channels (p_case or p_out [Pa], temperature [degC], time [s],
-            revolutions [rev], any other); those the effect needs are used, [-]
+            revolutions [rev], any other); those the effects need are used, [-]
+        dp : ndarray, optional
+            Port pressure drop (eqs. 34-36 solved together), [Pa]
+        dp_i : ndarray, optional
+            Chamber pressure drop instead of `dp` (eq. 36 directly), [Pa]
 
         Returns
         -------
@@ -65,22 +80,29 @@ class CalibratedModel:
 
         """
         needed = {name: channels[name] for name in self.model.channels}
-        return self.model.absorbency(np.asarray(speed, dtype=float), dp=dp, errors='mask',
-                                     channels=needed).flow
+        return self.model.absorbency(np.asarray(speed, dtype=float), dp=dp, dp_i=dp_i,
+                                     errors='mask', channels=needed).flow
 
-    def measured_flow(self, speed: FloatArray, dp: FloatArray,
-                      channels: Mapping[str, FloatArray]) -> FloatArray:
+    def measured_flow(self, speed: FloatArray, channels: Mapping[str, FloatArray], *,
+                      dp: FloatArray | None = None,
+                      dp_i: FloatArray | None = None) -> FloatArray:
         """
         Compute what the flowmeter reads at a measured speed, sensor effects included.
+
+        With `dp_i` from the measured flow (:func:`~satmotor_ros.identify.parts.loss_parts`)
+        this is the prediction the calibration fitted, eq. (36) of
+        :func:`~satmotor_ros.identify.parts.predict_flow`.
 
         Parameters
         ----------
         speed : ndarray
             Speed as the speed sensor reads it, [rad/s]
-        dp : ndarray
-            Port pressure drop, [Pa]
         channels : mapping of str to ndarray
-            Channels the effect needs, [-]
+            Channels the effects need, [-]
+        dp : ndarray, optional
+            Port pressure drop, [Pa]
+        dp_i : ndarray, optional
+            Chamber pressure drop instead of `dp`, [Pa]
 
         Returns
         -------
@@ -88,22 +110,20 @@ class CalibratedModel:
             Flowmeter reading, [m^3/s]
 
         """
-        flow = self.absorbency(self.model.true_speed(np.asarray(speed, dtype=float)), dp,
-                               channels)
+        flow = self.absorbency(self.model.true_speed(np.asarray(speed, dtype=float)), channels,
+                               dp=dp, dp_i=dp_i)
         return flow_reading(self.model.effects, flow)
 
-    def describe(self) -> dict[str, Any]:
+    def describe(self) -> list[dict[str, Any]]:
         """
-        Return the effect as loaded.
+        Return the effects as loaded.
 
         Returns
         -------
-        dict
-            ``{'effect': id, **fields}``; ``{'effect': 'none'}`` without one.
+        list of dict
+            ``{'effect': id, 'regressor': ..., 'coefficient': ...}`` per effect, in
+            the file's order; empty without one.
 
         """
-        if not self.model.effects:
-            return {'effect': 'none'}
-        effect = self.model.effects[0]
-        return {'effect': effect.name, 'regressor': effect.regressor,
-                'coefficient': effect.coefficient}
+        return [{'effect': e.name, 'regressor': e.regressor, 'coefficient': e.coefficient}
+                for e in self.model.effects]

@@ -11,8 +11,9 @@ from types import ModuleType
 import numpy as np
 
 from satmotor_ros.identify.output import effect_block, fitted_coefficients
-from satmotor_ros.identify.parts import SCALES
+from satmotor_ros.identify.parts import LossParts, SCALES
 from satmotor_ros.identify.pipeline import Calibration
+from satmotor_ros.identify.table import BenchTable
 from satmotor_ros.model import MotorModel
 from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.effects import TERMS
@@ -22,22 +23,44 @@ _UNITS = {'time': ('s', 1.0), 'revolutions': ('rev', 1.0), 'temperature': ('degC
           'p_case': ('MPa', MPA), 'p_out': ('MPa', MPA), 'p_in': ('MPa', MPA)}
 
 
-def _pyplot() -> ModuleType:
+def pyplot() -> ModuleType:
+    """Return matplotlib's pyplot on the file-only Agg backend."""
     import matplotlib
     matplotlib.use('Agg')
     from matplotlib import pyplot
     return pyplot
 
 
-def _regressors(cal: Calibration) -> dict[str, FloatArray]:
-    """Map ``'label [unit]'`` to speed, dp, flow, p_out, each channel and a chosen term."""
-    parts = cal.parts
+def channel_axes(parts: LossParts, table: BenchTable) -> dict[str, FloatArray]:
+    """
+    Map ``'label [unit]'`` to speed, dp, flow, p_out and each finite channel at the points.
+
+    Parameters
+    ----------
+    parts : LossParts
+        The model's components at the points, [-]
+    table : BenchTable
+        The same points, with their channels, [-]
+
+    Returns
+    -------
+    dict
+        Each quantity in the unit of its label.
+
+    """
     out = {'n [rpm]': parts.speed / RPM, 'dp [MPa]': parts.dp / MPA,
-           'flow [l/min]': parts.flow / LPM, 'p_out [MPa]': cal.table.p_out / MPA}
-    for name, x in cal.table.channels.items():
-        unit, scale = _UNITS.get(name, (cal.table.units.get(name, '') or '-', 1.0))
+           'flow [l/min]': parts.flow / LPM, 'p_out [MPa]': table.p_out / MPA}
+    for name, x in table.channels.items():
+        unit, scale = _UNITS.get(name, (table.units.get(name, '') or '-', 1.0))
         if np.all(np.isfinite(x)):
             out[f'{name} [{unit}]'] = x / scale
+    return out
+
+
+def _regressors(cal: Calibration) -> dict[str, FloatArray]:
+    """Map ``'label [unit]'`` to the channels (:func:`channel_axes`) and a chosen term."""
+    parts = cal.parts
+    out = channel_axes(parts, cal.table)
     chosen = cal.chosen
     if chosen is not None and chosen.effect.startswith('term:'):
         out[f'{chosen.regressor} [SI]'] = TERMS[chosen.regressor][0](parts.speed, parts.dp_i)
@@ -46,7 +69,7 @@ def _regressors(cal: Calibration) -> dict[str, FloatArray]:
 
 def _plot_residuals(cal: Calibration, path: Path) -> None:
     """Plot the out-of-sample residual of Q_vl against each regressor, before and after."""
-    plt = _pyplot()
+    plt = pyplot()
     regs = _regressors(cal)
     cols = 3
     rows = int(np.ceil(len(regs) / cols))
@@ -81,7 +104,7 @@ def _fitted_model(cal: Calibration) -> MotorModel:
 
 def _plot_characteristics(cal: Calibration, path: Path) -> None:
     """Plot measured Q_vl against dp with the model's curves, and measured against predicted."""
-    plt = _pyplot()
+    plt = pyplot()
     parts = cal.parts
     fig, (left, right) = plt.subplots(1, 2, figsize=(12, 4.8))
     edges = np.quantile(parts.speed, np.linspace(0, 1, 5))
@@ -124,7 +147,7 @@ def _plot_characteristics(cal: Calibration, path: Path) -> None:
 
 def _plot_ranking(cal: Calibration, path: Path) -> None:
     """Plot the candidates' cross-validated errors against the baseline's."""
-    plt = _pyplot()
+    plt = pyplot()
     ranking = cal.selection.ranking[:15]
     fig, ax = plt.subplots(figsize=(8, 0.35 * len(ranking) + 1.5))
     labels = [s.label for s in ranking][::-1]
@@ -229,4 +252,4 @@ def write_report(cal: Calibration, out: Path, summary: dict[str, object]) -> Pat
     return path
 
 
-__all__ = ['PLOTS', 'SCALES', 'write_report']
+__all__ = ['PLOTS', 'SCALES', 'channel_axes', 'pyplot', 'write_report']

@@ -1,0 +1,132 @@
+# SPDX-License-Identifier: Apache-2.0
+"""
+Validation: the error of a given model on new data, without refitting.
+
+The points are the calibration's (:func:`~satmotor_ros.identify.pipeline.steady_points`,
+:func:`~satmotor_ros.identify.parts.loss_parts`) and the error is the
+calibration's, of the volumetric losses Q_vl = Q - q_t n
+(:meth:`~satmotor_ros.identify.selection.Errors.of`); the prediction is the
+model's own, effects and instruments included
+(:class:`~satmotor_ros.identify.effects.CalibratedModel`), at the chamber drop
+the calibration uses. A calibration validated on its own data therefore gives
+its in-sample error. Nothing is fitted, so no cross-validation is needed.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+
+from satmotor_ros.identify.effects import CalibratedModel
+from satmotor_ros.identify.errors import DataError, IdentificationError
+from satmotor_ros.identify.parts import loss_parts, LossParts
+from satmotor_ros.identify.pipeline import Mode, steady_points
+from satmotor_ros.identify.selection import Errors
+from satmotor_ros.identify.steady import SteadyTolerance
+from satmotor_ros.identify.table import BenchTable
+from satmotor_ros.model import MotorModel
+from satmotor_ros.model._typing import FloatArray
+
+
+@dataclass(frozen=True)
+class Validation:
+    """A model held against data: the points, its prediction and its errors."""
+
+    liquid: str  # coefficient set validated
+    model: MotorModel  # the model as given, effects included
+    table: BenchTable  # the points used (usable rows only)
+    parts: LossParts  # measured flow, speed, drops and Q_vl at those points
+    residual: FloatArray  # measured minus predicted Q_vl [m^3/s]
+    error: Errors  # the residual summarised as calibration.json does
+    effects: tuple[dict[str, Any], ...]  # the model's effects as loaded
+
+    def describe_effects(self) -> str:
+        """Return the effects' names, comma-separated, or ``'none'``."""
+        return ', '.join(e['effect'] for e in self.effects) or 'none'
+
+    def summary(self) -> dict[str, Any]:
+        """
+        Build the validation.json object (DESIGN.md, "Validation output").
+
+        Returns
+        -------
+        dict
+            n_points and error first, then the liquid, motor, effects and source.
+
+        """
+        return {'n_points': len(self.parts), 'error': self.error.as_dict(),
+                'liquid': self.liquid, 'motor': self.model.name,
+                'effects': list(self.effects), 'data': self.table.source}
+
+
+def _bare(model: MotorModel) -> MotorModel:
+    """Return `model` without its effects: it only places the points (dp_i, usable rows)."""
+    coefficient_set = replace(model.coefficient_set, effects=())
+    return MotorModel(model.geometry, coefficient_set, model.valid_range, model.liquid,
+                      model.displacement_law, model.name)
+
+
+def validate(table: BenchTable, model: MotorModel, liquid: str, mode: Mode = 'auto',
+             tol: SteadyTolerance | None = None) -> Validation:
+    """
+    Compute the error of `model` on `table` without fitting anything.
+
+    Parameters
+    ----------
+    table : BenchTable
+        Steady points or a time series, [-]
+    model : MotorModel
+        The model to hold against the data (a calibrated file's, effects and
+        all), [-]
+    liquid : str
+        Its coefficient set, for the report, [-]
+    mode : {'auto', 'points', 'series'}
+        How to read the rows, as for a calibration, [-]
+    tol : SteadyTolerance, optional
+        Steady-state tolerances, [-]
+
+    Returns
+    -------
+    Validation
+        The points, the residual and its errors.
+
+    Raises
+    ------
+    IdentificationError
+        If no point is usable (the message says why).
+    DataError
+        If the model's effects need a channel the data lack (the message names it).
+
+    """
+    points = steady_points(table, mode, tol)
+    parts, usable = loss_parts(_bare(model), points)
+    if not usable.all():
+        points = points.select(usable, f'left out {int((~usable).sum())} points outside the '
+                                       'model (no forward flow, negative speed or chamber '
+                                       'drop out of range)')
+    channels = {**points.channels, 'p_out': points.p_out}
+    missing = [name for name in model.channels if name not in channels]
+    if missing:
+        msg = (f'{points.source}: no {", ".join(missing)} column, which the effects of '
+               f'{model.name} need')
+        raise DataError(msg)
+    calibrated = CalibratedModel(model)
+    predicted = calibrated.measured_flow(parts.speed, channels, dp_i=parts.dp_i)
+    flagged = ~np.isfinite(predicted)
+    if flagged.all():
+        msg = f'{points.source}: the model flags every point invalid'
+        raise IdentificationError(msg)
+    if flagged.any():
+        keep = ~flagged
+        points = points.select(keep, f'left out {int(flagged.sum())} points the model flags '
+                                     'invalid (its status is not OK there)')
+        parts, _ = loss_parts(_bare(model), points)
+        predicted = predicted[keep]
+    residual = parts.flow - predicted
+    return Validation(liquid, model, points, parts, residual, Errors.of(residual, parts.loss),
+                      tuple(calibrated.describe()))
+
+
+__all__ = ['Validation', 'validate']

@@ -1,0 +1,102 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Write ``validation.json``, ``report.md`` and ``residuals.png``: all of them or none."""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+from typing import Any
+
+from satmotor_ros.identify.report import channel_axes, pyplot
+from satmotor_ros.identify.validate import Validation
+from satmotor_ros.model.units import LPM
+
+FILES = ('validation.json', 'report.md', 'residuals.png')
+"""What :func:`write_validation` puts into the output directory."""
+
+
+def _plot_residuals(val: Validation, path: Path) -> None:
+    """Plot the residual of Q_vl against speed, dp, flow, p_out and each channel."""
+    plt = pyplot()
+    axes_data = channel_axes(val.parts, val.table)
+    cols = 3
+    rows = -(-len(axes_data) // cols)
+    fig, axes = plt.subplots(rows, cols, figsize=(12, 3.0 * rows), squeeze=False)
+    residual = val.residual / LPM
+    for ax, (label, x) in zip(axes.flat, axes_data.items()):
+        ax.plot(x, residual, 'o', ms=3, alpha=0.6)
+        ax.axhline(0.0, color='k', lw=0.8)
+        ax.set_xlabel(label)
+        ax.set_ylabel('residual of Q_vl [l/min]')
+        ax.grid(alpha=0.3)
+    for ax in list(axes.flat)[len(axes_data):]:
+        ax.set_visible(False)
+    fig.suptitle(f'Residual of the volumetric losses, {val.model.name} on {val.liquid} '
+                 f'(RMSE {val.error.rmse_lpm:.4g} l/min)')
+    fig.subplots_adjust(left=0.07, right=0.98, bottom=0.5 / rows, top=1 - 0.35 / rows,
+                        hspace=0.45, wspace=0.3)
+    fig.savefig(path, dpi=80, format='png')
+    plt.close(fig)
+
+
+def _report(val: Validation, summary: dict[str, Any]) -> str:
+    """Return ``report.md``'s text."""
+    err = val.error
+    lines = [f'# Validation of {val.model.name} on {val.liquid}', '',
+             f'Data: `{val.table.source}`, {len(val.parts)} steady operating points. '
+             f'Effects in the model: {val.describe_effects()}.']
+    lines += [f'- {note}' for note in val.table.notes]
+    lines += ['', '## Error', '',
+              '| RMSE [l/min] | mean abs [% of mean Q_vl] | max abs [l/min] |',
+              '| --- | --- | --- |',
+              f'| {err.rmse_lpm:.4g} | {err.mean_abs_pct:.3g} | {err.max_abs_lpm:.4g} |', '',
+              'Errors are of the volumetric losses Q_vl = Q - q_t n, measured minus predicted, '
+              'computed as `satmotor calibrate` computes them, with nothing refitted: the '
+              'whole table is out of sample for the model. Compare the RMSE with the '
+              "calibration's `error_after` (and the sensor noise): much larger, or a trend "
+              'in the plots below, means the calibration no longer holds.', '',
+              '## Residual against each channel', '', '![residuals](residuals.png)', '',
+              '## validation.json', '', '```json', json.dumps(summary, indent=2), '```', '']
+    return '\n'.join(lines)
+
+
+def write_validation(val: Validation, out: Path) -> dict[str, Any]:
+    """
+    Write :data:`FILES` into `out`: each first under a temporary name, then all into place.
+
+    Parameters
+    ----------
+    val : Validation
+        The result, [-]
+    out : pathlib.Path
+        Output directory (exists), [-]
+
+    Returns
+    -------
+    dict
+        The validation.json object.
+
+    Raises
+    ------
+    OSError
+        If a file cannot be written; no output file is then left behind.
+
+    """
+    summary = val.summary()
+    temporary = {name: out / f'.{name}.partial' for name in FILES}
+    try:
+        temporary['validation.json'].write_text(json.dumps(summary, indent=2) + '\n',
+                                                encoding='utf-8')
+        temporary['report.md'].write_text(_report(val, summary), encoding='utf-8')
+        _plot_residuals(val, temporary['residuals.png'])
+        for name, path in temporary.items():
+            os.replace(path, out / name)
+    except BaseException:
+        for path in temporary.values():
+            path.unlink(missing_ok=True)
+        raise
+    return summary
+
+
+__all__ = ['FILES', 'write_validation']
