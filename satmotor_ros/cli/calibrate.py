@@ -24,16 +24,29 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         'p_in, p_out, and any other channels) or a rosbag2 recording, test candidate effects '
         'by cross-validation, and write calibration.json, coefficients.yaml and report.md '
         'into --out.')
-    parser.add_argument('data', metavar='DATA', help='bench CSV or rosbag2 directory')
-    parser.add_argument('--out', required=True, metavar='DIR', help='output directory')
-    parser.add_argument('--mode', choices=('auto', 'points', 'series'), default='auto',
-                        help='rows are steady points, a time series, or decide from the data '
-                             '(default: auto)')
+    add_data_arguments(parser)
     parser.add_argument('--alpha', type=float, default=0.05,
                         help='family-wise significance level of the effect test (default 0.05)')
     parser.add_argument('--folds', type=int, default=5,
                         help='cross-validation folds (default 5)')
     add_motor_options(parser, liquid_required=True, model_options=False)
+
+
+def add_data_arguments(parser: argparse.ArgumentParser) -> None:
+    """
+    Add DATA, ``--out`` and ``--mode``: what the commands that read bench data share.
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser
+        The subcommand's parser, [-]
+
+    """
+    parser.add_argument('data', metavar='DATA', help='bench CSV or rosbag2 directory')
+    parser.add_argument('--out', required=True, metavar='DIR', help='output directory')
+    parser.add_argument('--mode', choices=('auto', 'points', 'series'), default='auto',
+                        help='rows are steady points, a time series, or decide from the data '
+                             '(default: auto)')
 
 
 def load_data(data: str) -> BenchTable:

@@ -7,7 +7,7 @@ import argparse
 from pathlib import Path
 
 from satmotor_ros.cli._common import add_motor_options, fail, subcommand
-from satmotor_ros.cli.calibrate import load_data
+from satmotor_ros.cli.calibrate import add_data_arguments, load_data
 from satmotor_ros.identify import IdentificationError
 from satmotor_ros.identify.pipeline import Mode
 from satmotor_ros.identify.validate import validate
@@ -23,11 +23,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         'Hold a model (the packaged one, a motor file or a calibrated coefficients.yaml with '
         'its effects) against a bench CSV or a rosbag2 recording without refitting anything, '
         'and write validation.json, report.md and residuals.png into --out.')
-    parser.add_argument('data', metavar='DATA', help='bench CSV or rosbag2 directory')
-    parser.add_argument('--out', required=True, metavar='DIR', help='output directory')
-    parser.add_argument('--mode', choices=('auto', 'points', 'series'), default='auto',
-                        help='rows are steady points, a time series, or decide from the data '
-                             '(default: auto)')
+    add_data_arguments(parser)
     add_motor_options(parser, liquid_required=True)
 
 

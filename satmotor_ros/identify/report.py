@@ -67,32 +67,52 @@ def _regressors(cal: Calibration) -> dict[str, FloatArray]:
     return out
 
 
-def _plot_residuals(cal: Calibration, path: Path) -> None:
-    """Plot the out-of-sample residual of Q_vl against each regressor, before and after."""
+def plot_residual_grid(axes_data: dict[str, FloatArray], residuals: dict[str, FloatArray],
+                       title: str, path: Path) -> None:
+    """
+    Plot residuals of Q_vl against each quantity, one panel per quantity, three a row.
+
+    Parameters
+    ----------
+    axes_data : dict
+        ``'label [unit]'`` to the quantity at the points (:func:`channel_axes`), [-]
+    residuals : dict
+        Legend label to the residual at the same points, [m^3/s]
+    title : str
+        The figure's title, [-]
+    path : pathlib.Path
+        PNG file to write, [-]
+
+    """
     plt = pyplot()
-    regs = _regressors(cal)
     cols = 3
-    rows = int(np.ceil(len(regs) / cols))
+    rows = int(np.ceil(len(axes_data) / cols))
     fig, axes = plt.subplots(rows, cols, figsize=(12, 3.0 * rows), squeeze=False)
-    before = cal.selection.baseline.cv_error / LPM
-    chosen = cal.selection.chosen
-    for ax, (label, x) in zip(axes.flat, regs.items()):
-        ax.plot(x, before, 'o', ms=3, alpha=0.6, label='before (no effect)')
-        if chosen is not None:
-            ax.plot(x, chosen.cv_error / LPM, 'o', ms=3, alpha=0.6,
-                    label=f'after ({chosen.label})')
+    for ax, (label, x) in zip(axes.flat, axes_data.items()):
+        for name, residual in residuals.items():
+            ax.plot(x, residual / LPM, 'o', ms=3, alpha=0.6, label=name)
         ax.axhline(0.0, color='k', lw=0.8)
         ax.set_xlabel(label)
         ax.set_ylabel('residual of Q_vl [l/min]')
         ax.grid(alpha=0.3)
-    for ax in list(axes.flat)[len(regs):]:
+    for ax in list(axes.flat)[len(axes_data):]:
         ax.set_visible(False)
     axes.flat[0].legend(fontsize=8)
-    fig.suptitle('Out-of-sample residual of the volumetric losses against each regressor')
+    fig.suptitle(title)
     fig.subplots_adjust(left=0.07, right=0.98, bottom=0.5 / rows, top=1 - 0.35 / rows,
                         hspace=0.45, wspace=0.3)
-    fig.savefig(path, dpi=80)
+    fig.savefig(path, dpi=80, format='png')
     plt.close(fig)
+
+
+def _plot_residuals(cal: Calibration, path: Path) -> None:
+    """Plot the out-of-sample residual of Q_vl against each regressor, before and after."""
+    residuals = {'before (no effect)': cal.selection.baseline.cv_error}
+    chosen = cal.selection.chosen
+    if chosen is not None:
+        residuals[f'after ({chosen.label})'] = chosen.cv_error
+    plot_residual_grid(_regressors(cal), residuals, 'Out-of-sample residual of the volumetric '
+                       'losses against each regressor', path)
 
 
 def _fitted_model(cal: Calibration) -> MotorModel:
@@ -252,4 +272,4 @@ def write_report(cal: Calibration, out: Path, summary: dict[str, object]) -> Pat
     return path
 
 
-__all__ = ['PLOTS', 'SCALES', 'channel_axes', 'pyplot', 'write_report']
+__all__ = ['PLOTS', 'SCALES', 'channel_axes', 'plot_residual_grid', 'pyplot', 'write_report']

@@ -8,9 +8,8 @@ import os
 from pathlib import Path
 from typing import Any
 
-from satmotor_ros.identify.report import channel_axes, pyplot
+from satmotor_ros.identify.report import channel_axes, plot_residual_grid
 from satmotor_ros.identify.validate import Validation
-from satmotor_ros.model.units import LPM
 
 FILES = ('validation.json', 'report.md', 'residuals.png')
 """What :func:`write_validation` puts into the output directory."""
@@ -18,26 +17,10 @@ FILES = ('validation.json', 'report.md', 'residuals.png')
 
 def _plot_residuals(val: Validation, path: Path) -> None:
     """Plot the residual of Q_vl against speed, dp, flow, p_out and each channel."""
-    plt = pyplot()
-    axes_data = channel_axes(val.parts, val.table)
-    cols = 3
-    rows = -(-len(axes_data) // cols)
-    fig, axes = plt.subplots(rows, cols, figsize=(12, 3.0 * rows), squeeze=False)
-    residual = val.residual / LPM
-    for ax, (label, x) in zip(axes.flat, axes_data.items()):
-        ax.plot(x, residual, 'o', ms=3, alpha=0.6)
-        ax.axhline(0.0, color='k', lw=0.8)
-        ax.set_xlabel(label)
-        ax.set_ylabel('residual of Q_vl [l/min]')
-        ax.grid(alpha=0.3)
-    for ax in list(axes.flat)[len(axes_data):]:
-        ax.set_visible(False)
-    fig.suptitle(f'Residual of the volumetric losses, {val.model.name} on {val.liquid} '
-                 f'(RMSE {val.error.rmse_lpm:.4g} l/min)')
-    fig.subplots_adjust(left=0.07, right=0.98, bottom=0.5 / rows, top=1 - 0.35 / rows,
-                        hspace=0.45, wspace=0.3)
-    fig.savefig(path, dpi=80, format='png')
-    plt.close(fig)
+    plot_residual_grid(channel_axes(val.parts, val.table),
+                       {f'{val.model.name} on {val.liquid}': val.residual},
+                       f'Residual of the volumetric losses, nothing refitted (RMSE '
+                       f'{val.error.rmse_lpm:.4g} l/min)', path)
 
 
 def _report(val: Validation, summary: dict[str, Any]) -> str:
