@@ -193,3 +193,21 @@ def test_a_user_liquid_outside_the_fitted_viscosity_is_extrapolated():
     widened = replace(oil_set, viscosity_range=(15e-6, 60e-6))
     model = MotorModel(spec.geometry, widened, spec.valid_range, thin)
     assert model.speed(20 * LPM, 10 * MPA).status == PointStatus.OK
+
+
+def test_a_nan_speed_in_the_batch_hides_no_other_elements_stall(oil):
+    flow, dp = np.array([1e-6, 1e308]), np.array([20099700.0, 19.9e6])  # stalled; speed NaN
+    with np.errstate(over='ignore', invalid='ignore'):  # 1e308 overflows on the way to NaN
+        op = oil.speed(flow, dp, errors='mask')
+    assert np.isnan(op.speed[1])
+    assert op.status.tolist() == [int(oil.speed_point(q, p).status) for q, p in zip(flow, dp)]
+    assert op.status[0] & PointStatus.STALLED
+
+
+def test_a_nan_element_hides_no_other_elements_extrapolation(oil):
+    from satmotor_ros.model.screening import flag_extrapolated
+    d = oil.derived
+    status = np.zeros(3, np.uint8)
+    speed = np.array([2.0 * d.speed_max, np.nan, d.speed_max])
+    flag_extrapolated(d, speed, np.full(3, d.dp_max), status)
+    assert status.tolist() == [PointStatus.EXTRAPOLATED, 0, 0]

@@ -16,8 +16,14 @@ KERNELS = {'channel_pressure_drop', 'chamber_pressure_drop', 'clearance_height',
 
 
 def _loaded_names(func):
-    return {i.argval for i in dis.get_instructions(func)
-            if i.opname in ('LOAD_GLOBAL', 'LOAD_ATTR', 'LOAD_METHOD', 'LOAD_NAME')}
+    """Return the globals and attributes a function's code loads, its nested functions' too."""
+    code = getattr(func, '__code__', func)
+    names = {i.argval for i in dis.get_instructions(code)
+             if i.opname in ('LOAD_GLOBAL', 'LOAD_ATTR', 'LOAD_METHOD', 'LOAD_NAME')}
+    for const in code.co_consts:
+        if hasattr(const, 'co_code'):
+            names |= _loaded_names(const)
+    return names
 
 
 def _same(a, b):
@@ -101,3 +107,110 @@ def test_a_call_is_inlined_only_where_the_same_operations_run():
     inlined = inline_equations(_inlined)
     assert not _loaded_names(inlined) & {'_square', '_scaled'} and inlined() == 15.0
     assert inline_equations(len) is len  # no source: unchanged
+
+
+def _ten_times(x):
+    return x * 10.0
+
+
+def _ten_times_plus_one(x):
+    return _ten_times(x) + 1.0
+
+
+def _shadowed_by_a_parameter(_ten_times):
+    return _ten_times_plus_one(-1.0), _ten_times(-1.0)
+
+
+def _shadowed_by_an_assignment():
+    _ten_times = abs  # noqa: N806
+    return _ten_times_plus_one(-1.0), _ten_times(-1.0)
+
+
+def _shadowed_in_a_closure():
+    _ten_times = abs  # noqa: N806
+
+    def inner():
+        return _ten_times_plus_one(-1.0), _ten_times(-1.0)
+    return inner()
+
+
+def _shadowed_by_a_comprehension():
+    return [_ten_times_plus_one(-1.0) for _ten_times in (abs,)]
+
+
+@pytest.mark.parametrize('builder', [_shadowed_by_an_assignment, _shadowed_in_a_closure,
+                                     _shadowed_by_a_comprehension])
+def test_a_call_reading_a_global_the_builder_binds_as_a_local_is_not_inlined(builder):
+    inlined = inline_equations(builder)
+    assert inlined() == builder() and builder()[0] == -9.0
+    assert '_ten_times_plus_one' in _loaded_names(inlined)
+
+
+def test_a_call_reading_a_global_the_builder_has_as_a_parameter_is_not_inlined():
+    inlined = inline_equations(_shadowed_by_a_parameter)
+    assert inlined(abs) == _shadowed_by_a_parameter(abs) == (-9.0, 1.0)
+    assert '_ten_times_plus_one' in _loaded_names(inlined)
+
+
+def _first_doubled(x, y):
+    return x * 2.0
+
+
+def _fails():
+    raise ZeroDivisionError('evaluated')
+
+
+def _unused_call_argument():
+    return _first_doubled(3.0, _fails())
+
+
+def _unused_plain_arguments(y):
+    return _first_doubled(3.0, y) + _first_doubled(3.0, 1.0)
+
+
+def test_an_argument_the_callee_never_reads_is_still_evaluated():
+    inlined = inline_equations(_unused_call_argument)
+    with pytest.raises(ZeroDivisionError, match='evaluated'):
+        inlined()
+    assert '_first_doubled' in _loaded_names(inlined)
+    plain = inline_equations(_unused_plain_arguments)  # nothing to evaluate: inlined
+    assert '_first_doubled' not in _loaded_names(plain) and plain(_fails) == 12.0
+
+
+def _twice(a, b):
+    once = a + 1.0
+    return once * b + once
+
+
+def _nested(v, w):
+    return _twice(v, _twice(w, 1.0))
+
+
+def test_nested_calls_of_a_folded_body_each_keep_their_own_local():
+    inlined = inline_equations(_nested)
+    assert '_twice' not in _loaded_names(inlined)
+    assert inlined(1.0, 2.0) == _nested(1.0, 2.0) == 14.0
+
+
+@pytest.mark.parametrize('law', ['eq33', 'eq39'])
+def test_inlined_law_methods_equal_their_originals_bitwise(law):
+    model = MotorModel.default('water', law)
+    law_ = model.law
+    kind = type(law_)
+    dp_i = np.array([0.0, 1e-3, 0.5, 1.0, 3.0, 14.0, 25.0]) * MPA
+    speed = np.array([0.0, 1e-3, 5.0, 40.0, 300.0, 1000.0, 2000.0]) * RPM
+    parts = (1e-6, 2e-6, 0.0, 3e-7)
+    for p, n in [(dp_i, speed), *zip(dp_i.tolist(), speed.tolist())]:
+        with np.errstate(divide='ignore', invalid='ignore'):
+            for name in ('loss', 'share', 'floor'):
+                method = getattr(kind, name)
+                if hasattr(method, '__wrapped__'):
+                    args = {'loss': (n, p), 'share': (parts, n, p), 'floor': (p,)}[name]
+                    assert _same(method(law_, *args), method.__wrapped__(law_, *args)), name
+            (floor, terms), (floor0, terms0) = (kind.at_pressure(law_, p),
+                                                kind.at_pressure.__wrapped__(law_, p))
+            assert _same(floor, floor0) and _same(terms(n + 1.0), terms0(n + 1.0))
+            terms, terms0 = kind.at_speed(law_, n), kind.at_speed.__wrapped__(law_, n)
+            assert _same(terms(p), terms0(p))
+    assert law != 'eq39' or all(hasattr(getattr(kind, m), '__wrapped__')
+                                for m in ('loss', 'share', 'floor'))

@@ -11,13 +11,16 @@ expression, its parameters bound to the call's arguments: the same operations
 in the same order (bitwise the same result, on floats and on arrays), with no
 second copy of any equation in the source. A call is left as it is unless the
 callee, named as ``function`` or ``module.function``, is a function whose body
-is one ``return`` expression, neither name is rebound in the builder, each
-parameter used more than once gets a plain name or constant (so nothing is
-evaluated twice), and the globals that expression reads are the same objects
-in the builder's module (upper-case numbers, units, are put in as their values).
-A body of ``x = ...`` lines before the ``return`` folds in as ``(x := ...)`` where
-x is first read, if nothing in it is evaluated conditionally. A traceback
-points at the builder's line of the call.
+is one ``return`` expression, neither name is bound anywhere in the builder,
+each parameter used more than once or never gets a plain name or constant (so
+nothing is evaluated twice, and nothing that could fail is skipped), and the
+globals that expression reads are the same objects in the builder's module and
+are not names the builder binds (upper-case numbers, units, are put in as their
+values). A body of ``x = ...`` lines before the ``return`` folds in as
+``(x := ...)`` where x is first read, if nothing in it is evaluated
+conditionally; each inlined call gets its own name for x, so calls nested in
+each other's arguments do not share it. A traceback points at the builder's
+line of the call.
 """
 
 from __future__ import annotations
@@ -125,11 +128,41 @@ class _Substitute(ast.NodeTransformer):
         return node
 
 
+class _Rename(ast.NodeTransformer):
+    """Rename names: an inlined call's own ``x := ...`` locals."""
+
+    def __init__(self, names: dict[str, str]) -> None:
+        self.names = names
+
+    def visit_Name(self, node: ast.Name) -> ast.expr:  # noqa: N802 (ast's name)
+        return ast.Name(self.names.get(node.id, node.id), node.ctx)
+
+
+def _bound(tree: ast.AST) -> set[str]:
+    """Return every name a function binds anywhere in it: its locals and its closures' locals."""
+    bound = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Name) and not isinstance(node.ctx, ast.Load):
+            bound.add(node.id)
+        elif isinstance(node, ast.arg):
+            bound.add(node.arg)
+        elif isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+            bound.add(node.name)
+        elif isinstance(node, ast.alias):
+            bound.add(node.asname or node.name.partition('.')[0])
+        elif isinstance(node, (ast.ExceptHandler, ast.MatchAs, ast.MatchStar)) and node.name:
+            bound.add(node.name)
+        elif isinstance(node, ast.MatchMapping) and node.rest:
+            bound.add(node.rest)
+    return bound
+
+
 class _Inliner(ast.NodeTransformer):
     """Inline the calls of one-expression functions of the builder's module."""
 
     def __init__(self, namespace: dict[str, Any], rebound: set[str]) -> None:
         self.namespace, self.rebound = namespace, rebound
+        self.sites = 0  # inlined calls so far: numbers their ``x := ...`` locals
 
     def _callee(self, func: ast.expr) -> Callable[..., Any] | None:
         """Return the function a call's ``name`` or ``module.name`` refers to, or None."""
@@ -159,16 +192,24 @@ class _Inliner(ast.NodeTransformer):
             value = callee.__globals__.get(name, self)
             if name.isupper() and type(value) in (float, int):
                 values[name] = ast.Constant(value)  # a unit or constant: its value
-            elif value is not self.namespace.get(name, None):
-                return node  # it reads a global the builder's module does not share
+            elif value is not self.namespace.get(name, None) or name in self.rebound:
+                return node  # the builder's module, or the builder itself, has another `name`
         for param, value in values.items():
-            if names.count(param) > 1 and not isinstance(value, (ast.Name, ast.Constant)):
-                return node  # the argument would be evaluated more than once
-        inlined: ast.expr = _Substitute(values).visit(copy.deepcopy(expr))
+            if names.count(param) != 1 and not isinstance(value, (ast.Name, ast.Constant)):
+                return node  # the argument would be evaluated twice, or never
+        self.sites += 1
+        renamed = {name: self._unbound(f'{name}_{self.sites}') for name in local}
+        inlined: ast.expr = _Substitute(values).visit(_Rename(renamed).visit(copy.deepcopy(expr)))
         for part in ast.walk(inlined):  # the equation's lines are not the builder's: the call's
             if isinstance(part, ast.expr):
                 ast.copy_location(part, node)
         return inlined
+
+    def _unbound(self, name: str) -> str:
+        """Return `name`, or `name` with underscores appended, free in the builder and module."""
+        while name in self.rebound or name in self.namespace:
+            name += '_'
+        return name
 
 
 def inline_equations(builder: Builder) -> Builder:
@@ -191,12 +232,8 @@ def inline_equations(builder: Builder) -> Builder:
     if node is None:
         return builder
     node.decorator_list = []
-    rebound = {n.id for n in ast.walk(node)
-               if isinstance(n, ast.Name) and not isinstance(n.ctx, ast.Load)}
-    rebound |= {a.arg for n in ast.walk(node) if isinstance(n, ast.arguments)
-                for a in (*n.posonlyargs, *n.args, *n.kwonlyargs)}
     module = sys.modules[builder.__module__]
-    tree = ast.Module(body=[_Inliner(vars(module), rebound).visit(node)], type_ignores=[])
+    tree = ast.Module(body=[_Inliner(vars(module), _bound(node)).visit(node)], type_ignores=[])
     ast.fix_missing_locations(tree)
     namespace: dict[str, Any] = {}
     code = compile(tree, inspect.getsourcefile(builder) or '<inlined>', 'exec',

@@ -75,8 +75,9 @@ def speed_map(eqs: Equations, geometry: MotorGeometry, flow: object, dp_name: st
             n = eqs.closed_form_speed(q, chamber, leak)
         else:
             n, solved = solve_speed(eqs, q, chamber, leak, status)
-        if n.size and n.min() == 0.0:
-            status |= (n == 0.0) * np.uint8(PointStatus.STALLED)
+        stalled = n == 0.0  # not a min() == 0 guard: a NaN elsewhere would hide it
+        if stalled.any():
+            status |= stalled * np.uint8(PointStatus.STALLED)
         losses, total = components(eqs, n, chamber, q_lfg, q_c, q_ex, leak)
         if not closed_form:
             absorbed = absorbency(n, total, d.qt)

@@ -314,8 +314,9 @@ def flag_extrapolated(derived: DerivedCoefficients, speed: FloatArray, dp_i: Flo
     d = derived
     if d.liquid_extrapolated:
         status |= np.uint8(PointStatus.EXTRAPOLATED)
-    elif speed.size and (dp_i.max() > d.dp_max or speed.max() > d.speed_max
-                         or dp_i.min() < d.dp_min or speed.min() < d.speed_min):
+    else:  # each element on its own: a max()/min() guard is NaN, and skips all, at one NaN
         with np.errstate(invalid='ignore'):
-            status |= ((dp_i > d.dp_max) | (speed > d.speed_max) | (dp_i < d.dp_min)
-                       | (speed < d.speed_min)) * np.uint8(PointStatus.EXTRAPOLATED)
+            outside = ((dp_i > d.dp_max) | (speed > d.speed_max) | (dp_i < d.dp_min)
+                       | (speed < d.speed_min))
+        if outside.any():
+            status |= outside * np.uint8(PointStatus.EXTRAPOLATED)
