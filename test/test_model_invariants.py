@@ -152,3 +152,25 @@ def test_forward_map_with_port_drop_matches_the_port_reference_grid(liquid):
     speeds, drops = ref['n_rpm'] * RPM, ref['dp_MPa'] * MPA
     points = [model.absorbency_point(n, dp) for n, dp in zip(speeds, drops)]
     np.testing.assert_allclose([p.flow / LPM for p in points], ref['Q_lpm'], rtol=1e-6)
+
+
+def test_the_maps_give_the_same_fields_in_chunks_as_in_one_chunk(monkeypatch):
+    """Chunk boundaries, masked elements and a component 0 throughout (Q_ex) change nothing."""
+    from satmotor_ros.model import batch
+    model, p_ex = MODELS['water', 'eq39'], 0.5 * MPA
+    assert model.derived.k_ex == 0.0  # the external leakage stays 0 in every chunk
+    rng = np.random.default_rng(3)
+    flow, dp = rng.uniform(-5.0, 60.0, 40) * LPM, rng.uniform(-1.0, 30.0, 40) * MPA
+    speed = rng.uniform(-50.0, 2000.0, 40) * RPM
+    flow[::9] = np.nan
+    calls = [lambda: model.speed(flow, dp, p_ex=p_ex, method='iterative', errors='mask'),
+             lambda: model.absorbency(speed.reshape(8, 5), dp.reshape(8, 5), p_ex=p_ex,
+                                      errors='mask')]
+    whole = [call() for call in calls]
+    monkeypatch.setattr(batch, 'CHUNK', 7)  # 6 chunks, the last one short
+    for one, chunked in zip(whole, (call() for call in calls)):
+        assert (chunked.status & int(INVALID)).any() and (chunked.status == 0).any()
+        for name in ('flow', 'speed', 'dp', 'dp_i', 'status'):
+            np.testing.assert_array_equal(getattr(chunked, name), getattr(one, name))
+        for name, value in chunked.losses.as_dict().items():
+            np.testing.assert_array_equal(value, getattr(one.losses, name))

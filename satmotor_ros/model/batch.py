@@ -3,7 +3,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 
 import numpy as np
 
@@ -27,18 +27,23 @@ Chunk = dict[str, 'np.ndarray | float']
 """Results of one chunk by field name: OperatingPoints fields and COMPONENTS (0.0: none)."""
 
 
-def _join(parts: list[Chunk], shape: tuple[int, ...]) -> dict[str, np.ndarray]:
+def _join(parts: Iterator[Chunk], size: int, chunk: int) -> dict[str, np.ndarray]:
+    """
+    Write the chunks' fields into whole arrays as they come (a scalar is 0: no pages written).
+
+    Each chunk's temporaries are freed before the next is computed, so that the
+    chunks reuse the same memory; a single chunk's arrays are kept as they are.
+    """
     joined: dict[str, np.ndarray] = {}
-    for key in parts[0]:
-        values = [p[key] for p in parts]
-        scalar = [np.ndim(v) == 0 for v in values]
-        if all(scalar):  # a component that is 0 throughout (no Q_ex)
-            joined[key] = np.zeros(shape)  # calloc'd: no pages written
-            continue
-        if any(scalar):  # 0 in some chunks, masked to NaN in others
-            values = [np.broadcast_to(v, np.shape(p['status'])) for v, p in zip(values, parts)]
-        joined[key] = (np.concatenate(values) if len(values) > 1
-                       else np.asarray(values[0])).reshape(shape)
+    for start, part in zip(range(0, max(size, 1), chunk), parts):
+        for key, value in part.items():
+            if start == 0 and size <= chunk:  # the only chunk
+                joined[key] = np.asarray(value) if np.ndim(value) else np.zeros(size)
+                continue
+            if key not in joined:  # calloc'd: a component that is 0 throughout writes no page
+                joined[key] = np.zeros(size, dtype=np.result_type(value))
+            if np.ndim(value) or value:
+                joined[key][start:start + chunk] = value
     return joined
 
 
@@ -170,9 +175,9 @@ def run(core: Callable[..., Chunk], arrays: Sequence[FloatArray], status: Status
     flat = [a.reshape(-1) for a in clean]  # a view where it can be, e.g. broadcast scalars
     flat_status = status.ravel()
     chunk = CHUNK if iterative else max(flat_status.size, 1)
-    parts = [core(*(a[i:i + chunk] for a in flat), flat_status[i:i + chunk], (i, shape))
-             for i in range(0, max(flat_status.size, 1), chunk)]
-    fields_ = _join(parts, shape)
+    parts = (core(*(a[i:i + chunk] for a in flat), flat_status[i:i + chunk], (i, shape))
+             for i in range(0, max(flat_status.size, 1), chunk))
+    fields_ = {k: v.reshape(shape) for k, v in _join(parts, flat_status.size, chunk).items()}
     invalid = (fields_['status'] & int(INVALID)) != 0
     for name, value in given.items():
         fields_[name] = np.where(invalid, np.nan, value) if invalid.any() else value

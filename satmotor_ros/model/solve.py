@@ -186,21 +186,22 @@ def solve_increasing(func: Callable[[FloatArray], tuple[FloatArray, FloatArray]]
             break
         f, slope = func(x)
         below, above = f < 0.0, f > 0.0
+        # putmask, not copyto(where=): the sign of f is mixed, and copyto slows down on mixed masks
         if mirror:
             other = x - f
-            np.minimum(b, other, out=b, where=below)
-            np.maximum(a, other, out=a, where=above)
-        np.copyto(a, x, where=below)
-        np.copyto(b, x, where=above)
+            np.putmask(b, below, np.minimum(b, other))
+            np.putmask(a, above, np.maximum(a, other))
+        np.putmask(a, below, x)
+        np.putmask(b, above, x)
         band = np.abs(x)
         band *= rtol
         band += xtol
         with np.errstate(divide='ignore', invalid='ignore', over='ignore'):
             step = f / slope
-            np.copyto(step, np.inf, where=~(slope > 0.0))  # no usable slope: bisect
             newton = x - step
             size = np.abs(step)
-            bracketed = (newton >= a) & (newton <= b)
+            # a slope that is not > 0 (or NaN) is not usable: bisect
+            bracketed = (slope > 0.0) & (newton >= a) & (newton <= b)
             small = size <= band
             if not first:  # the curvature needs two Newton evaluations
                 moved = np.abs(x - last_x)
@@ -208,9 +209,9 @@ def solve_increasing(func: Callable[[FloatArray], tuple[FloatArray, FloatArray]]
                 small |= ((np.abs(f) <= bend * moved)
                           & (bend * size * size <= CURVATURE_MARGIN * band * moved * slope))
             small &= bracketed
-            take = bracketed & (newton != last_x)
+            take = small | (bracketed & (newton != last_x))  # these move to their Newton step
             exact = ~(below | above)  # f == 0, or NaN
-            settled = ~done & (exact | ((b - a <= band) & ~(small | take)))
+            settled = ~done & (exact | ((b - a <= band) & ~take))
             if settled.any():  # an exact root, a NaN, or a closed bracket
                 accepted = np.abs(f) <= check + check_rtol * np.abs(x)
                 rejected |= settled & (np.isnan(f) | (~exact & ~accepted))
@@ -219,7 +220,7 @@ def solve_increasing(func: Callable[[FloatArray], tuple[FloatArray, FloatArray]]
         go = ~done & ~small
         np.copyto(last_x, x, where=go)
         np.copyto(last_slope, slope, where=go)
-        np.copyto(x, newton, where=~done & (small | take))
+        np.copyto(x, newton, where=~done & take)
         halve = go & ~take
         if halve.any():
             np.copyto(last_slope, np.nan, where=halve)
