@@ -4,9 +4,9 @@
 from __future__ import annotations
 
 import argparse
-from collections.abc import Callable
 import math
 import sys
+from types import ModuleType
 from typing import Any
 
 from satmotor_ros.interface import DISPLACEMENT_LAWS, MotorOptions, OptionError
@@ -28,11 +28,10 @@ _USER_LIQUID = {'viscosity': ('viscosity', 'cSt'), 'density': ('density', 'kg/m^
 _PREFIX = 'motor_options.'  # the argparse dest of a motor option: prefix + field
 
 
-def subcommand(sub: argparse._SubParsersAction[argparse.ArgumentParser], name: str,
-               command: Callable[..., int], help_text: str,
-               description: str) -> argparse.ArgumentParser:
+def add_subcommand(sub: argparse._SubParsersAction[argparse.ArgumentParser], name: str,
+                   module: ModuleType) -> None:
     """
-    Add a subcommand whose parsed options are passed to `command` as keywords.
+    Add the subcommand a module defines; its parsed options go to ``command`` as keywords.
 
     Parameters
     ----------
@@ -40,20 +39,14 @@ def subcommand(sub: argparse._SubParsersAction[argparse.ArgumentParser], name: s
         The ``satmotor`` subparsers, [-]
     name : str
         The subcommand, [-]
-    command : callable
-        Runs it and returns the exit code, [-]
-    help_text, description : str
-        Short and long help, [-]
-
-    Returns
-    -------
-    argparse.ArgumentParser
-        The subcommand's parser, for its own options.
+    module : module
+        Defines ``HELP`` and ``DESCRIPTION`` (short and long help), ``add_arguments(parser)``
+        and ``command`` (runs it and returns the exit code), [-]
 
     """
-    parser = sub.add_parser(name, help=help_text, description=description)
-    parser.set_defaults(command=command)
-    return parser
+    parser = sub.add_parser(name, help=module.HELP, description=module.DESCRIPTION)
+    parser.set_defaults(command=module.command)
+    module.add_arguments(parser)
 
 
 def add_motor_options(parser: argparse.ArgumentParser, *, liquid_required: bool = False,

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from satmotor_ros.cli._common import add_motor_options, CliError, fail, subcommand
+from satmotor_ros.cli._common import add_motor_options, CliError, fail
 from satmotor_ros.interface import MotorOptions
 from satmotor_ros.model import load_motor, ModelError, MotorModel
 from satmotor_ros.model.losses import (displacement_change, displacement_change_empirical,
@@ -37,13 +37,14 @@ class Figure:
     plotted: tuple[str, ...]  # which columns are drawn; line styles in order
 
 
-def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
-    """Register ``satmotor characteristics`` and its options."""
-    parser = subcommand(
-        sub, 'characteristics', command, 'write characteristic plots (PNG) and their data (CSV)',
-        "Characteristics of the paper's Figs. 8-16 kind over the chamber pressure drop: losses "
-        'at constant flow and at constant speed, change of displacement, speed loss, and '
-        'water against oil.')
+HELP = 'write characteristic plots (PNG) and their data (CSV)'
+DESCRIPTION = ("Characteristics of the paper's Figs. 8-16 kind over the chamber pressure drop: "
+               'losses at constant flow and at constant speed, change of displacement, speed '
+               'loss, and water against oil.')
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Add the options of ``satmotor characteristics``."""
     parser.add_argument('--out', required=True, metavar='DIR', help='output directory')
     parser.add_argument('--points', type=int, default=60, help='points per curve (default 60)')
     add_motor_options(parser)

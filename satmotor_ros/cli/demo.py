@@ -18,7 +18,7 @@ import sys
 import time
 from typing import Any
 
-from satmotor_ros.cli._common import CliError, fail, subcommand
+from satmotor_ros.cli._common import CliError, fail
 from satmotor_ros.plant.config import parameter_specs, params_from_flat
 from satmotor_ros.plant.scenario import default_cycle
 
@@ -26,14 +26,15 @@ LIQUIDS = ('water', 'oil')
 FEEDFORWARDS = ('model', 'none')
 
 
-def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
-    """Register ``satmotor demo`` and its options."""
-    parser = subcommand(
-        sub, 'demo', command, 'run virtual motor, model and controller over ROS; bag + report',
-        'Runs the virtual motor, the motor_model node and the speed controller together over '
-        'real ROS topics through a cycle of speed and load steps, with and without '
-        'feed-forward, faster than real time; records every topic to an MCAP bag per run and '
-        'writes report.md with plots.')
+HELP = 'run virtual motor, model and controller over ROS; bag + report'
+DESCRIPTION = ('Runs the virtual motor, the motor_model node and the speed controller together '
+               'over real ROS topics through a cycle of speed and load steps, with and without '
+               'feed-forward, faster than real time; records every topic to an MCAP bag per run '
+               'and writes report.md with plots.')
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Add the options of ``satmotor demo``."""
     parser.add_argument('--liquid', choices=(*LIQUIDS, 'both'), default='both',
                         help='liquid(s) to run (default: both)')
     parser.add_argument('--duration', default='24',
@@ -210,4 +211,4 @@ class Progress:
         sys.stderr.write('\n')
 
 
-__all__ = ['add_parser', 'command', 'parse_effects']
+__all__ = ['add_arguments', 'command', 'parse_effects']

@@ -10,7 +10,12 @@ import sys
 from satmotor_ros import __version__
 from satmotor_ros.cli import (calibrate, characteristics, demo, operating_point, replay,
                               validate)
-from satmotor_ros.cli._common import CliError, fail, take_motor_options
+from satmotor_ros.cli._common import add_subcommand, CliError, fail, take_motor_options
+
+SUBCOMMANDS = {'demo': demo, 'operating-point': operating_point,
+               'characteristics': characteristics, 'replay': replay, 'calibrate': calibrate,
+               'validate': validate}
+"""Each ``satmotor`` subcommand and the module that defines it, in the order of ``--help``."""
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -29,8 +34,8 @@ def build_parser() -> argparse.ArgumentParser:
                     '(Śliwiński 2017 model).')
     parser.add_argument('--version', action='version', version=f'%(prog)s {__version__}')
     sub = parser.add_subparsers(dest='subcommand', required=True, metavar='COMMAND')
-    for module in (demo, operating_point, characteristics, replay, calibrate, validate):
-        module.add_parser(sub)
+    for name, module in SUBCOMMANDS.items():
+        add_subcommand(sub, name, module)
     return parser
 
 

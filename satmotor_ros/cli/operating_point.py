@@ -7,7 +7,7 @@ import argparse
 import json
 from typing import TypedDict
 
-from satmotor_ros.cli._common import add_motor_options, CliError, fail, quantity, subcommand
+from satmotor_ros.cli._common import add_motor_options, CliError, fail, quantity
 from satmotor_ros.interface import MotorOptions
 from satmotor_ros.model import (COMPONENTS, describe_status, ModelError, MotorModel,
                                 OperatingPoints, PointStatus)
@@ -43,13 +43,14 @@ class PointReport(TypedDict):
     warnings: list[str]
 
 
-def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
-    """Register ``satmotor operating-point`` and its options."""
-    parser = subcommand(
-        sub, 'operating-point', command, 'speed and losses at one flow and pressure drop',
-        'Effective speed (eq. 40), speed loss (eq. 41) and the volumetric-loss breakdown '
-        '(eq. 31) at one operating point. Quantities take an optional unit: '
-        '--flow 8.3e-5m^3/s, --dp 250bar.')
+HELP = 'speed and losses at one flow and pressure drop'
+DESCRIPTION = ('Effective speed (eq. 40), speed loss (eq. 41) and the volumetric-loss breakdown '
+               '(eq. 31) at one operating point. Quantities take an optional unit: --flow '
+               '8.3e-5m^3/s, --dp 250bar.')
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Add the options of ``satmotor operating-point``."""
     parser.add_argument('--flow', required=True, help='flow into the motor (default l/min)')
     drop = parser.add_mutually_exclusive_group(required=True)
     drop.add_argument('--dp', help='pressure drop between the ports (default MPa); the '

@@ -20,7 +20,7 @@ from satmotor_ros.bags import (BagError, describe_topics, encode_many, FLOAT64, 
                                list_topics, missing_topics, OutTopic, parse_topic_map,
                                read_series, Series, write_bag)
 from satmotor_ros.cli import _fastcsv as fastcsv
-from satmotor_ros.cli._common import add_motor_options, CliError, fail, subcommand
+from satmotor_ros.cli._common import add_motor_options, CliError, fail
 from satmotor_ros.interface import (CHANNELS, JOINT_NAME, LOSS_COMPONENTS, LOSSES_PREFIX,
                                     MotorOptions, PREDICTED_JOINT_STATE, SPEED_RESIDUAL)
 from satmotor_ros.model import describe_status, ModelError, MotorModel
@@ -41,14 +41,15 @@ _OUTPUT_COLUMNS = (('dp', 'dp [MPa]', MPA, 9), ('dp_i', 'dp_i [MPa]', MPA, 9),
                    ('residual', 'residual [rpm]', RPM, 9))
 
 
-def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
-    """Register ``satmotor replay`` and its options."""
-    parser = subcommand(
-        sub, 'replay', command, "run the motor_model node's prediction over a recorded bag",
-        "Replay a rosbag2 bag (sqlite3 or MCAP) through the motor_model node's prediction, as "
-        "fast as it can: the inputs are combined in log-time order by the node's rule. With a "
-        'measured speed (joint_states) it prints residual statistics and plots predicted '
-        'against measured speed.')
+HELP = "run the motor_model node's prediction over a recorded bag"
+DESCRIPTION = ("Replay a rosbag2 bag (sqlite3 or MCAP) through the motor_model node's "
+               'prediction, as fast as it can: the inputs are combined in log-time order by the '
+               "node's rule. With a measured speed (joint_states) it prints residual statistics "
+               'and plots predicted against measured speed.')
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Add the options of ``satmotor replay``."""
     parser.add_argument('bag', help='bag directory, or a single .db3/.mcap file')
     parser.add_argument('--out', default=None, metavar='FILE.csv',
                         help='write one row per driving message (units in the header)')

@@ -4,25 +4,23 @@
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
-from satmotor_ros.cli._common import add_motor_options, fail, subcommand
-from satmotor_ros.cli.calibrate import add_data_arguments, load_data
-from satmotor_ros.identify import IdentificationError
+from satmotor_ros.cli._bench import add_data_arguments, load_data, output_dir, run_bench_command
+from satmotor_ros.cli._common import add_motor_options
 from satmotor_ros.identify.pipeline import Mode
 from satmotor_ros.identify.validate import validate
 from satmotor_ros.identify.validation_report import write_validation
 from satmotor_ros.interface import MotorOptions
-from satmotor_ros.model import ModelError
 
 
-def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
-    """Register ``satmotor validate`` and its options."""
-    parser = subcommand(
-        sub, 'validate', command, 'error of a given (calibrated) model on new data',
-        'Hold a model (the packaged one, a motor file or a calibrated coefficients.yaml with '
-        'its effects) against a bench CSV or a rosbag2 recording without refitting anything, '
-        'and write validation.json, report.md and residuals.png into --out.')
+HELP = 'error of a given (calibrated) model on new data'
+DESCRIPTION = ('Hold a model (the packaged one, a motor file or a calibrated coefficients.yaml '
+               'with its effects) against a bench CSV or a rosbag2 recording without refitting '
+               'anything, and write validation.json, report.md and residuals.png into --out.')
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Add the options of ``satmotor validate``."""
     add_data_arguments(parser)
     add_motor_options(parser, liquid_required=True)
 
@@ -33,12 +31,8 @@ def command(data: str, out: str, mode: Mode, options: MotorOptions) -> int:
 
     Parameters
     ----------
-    data : str
-        Bench CSV or rosbag2 directory, [-]
-    out : str
-        Output directory, [-]
-    mode : str
-        ``'auto'``, ``'points'`` or ``'series'``, [-]
+    data, out, mode : str
+        DATA, ``--out`` and ``--mode`` as :func:`add_data_arguments` parses them, [-]
     options : MotorOptions
         The model to validate, [-]
 
@@ -48,19 +42,17 @@ def command(data: str, out: str, mode: Mode, options: MotorOptions) -> int:
         0 with the error on stdout; 1 with one line on stderr for unusable data or options.
 
     """
-    try:
-        model = options.build_model()
-        result = validate(load_data(data), model, options.liquid, mode)
-        target = Path(out)
-        target.mkdir(parents=True, exist_ok=True)
-        summary = write_validation(result, target)
-    except (IdentificationError, ModelError) as err:
-        return fail(err)
-    except OSError as err:
-        return fail(f'--out {out!r}: {err.strerror}')
+    return run_bench_command(out, lambda: _validate(data, out, mode, options))
+
+
+def _validate(data: str, out: str, mode: Mode, options: MotorOptions) -> str:
+    """Validate, write the outputs and return the summary line."""
+    model = options.build_model()
+    result = validate(load_data(data), model, options.liquid, mode)
+    target = output_dir(out)
+    summary = write_validation(result, target)
     error = summary['error']
-    print(f'{model.name}, set {options.liquid}, effects: {result.describe_effects()}; '
-          f'RMSE of Q_vl {error["rmse_lpm"]:.4g} l/min, mean {error["mean_abs_pct"]:.3g} %, max '
-          f'{error["max_abs_lpm"]:.4g} l/min over {summary["n_points"]} points, nothing '
-          f'refitted; wrote {target}/validation.json, report.md, residuals.png')
-    return 0
+    return (f'{model.name}, set {options.liquid}, effects: {result.describe_effects()}; '
+            f'RMSE of Q_vl {error["rmse_lpm"]:.4g} l/min, mean {error["mean_abs_pct"]:.3g} %, '
+            f'max {error["max_abs_lpm"]:.4g} l/min over {summary["n_points"]} points, nothing '
+            f'refitted; wrote {target}/validation.json, report.md, residuals.png')
