@@ -28,6 +28,7 @@ Residual = Callable[[Real], tuple[Real, Real]]
 """x -> (f(x), df/dx) for :mod:`.solve`."""
 
 _TINY_DROP = 1e-300  # [Pa]; below the resolution of any dp_i but 0
+_TINY_FLOW = 1e-300  # [m^3/s]; below the resolution of any loss but 0
 
 
 class Equations:
@@ -111,14 +112,15 @@ def _breakdown(d: DerivedCoefficients, law: DisplacementLaw) -> Callable[
         [Real, Real, Real], tuple[Real, Real, Real, Real, Real]]:
     """Return (n, dp_i, leak) -> the components of eq. (31) and Q_vl, as the law shares them."""
     k_fc, k_dch, k_b, k_i = d.k_fc, d.k_dch, d.k_b, d.k_i
-    share = law.share if law.shares else None
+    shared_loss = law.loss if law.shares else None
 
     def breakdown(speed: Real, dp_i: Real, leak: Real) -> tuple[Real, Real, Real, Real, Real]:
         fc, dch, bl, ine = (pressure_speed_loss(dp_i, speed, k_fc),
                             pressure_speed_loss(dp_i, speed, k_dch),
                             pressure_speed_loss(dp_i, speed, k_b), inertia_loss(speed, k_i))
-        if share is not None:
-            fc, dch, bl, ine = share((fc, dch, bl, ine), speed, dp_i)
+        if shared_loss is not None:  # scaled to add up to the law's loss; parts of 0 stay 0
+            scale = shared_loss(speed, dp_i) / (fc + dch + bl + ine + _TINY_FLOW)
+            fc, dch, bl, ine = fc * scale, dch * scale, bl * scale, ine * scale
         return fc, dch, bl, ine, leak + ((fc + dch) + (bl + ine))
     return breakdown
 

@@ -3,8 +3,8 @@
 The two laws for the change of displacement: the physical eq. (33) and the empirical eq. (39).
 
 Each law gives its loss Delta Q_vl = Delta q * n, the slopes of that loss,
-the lowest speed it is used at, and how its loss is shared among the
-components of eq. (31). Every method works on Python floats and on arrays
+the lowest speed it is used at, and whether eq. (31)'s components are scaled
+to add up to its loss. Every method works on Python floats and on arrays
 alike, so the single-point path and the array maps share them.
 """
 
@@ -20,11 +20,6 @@ from satmotor_ros.model._typing import Real
 from satmotor_ros.model.derived import DerivedCoefficients
 from satmotor_ros.model.errors import ModelError
 from satmotor_ros.model.units import MPA, RPM
-
-_TINY_FLOW = 1e-300  # [m^3/s]; below the resolution of any loss but 0
-
-Parts = tuple[Real, Real, Real, Real]
-"""Delta Q_fc, Delta Q_dch, Delta Q_b and Delta Q_id of eqs. (11)-(14), [m^3/s]."""
 
 Terms = Callable[[Real], tuple[Real, Real]]
 """A loss and one of its slopes as a function of one variable, the other held fixed: n > 0."""
@@ -44,7 +39,7 @@ class DisplacementLaw(ABC):
     name = ''
     closed_form = False  # whether eq. (40) inverts it, with no solve
     has_floor = False  # whether it is used only above a floor speed
-    shares = False  # whether its loss is shared among eqs. (11)-(14) by :meth:`share`
+    shares = False  # whether eq. (31)'s components are scaled to add up to its :meth:`loss`
 
     def __init__(self, derived: DerivedCoefficients) -> None:
         """Keep the constants."""
@@ -67,10 +62,6 @@ class DisplacementLaw(ABC):
     @abstractmethod
     def floor(self, dp_i: Real) -> Real:
         """Return the lowest speed the law is used at, [rad/s]."""
-
-    def share(self, parts: Parts[Real], speed: Real, dp_i: Real) -> Parts[Real]:
-        """Return the components of eqs. (11)-(14) that add up to this law's loss, [m^3/s]."""
-        return parts
 
 
 class PhysicalLaw(DisplacementLaw):
@@ -165,15 +156,6 @@ class EmpiricalLaw(DisplacementLaw):
     def floor(self, dp_i: Real) -> Real:
         """Return the lowest speed eq. (39) is used at, (C_2 ln dp_i)^2 rpm, [rad/s]."""
         return eq.empirical_speed_floor(dp_i, self.derived.c2_39)
-
-    @inline_equations
-    def share(self, parts: Parts[Real], speed: Real, dp_i: Real) -> Parts[Real]:
-        """Scale the components of eqs. (11)-(14) so that they add up to eq. (39)'s loss."""
-        fc, dch, bl, ine = parts
-        physical = fc + dch + bl + ine
-        scale = self.loss(speed, dp_i) / (physical + _TINY_FLOW)  # parts of 0 stay 0
-        return fc * scale, dch * scale, bl * scale, ine * scale
-
 
 LAWS = {'eq33': PhysicalLaw, 'eq39': EmpiricalLaw}
 """The displacement laws by name."""
