@@ -116,11 +116,12 @@ def solve_increasing_scalar(func: Callable[[float], tuple[float, float]], lo: fl
                 size = step if step >= 0.0 else -step
                 if size <= band:
                     return newton, 0
-                moved = x - last_x if x > last_x else last_x - x
-                bend = slope - last_slope if slope > last_slope else last_slope - slope
-                if (size * bend * size <= margin * band * moved * slope
-                        and (f if f > 0.0 else -f) <= bend * moved):
-                    return newton, 0
+                if last_slope == last_slope:  # a curvature needs two Newton evaluations
+                    moved = x - last_x if x > last_x else last_x - x
+                    bend = slope - last_slope if slope > last_slope else last_slope - slope
+                    if (size * bend * size <= margin * band * moved * slope
+                            and (f if f > 0.0 else -f) <= bend * moved):
+                        return newton, 0
                 if newton != last_x:  # not back to where it was: a jump's pieces are straight
                     last_x, last_slope, x = x, slope, newton
                     continue
