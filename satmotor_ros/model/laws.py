@@ -157,6 +157,7 @@ class EmpiricalLaw(DisplacementLaw):
         """Return the lowest speed eq. (39) is used at, (C_2 ln dp_i)^2 rpm, [rad/s]."""
         return eq.empirical_speed_floor(dp_i, self.derived.c2_39)
 
+
 LAWS = {'eq33': PhysicalLaw, 'eq39': EmpiricalLaw}
 """The displacement laws by name."""
 
