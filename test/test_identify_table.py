@@ -43,8 +43,14 @@ def test_table_reads_hydraulic_units(tmp_path):
     ('speed,flow [l/min],p_in [MPa],p_out [MPa]\n1,2,3,4\n', "column 'speed' has no unit"),
     ('speed [rpm],flow [l/min],p_in [MPa],p_out [MPa]\n1,2,x,4\n',
      "column 'p_in' row 2: 'x' is not a number"),
-    ('speed [rpm],flow [l/min],p_in [MPa],p_out [MPa],p_tank [psig]\n1,2,3,4,5\n',
-     "column 'p_tank \\[psig\\]'"),
+    ('speed [rpm],flow [l/min],p_in [MPa],p_out [MPa],p_tank [inHg]\n1,2,3,4,5\n',
+     "column 'p_tank \\[inHg\\]'"),
+    ('speed [rpm],flow [l/min],p_a [psi],temperature [K]\n1,2,3,4\n',
+     "missing required column 'p_b'"),
+    ('speed [rpm],flow [l/min],p_a [psi],p_b [psi],p_in [psi]\n1,2,3,4,5\n',
+     'either p_in, p_out or p_a, p_b'),
+    ('#time(s),RPM\n 0.0 12\n', "missing required column 'speed'.*--columns"),
+    ('0.0,12,1,2\n', 'no header row.*--columns'),
     ('speed [rpm],flow [l/min],p_in [MPa],p_out [MPa],flow [l/min]\n1,2,3,4,5\n',
      "column 'flow' appears 2 times"),
     ('', 'is empty'),
@@ -107,3 +113,52 @@ def test_table_accepts_semicolons_decimal_commas_and_unit_case(tmp_path):
     assert table.speed[0] == pytest.approx(600 * RPM)
     assert table.flow[0] == pytest.approx(20.5 * LPM)
     assert table.p_out[0] == pytest.approx(5e5)
+
+
+def test_table_reads_port_pressures_with_signed_speed_and_flow(tmp_path):
+    text = ('time [s],speed [rpm],flow [l/min],p_a [psi],p_b [psig]\n'
+            '0,600,20,1000,50\n1,-600,-20,50,1000\n')
+    table = read_csv(_write(tmp_path, text))
+    psi = 6894.757293168
+    assert table.p_in == pytest.approx([1000 * psi, 50 * psi])  # p_in is port A
+    assert table.p_out == pytest.approx([50 * psi, 1000 * psi])
+    assert table.speed[1] == pytest.approx(-600 * RPM)
+    assert table.flow[1] == pytest.approx(-20 * LPM)
+    assert 'p_a' not in table.channels and table.units['p_in'] == 'psi'
+
+
+def test_table_makes_absolute_pressures_gauge(tmp_path):
+    text = 'speed [rpm],flow [l/min],p_in [bara],p_out [psia]\n600,20,11.01325,14.6959\n'
+    table = read_csv(_write(tmp_path, text))
+    assert table.p_in[0] == pytest.approx(1.0e6)
+    assert table.p_out[0] == pytest.approx(0.0, abs=10.0)
+
+
+def test_table_drops_rows_below_vacuum_and_names_the_column(tmp_path):
+    rows = ''.join(f'{600 + i},20,{p},0\n' for i, p in enumerate([100, -15.5, 90, 80, 70]))
+    table = read_csv(_write(tmp_path, 'speed [rpm],flow [l/min],p_a [psig],p_b [psig]\n' + rows))
+    assert len(table) == 4
+    assert table.speed[1] == pytest.approx(602 * RPM)
+    note = [n for n in table.notes if n.startswith('impossible values')]
+    assert len(note) == 1
+    assert "column 'p_a'" in note[0] and 'dropped 1 rows' in note[0] and '-106.9 kPa' in note[0]
+
+
+def test_table_refuses_a_file_whose_pressures_are_mostly_impossible(tmp_path):
+    rows = ''.join(f'600,20,{p},0\n' for p in [-2, -3, -4, 5])  # absolute MPa read as bar?
+    with pytest.raises(DataError, match="column 'p_in': 3 of 4 values are a gauge pressure "
+                                        'below vacuum.*gauge or absolute'):
+        read_csv(_write(tmp_path, 'speed [rpm],flow [l/min],p_in [bar],p_out [bar]\n' + rows))
+
+
+def test_table_refuses_a_temperature_below_absolute_zero_in_most_rows(tmp_path):
+    text = 'speed [rpm],flow [l/min],p_in [MPa],p_out [MPa],temperature [K]\n600,20,10,1,-5\n'
+    with pytest.raises(DataError, match="column 'temperature'.*below absolute zero"):
+        read_csv(_write(tmp_path, text))
+
+
+def test_table_reads_blank_separated_rows_under_a_commented_header(tmp_path):
+    text = ('# a log\n#speed [rpm],flow [l/min],p_in [MPa],p_out [MPa]\n'
+            '  600  20 10 1\n 700 21 11 1\n')
+    table = read_csv(_write(tmp_path, text))
+    assert len(table) == 2 and table.speed[1] == pytest.approx(700 * RPM)

@@ -6,15 +6,18 @@ from __future__ import annotations
 import argparse
 from collections.abc import Callable
 from pathlib import Path
+import sys
 
 from satmotor_ros.cli._common import fail
 from satmotor_ros.identify import BenchTable, DataError, IdentificationError, read_csv
+from satmotor_ros.identify.columns import load_mapping, read_log
+from satmotor_ros.identify.table import IMPOSSIBLE
 from satmotor_ros.model import ModelError
 
 
 def add_data_arguments(parser: argparse.ArgumentParser) -> None:
     """
-    Add DATA, ``--out`` and ``--mode``: what the commands that read bench data share.
+    Add DATA, ``--out``, ``--mode`` and ``--columns``, shared by the bench-data commands.
 
     Parameters
     ----------
@@ -27,16 +30,24 @@ def add_data_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--mode', choices=('auto', 'points', 'series'), default='auto',
                         help='rows are steady points, a time series, or decide from the data '
                              '(default: auto)')
+    parser.add_argument('--columns', default='', metavar='MAPPING',
+                        help='read a log with its own column names and units through a column '
+                             'mapping: a YAML file or a packaged name such as mbari_pto '
+                             '(doc/columns.md)')
 
 
-def load_data(data: str) -> BenchTable:
+def load_data(data: str, columns: str = '') -> BenchTable:
     """
-    Load a bench CSV, or a rosbag2 directory through :mod:`satmotor_ros.bags`.
+    Load a bench CSV, a log through a column mapping, or a rosbag2 directory.
+
+    Rows dropped for a physically impossible value are named on stderr too.
 
     Parameters
     ----------
     data : str
         Path as typed, [-]
+    columns : str
+        ``--columns``: a mapping file or packaged name; '' for a bench CSV or a bag, [-]
 
     Returns
     -------
@@ -54,9 +65,16 @@ def load_data(data: str) -> BenchTable:
         msg = f'DATA {data!r}: no such file or directory'
         raise DataError(msg)
     if path.is_dir():
+        if columns:
+            msg = f'--columns {columns!r}: a column mapping reads text logs, not a rosbag2'
+            raise DataError(msg)
         from satmotor_ros.identify.bag import read_bag
         return read_bag(path)
-    return read_csv(path)
+    table = read_log(path, load_mapping(columns)) if columns else read_csv(path)
+    for note in table.notes:
+        if note.startswith(IMPOSSIBLE):
+            print(f'warning: {data}: {note}', file=sys.stderr)
+    return table
 
 
 def output_dir(out: str) -> Path:

@@ -16,9 +16,10 @@ from satmotor_ros.interface import MotorOptions
 
 HELP = 'fit the model to bench data and find the effect it lacks'
 DESCRIPTION = ('Fit the loss model to a bench table (CSV with "name [unit]" headers: speed, '
-               'flow, p_in, p_out, and any other channels) or a rosbag2 recording, test '
-               'candidate effects by cross-validation, and write calibration.json, '
-               'coefficients.yaml and report.md into --out.')
+               'flow, p_in, p_out or p_a, p_b, and any other channels), a log of its own '
+               'layout read through --columns, or a rosbag2 recording, test candidate effects '
+               'by cross-validation, and write calibration.json, coefficients.yaml and '
+               'report.md into --out.')
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -32,14 +33,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def command(data: str, out: str, mode: Mode, alpha: float, folds: int,
-            options: MotorOptions) -> int:
+            options: MotorOptions, columns: str = '') -> int:
     """
     Calibrate and write the three outputs.
 
     Parameters
     ----------
-    data, out, mode : str
-        DATA, ``--out`` and ``--mode`` as :func:`add_data_arguments` parses them, [-]
+    data, out, mode, columns : str
+        DATA, ``--out``, ``--mode`` and ``--columns`` as :func:`add_data_arguments` parses
+        them, [-]
     alpha : float
         Significance level, [-]
     folds : int
@@ -54,14 +56,15 @@ def command(data: str, out: str, mode: Mode, alpha: float, folds: int,
         unusable data or options.
 
     """
-    return run_bench_command(out, lambda: _calibrate(data, out, mode, alpha, folds, options))
+    return run_bench_command(out, lambda: _calibrate(data, out, mode, alpha, folds, options,
+                                                     columns))
 
 
 def _calibrate(data: str, out: str, mode: Mode, alpha: float, folds: int,
-               options: MotorOptions) -> str:
+               options: MotorOptions, columns: str) -> str:
     """Calibrate, write the outputs and return the summary line."""
     spec = options.spec()
-    table = load_data(data)
+    table = load_data(data, columns)
     cal = calibrate(table, options.liquid, spec, Options(alpha=alpha, n_folds=folds, mode=mode))
     target = output_dir(out)
     summary = write_json(cal, target / 'calibration.json')

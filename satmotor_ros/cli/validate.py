@@ -25,14 +25,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_motor_options(parser, liquid_required=True)
 
 
-def command(data: str, out: str, mode: Mode, options: MotorOptions) -> int:
+def command(data: str, out: str, mode: Mode, options: MotorOptions, columns: str = '') -> int:
     """
     Validate the model on the data and write the three outputs.
 
     Parameters
     ----------
-    data, out, mode : str
-        DATA, ``--out`` and ``--mode`` as :func:`add_data_arguments` parses them, [-]
+    data, out, mode, columns : str
+        DATA, ``--out``, ``--mode`` and ``--columns`` as :func:`add_data_arguments` parses
+        them, [-]
     options : MotorOptions
         The model to validate, [-]
 
@@ -42,13 +43,13 @@ def command(data: str, out: str, mode: Mode, options: MotorOptions) -> int:
         0 with the error on stdout; 1 with one line on stderr for unusable data or options.
 
     """
-    return run_bench_command(out, lambda: _validate(data, out, mode, options))
+    return run_bench_command(out, lambda: _validate(data, out, mode, options, columns))
 
 
-def _validate(data: str, out: str, mode: Mode, options: MotorOptions) -> str:
+def _validate(data: str, out: str, mode: Mode, options: MotorOptions, columns: str) -> str:
     """Validate, write the outputs and return the summary line."""
     model = options.build_model()
-    result = validate(load_data(data), model, options.liquid, mode)
+    result = validate(load_data(data, columns), model, options.liquid, mode)
     target = output_dir(out)
     summary = write_validation(result, target)
     error = summary['error']

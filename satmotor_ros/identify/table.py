@@ -4,28 +4,43 @@
 from __future__ import annotations
 
 from collections.abc import Mapping
-import csv
 from dataclasses import dataclass, field
-import io
 from pathlib import Path
 import re
 
 import numpy as np
 
 from satmotor_ros.identify.errors import DataError
+from satmotor_ros.identify.textfile import read_cells
 from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.errors import UnitError
-from satmotor_ros.model.units import kinds, RPM, to_si, units_of
+from satmotor_ros.model.units import (ATMOSPHERE, kinds, pressure_reference, RPM, to_si,
+                                      units_of)
 
 REQUIRED = ('speed', 'flow', 'p_in', 'p_out')
 """Columns every bench table must have (DESIGN.md, "Bench tables")."""
 
+PORTS = {'p_a': 'p_in', 'p_b': 'p_out'}
+"""Port pressures A and B, the alternative to p_in and p_out for signed speed and flow: port A
+is the inlet when the flow is positive, so p_a is read as p_in and p_b as p_out."""
+
 KNOWN_KINDS = {'speed': 'speed', 'flow': 'flow', 'p_in': 'pressure', 'p_out': 'pressure',
-               'p_case': 'pressure', 'temperature': 'temperature', 'time': 'time',
-               'torque': 'torque'}
+               'p_a': 'pressure', 'p_b': 'pressure', 'p_case': 'pressure',
+               'temperature': 'temperature', 'time': 'time', 'torque': 'torque'}
 """Kind of quantity of the named columns; any other ``p_*`` column is a pressure too."""
 
-_EXTRA_UNITS = {('pressure', 'psi'): 6894.757293168, ('pressure', 'mbar'): 100.0,
+IMPOSSIBLE = 'impossible values'
+"""How the notes on rows dropped for a physically impossible value begin."""
+
+_FLOORS = {'pressure': (-ATMOSPHERE, 1.0e3, 'kPa', 'a gauge pressure below vacuum'),
+           'temperature': (-273.15, 1.0, 'degC', 'a temperature below absolute zero')}
+"""Kind -> (least possible SI value, display scale, display unit, what a lower value is)."""
+
+_NOT_CHANNEL_KINDS = ('velocity', 'area')
+"""Kinds that only describe a derived flow's inputs (doc/columns.md): a channel in mm/s stays
+as given rather than being read as a velocity."""
+
+_EXTRA_UNITS = {('pressure', 'mbar'): 100.0,
                 ('temperature', '°C'): 1.0, ('temperature', 'C'): 1.0,
                 ('flow', 'm3/s'): 1.0, ('flow', 'm³/s'): 1.0, ('flow', 'l/h'): 1.0e-3 / 3600.0,
                 ('speed', '1/min'): RPM, ('speed', 'min^-1'): RPM, ('time', 'h'): 3600.0}
@@ -108,8 +123,9 @@ def column_to_si(name: str, unit: str, values: FloatArray) -> FloatArray:
     Returns
     -------
     ndarray
-        Values in SI (degC for temperature); unchanged for a column of no known
-        kind whose unit is not a known one.
+        Values in SI (degC for temperature; a pressure in an absolute unit such as
+        psia made gauge); unchanged for a column of no known kind whose unit is not a
+        known one.
 
     Raises
     ------
@@ -120,11 +136,13 @@ def column_to_si(name: str, unit: str, values: FloatArray) -> FloatArray:
     kind = _kind_of(name)
     if kind is None:
         for other in kinds():
-            if unit and unit in units_of(other):
+            if unit and unit in units_of(other) and other not in _NOT_CHANNEL_KINDS:
                 scale, offset = _affine(unit, other)
                 return values * scale + offset
         return values
     unit = _known_spelling(kind, unit)
+    if kind == 'pressure' and pressure_reference(unit) == 'absolute':
+        return values * _affine(unit, kind)[0] - ATMOSPHERE
     if (kind, unit) in _EXTRA_UNITS:
         return values * _EXTRA_UNITS[(kind, unit)]
     if not unit:
@@ -171,7 +189,8 @@ def parse_header(header: list[str]) -> list[tuple[str, str]]:
     Raises
     ------
     DataError
-        If a header is malformed, empty or repeated, or a required column is missing.
+        If a header is malformed, empty or repeated, a required column is missing, or
+        both p_in/p_out and p_a/p_b are given.
 
     """
     columns = []
@@ -188,39 +207,68 @@ def parse_header(header: list[str]) -> list[tuple[str, str]]:
         if names.count(name) > 1:
             msg = f"column '{name}' appears {names.count(name)} times"
             raise DataError(msg)
-    missing = [name for name in REQUIRED if name not in names]
+    ports = [name for name in (*PORTS, *PORTS.values()) if name in names]
+    if set(ports) & set(PORTS) and set(ports) & set(PORTS.values()):
+        msg = f'columns {", ".join(ports)}: give either p_in, p_out or p_a, p_b, not both'
+        raise DataError(msg)
+    need = ('speed', 'flow', *(PORTS if set(ports) & set(PORTS) else PORTS.values()))
+    missing = [name for name in need if name not in names]
     if missing:
         msg = (f"missing required column '{missing[0]}' (have: {', '.join(names)}; need "
-               f'{", ".join(REQUIRED)} with units, e.g. "speed [rpm]")')
+               'speed, flow and p_in, p_out (or p_a, p_b) with units, e.g. "speed [rpm]"; '
+               'a log with other column names is read through --columns, doc/columns.md)')
         raise DataError(msg)
     return columns
 
 
-def _numbers(rows: list[list[str]], columns: list[tuple[str, str]]) -> np.ndarray:
-    data = np.full((len(rows), len(columns)), np.nan)
-    for r, row in enumerate(rows):
-        if len(row) != len(columns):
-            msg = f'row {r + 2}: {len(row)} cells, header has {len(columns)}'
-            raise DataError(msg)
-        for c, cell in enumerate(row):
-            text = cell.strip()
-            if not text or text.lower() in ('nan', 'na'):
-                continue
-            try:
-                data[r, c] = float(text)
-            except ValueError:
-                msg = f"column '{columns[c][0]}' row {r + 2}: {text!r} is not a number"
-                raise DataError(msg) from None
-    return data
+def _impossible(si: Mapping[str, FloatArray], labels: Mapping[str, str],
+                source: str) -> tuple[np.ndarray, tuple[str, ...]]:
+    """
+    Flag the rows where a pressure or temperature column holds a physically impossible value.
+
+    Returns the row mask and one note per column naming it; refuses the file (DataError)
+    when most rows are impossible, which points at a wrong unit or reference, not at noise.
+    """
+    n = len(next(iter(si.values())))
+    bad = np.zeros(n, dtype=bool)
+    notes = []
+    worst = ('', 0)
+    for name, values in si.items():
+        kind = _kind_of(name)
+        if kind not in _FLOORS:
+            continue
+        floor, scale, unit, what = _FLOORS[kind]
+        low = values < floor
+        count = int(low.sum())
+        if not count:
+            continue
+        label = labels.get(name, name)
+        lowest = float(values[low].min()) / scale
+        notes.append(f"{IMPOSSIBLE}: column '{label}': dropped {count} rows with {what} "
+                     f'(< {floor / scale:.6g} {unit}; lowest {lowest:.4g} {unit})')
+        bad |= low
+        if count > worst[1]:
+            worst = (f"column '{label}': {count} of {n} values are {what} (lowest {lowest:.4g} "
+                     f'{unit})', count)
+    if 2 * int(bad.sum()) > n:
+        msg = (f'{source}: {worst[0]}; most rows are impossible: check the unit and whether '
+               'the pressure is gauge or absolute')
+        raise DataError(msg)
+    return bad, tuple(notes)
 
 
 def table_from_columns(columns: Mapping[str, tuple[str, np.ndarray]], source: str,
-                       time_series: bool = False) -> BenchTable:
+                       time_series: bool = False,
+                       labels: Mapping[str, str] | None = None) -> BenchTable:
     """
     Build a :class:`BenchTable` from named columns with units.
 
     Rows with a missing or non-finite value in a required column are dropped
-    (and counted in the notes).
+    (and counted in the notes); so are rows with a physically impossible value
+    (a gauge pressure below vacuum, -101.325 kPa, or a temperature below
+    absolute zero), with a note naming the column, unless they are most rows:
+    then the table is refused. Port pressures ``p_a``, ``p_b`` become
+    ``p_in``, ``p_out`` (:data:`PORTS`).
 
     Parameters
     ----------
@@ -230,6 +278,8 @@ def table_from_columns(columns: Mapping[str, tuple[str, np.ndarray]], source: st
         Where the data came from, for messages, [-]
     time_series : bool
         Whether the rows are raw samples in time order, [-]
+    labels : mapping of str to str, optional
+        Column name -> how messages name it (e.g. the log's own column), [-]
 
     Returns
     -------
@@ -239,26 +289,32 @@ def table_from_columns(columns: Mapping[str, tuple[str, np.ndarray]], source: st
     Raises
     ------
     DataError
-        If a required column is missing, a unit is wrong, or no row is usable.
+        If a required column is missing, a unit is wrong, no row is usable, or
+        most rows hold an impossible value.
 
     """
     parse_header([f'{name} [{unit}]' if unit else name for name, (unit, _) in columns.items()])
-    si = {name: column_to_si(name, unit, np.asarray(values, dtype=float))
+    labels = labels or {}
+    si = {PORTS.get(name, name): column_to_si(name, unit, np.asarray(values, dtype=float))
           for name, (unit, values) in columns.items()}
+    labels = {PORTS.get(name, name): labels.get(name, name) for name in columns}
     good = np.ones(len(si['speed']), dtype=bool)
     for name in REQUIRED:
         good &= np.isfinite(si[name])
-    notes: tuple[str, ...] = ()
     if not good.any():
         msg = f'{source}: no row has finite values in all of {", ".join(REQUIRED)}'
         raise DataError(msg)
+    notes: tuple[str, ...] = ()
     if not good.all():
         notes = (f'dropped {int((~good).sum())} rows with a missing or non-finite value in '
                  f'{", ".join(REQUIRED)}',)
-    units = {name: unit for name, (unit, _) in columns.items()}
+    bad, flagged = _impossible(si, labels, source)
+    good &= ~bad
+    units = {PORTS.get(name, name): unit for name, (unit, _) in columns.items()}
     extra = {name: values[good].copy() for name, values in si.items() if name not in REQUIRED}
     speed, flow, p_in, p_out = (si[name][good].copy() for name in REQUIRED)
-    return BenchTable(speed, flow, p_in, p_out, extra, units, source, time_series, notes)
+    return BenchTable(speed, flow, p_in, p_out, extra, units, source, time_series,
+                      notes + flagged)
 
 
 def read_csv(path: str | Path) -> BenchTable:
@@ -269,7 +325,8 @@ def read_csv(path: str | Path) -> BenchTable:
     ----------
     path : str or pathlib.Path
         CSV file with one header row of ``name [unit]`` cells, separated by
-        commas (or semicolons with decimal commas, or tabs), [-]
+        commas (or semicolons with decimal commas, tabs or blanks); lines
+        starting with ``#`` are comments, [-]
 
     Returns
     -------
@@ -291,39 +348,14 @@ def read_csv(path: str | Path) -> BenchTable:
     9.5
 
     """
-    file = Path(path)
-    try:
-        text = file.read_text(encoding='utf-8-sig')
-    except OSError as err:
-        msg = f'cannot read {str(file)!r}: {err.strerror}'
-        raise DataError(msg) from None
-    except UnicodeDecodeError:
-        msg = f'{str(file)!r} is not a UTF-8 text file'
-        raise DataError(msg) from None
-    lines = [line for line in text.splitlines() if line.strip() and not line.startswith('#')]
-    if not lines:
-        msg = f'{str(file)!r} is empty: expected a header row and data rows'
+    text = read_cells(path)
+    if text.header is None:
+        msg = (f'{str(path)!r} has no header row of "name [unit]" cells (e.g. "speed [rpm]"); '
+               'a log with its own columns is read through --columns, doc/columns.md')
         raise DataError(msg)
-    delimiter = ','
-    for other in (';', '\t'):
-        if other in lines[0] and ',' not in lines[0]:
-            delimiter = other
-    body = lines[1:]
-    if delimiter == ';':  # a European CSV: decimal commas
-        body = [line.replace(',', '.') for line in body]
-    columns = parse_header(next(csv.reader([lines[0]], delimiter=delimiter)))
-    try:
-        data = np.loadtxt(io.StringIO('\n'.join(body)), delimiter=delimiter, ndmin=2)
-    except ValueError:
-        data = _numbers(list(csv.reader(body, delimiter=delimiter)), columns)
-    if data.shape[0] == 0:
-        msg = f'{str(file)!r} has a header but no data rows'
-        raise DataError(msg)
-    if data.shape[1] != len(columns):
-        msg = f'{str(file)!r}: rows have {data.shape[1]} cells, the header has {len(columns)}'
-        raise DataError(msg)
-    named = {name: (unit, data[:, i]) for i, (name, unit) in enumerate(columns)}
-    return table_from_columns(named, str(file))
+    columns = parse_header(list(text.header))
+    named = {name: (unit, text.data[:, i]) for i, (name, unit) in enumerate(columns)}
+    return table_from_columns(named, str(path))
 
 
 def write_csv(path: str | Path, columns: Mapping[str, tuple[str, np.ndarray]]) -> None:

@@ -36,25 +36,40 @@ CM3_PER_REV = 1.0e-6 / (2.0 * math.pi)
 ATMOSPHERE = 101325.0
 """Standard atmosphere in Pa: absolute (sensor_msgs/FluidPressure) minus this is gauge."""
 
+INCH = 0.0254
+"""One inch in m (exact, by definition)."""
+
+PSI = 4.4482216152605 / INCH ** 2
+"""One pound-force per square inch in Pa."""
+
+GPM = 231.0 * INCH ** 3 / 60.0
+"""One US gallon (231 in^3) per minute in m^3/s."""
+
 # kind -> unit -> (scale, offset): si = value * scale + offset
 _UNITS: dict[str, dict[str, tuple[float, float]]] = {
     'flow': {
         'm^3/s': (1.0, 0.0), 'l/min': (LPM, 0.0), 'L/min': (LPM, 0.0), 'lpm': (LPM, 0.0),
-        'cm^3/s': (1.0e-6, 0.0), 'l/s': (1.0e-3, 0.0),
+        'cm^3/s': (1.0e-6, 0.0), 'l/s': (1.0e-3, 0.0), 'gpm': (GPM, 0.0),
+        'in^3/s': (INCH ** 3, 0.0), 'in^3/min': (INCH ** 3 / 60.0, 0.0),
     },
     'pressure': {
         'Pa': (1.0, 0.0), 'kPa': (1.0e3, 0.0), 'MPa': (MPA, 0.0), 'GPa': (1.0e9, 0.0),
-        'bar': (1.0e5, 0.0),
+        'bar': (1.0e5, 0.0), 'barg': (1.0e5, 0.0), 'bara': (1.0e5, 0.0), 'psi': (PSI, 0.0),
+        'psig': (PSI, 0.0), 'psia': (PSI, 0.0),
     },
     'speed': {
         'rad/s': (1.0, 0.0), 'rpm': (RPM, 0.0), 'rev/min': (RPM, 0.0), 'rev/s': (60.0 * RPM, 0.0),
     },
     'viscosity': {'m^2/s': (1.0, 0.0), 'cSt': (CST, 0.0), 'mm^2/s': (CST, 0.0)},
     'density': {'kg/m^3': (1.0, 0.0), 'g/cm^3': (1.0e3, 0.0)},
-    'length': {'m': (1.0, 0.0), 'mm': (1.0e-3, 0.0), 'um': (1.0e-6, 0.0), 'µm': (1.0e-6, 0.0)},
+    'length': {'m': (1.0, 0.0), 'mm': (1.0e-3, 0.0), 'um': (1.0e-6, 0.0), 'µm': (1.0e-6, 0.0),
+               'in': (INCH, 0.0)},
+    'velocity': {'m/s': (1.0, 0.0), 'mm/s': (1.0e-3, 0.0), 'in/s': (INCH, 0.0)},
+    'area': {'m^2': (1.0, 0.0), 'cm^2': (1.0e-4, 0.0), 'mm^2': (1.0e-6, 0.0),
+             'in^2': (INCH ** 2, 0.0)},
     'displacement': {
         'm^3/rad': (1.0, 0.0), 'm^3/rev': (1.0 / (2 * math.pi), 0.0),
-        'cm^3/rev': (CM3_PER_REV, 0.0),
+        'cm^3/rev': (CM3_PER_REV, 0.0), 'in^3/rev': (INCH ** 3 / (2 * math.pi), 0.0),
     },
     'temperature': {'degC': (1.0, 0.0), 'K': (1.0, -273.15)},
     'time': {'s': (1.0, 0.0), 'ms': (1.0e-3, 0.0), 'min': (60.0, 0.0)},
@@ -107,7 +122,8 @@ def _table(kind: str) -> dict[str, tuple[float, float]]:
 def _scale(unit: str, kind: str) -> tuple[float, float]:
     table = _table(kind)
     if unit not in table:
-        msg = f'unit {unit!r} is not a {kind} unit; use one of: {", ".join(table)}'
+        article = 'an' if kind[0] in 'aeiou' else 'a'
+        msg = f'unit {unit!r} is not {article} {kind} unit; use one of: {", ".join(table)}'
         raise UnitError(msg)
     return table[unit]
 
@@ -166,6 +182,35 @@ def from_si(value: float, unit: str, kind: str) -> float:
     """
     scale, offset = _scale(unit, kind)
     return (value - offset) / scale
+
+
+def pressure_reference(unit: str) -> str | None:
+    """
+    Tell whether a pressure unit says gauge or absolute.
+
+    Parameters
+    ----------
+    unit : str
+        Pressure unit as written, [-]
+
+    Returns
+    -------
+    str or None
+        ``'gauge'`` for psig and barg, ``'absolute'`` for psia and bara, None for a unit that
+        does not say (Pa, bar, psi, ...).
+
+    Examples
+    --------
+    >>> pressure_reference('psig'), pressure_reference('PSIA'), pressure_reference('MPa')
+    ('gauge', 'absolute', None)
+
+    """
+    folded = unit.lower()
+    if folded in ('psig', 'barg'):
+        return 'gauge'
+    if folded in ('psia', 'bara'):
+        return 'absolute'
+    return None
 
 
 def parse_quantity(text: str, kind: str, default_unit: str) -> float:

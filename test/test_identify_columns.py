@@ -1,0 +1,156 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Users' own logs through a column mapping: the MBARI logs, other layouts, one-line errors."""
+
+import math
+
+import numpy as np
+import pytest
+from satmotor_ros.cli.main import main
+from satmotor_ros.identify import DataError
+from satmotor_ros.identify.columns import load_mapping, mapping_from_dict, read_log
+from satmotor_ros.model.units import INCH, LPM, MPA, PSI, RPM
+from shared_data import shared_path
+import yaml
+
+MBARI = ('2021.07.26T10.51.44.exp', 'FrictionIDMovesWithBiasCurr.exp')
+DISPLACEMENT = 0.30 * INCH ** 3 / (2.0 * math.pi)  # Parker F11-5 [m^3/rad]
+
+
+def _mbari(name):
+    return read_log(shared_path('data', 'real', 'mbari_pto', name), load_mapping('mbari_pto'))
+
+
+def _raw(name):
+    return np.loadtxt(shared_path('data', 'real', 'mbari_pto', name), comments='#')
+
+
+@pytest.mark.parametrize(('name', 'rows', 'dropped'), [(MBARI[0], 22001, 49),
+                                                       (MBARI[1], 20001, 88)])
+def test_mbari_logs_read_through_the_packaged_mapping_in_si(name, rows, dropped):
+    raw = _raw(name)
+    assert raw.shape[0] == rows
+    table = _mbari(name)
+    lowest = raw[:, 4].min() * PSI / 1.0e3  # [kPa]
+    keep = raw[:, 4] >= -101325.0 / PSI  # LowerHydPress below vacuum: impossible, dropped
+    assert (~keep).sum() == dropped and len(table) == rows - dropped
+    raw = raw[keep]
+    assert table.p_in.max() == pytest.approx(raw[:, 5].max() * PSI)  # p_a is UpperHydPress
+    assert table.p_out.max() / MPA == pytest.approx(raw[:, 4].max() * PSI / MPA)
+    assert 20.0 < table.p_out.max() / MPA < 23.0  # ~3200 psig
+    assert table.speed == pytest.approx(raw[:, 3] * RPM)
+    assert table.flow == pytest.approx(-raw[:, 2] * 1.375 * INCH ** 3)  # -Spd x area
+    assert table.channels['time'][-1] == pytest.approx(raw[-1, 0])
+    assert table.channels['position'] == pytest.approx(raw[:, 1] * INCH)
+    assert set(table.channels) == {'time', 'position', 'winding_current'}
+    # flow and speed agree with the F11-5's displacement where the motor turns fast
+    fast = np.abs(table.speed) > 1000 * RPM
+    ratio = table.flow[fast] / (table.speed[fast] * DISPLACEMENT)
+    assert np.median(ratio) == pytest.approx(1.0, abs=0.05)
+    assert (ratio > 0).mean() > 0.95  # port A is the inlet when the flow is positive
+    assert (table.flow > 1 * LPM).any() and (table.flow < -1 * LPM).any()  # both directions
+    note = [n for n in table.notes if n.startswith('impossible values')]
+    assert note == [f"impossible values: column 'p_b (LowerHydPress)': dropped {dropped} rows "
+                    f'with a gauge pressure below vacuum (< -101.325 kPa; lowest {lowest:.4g} '
+                    'kPa)']
+    assert any('flow = -Spd [in/s]' in n for n in table.notes)
+
+
+def _log(tmp_path, text, name='log.txt'):
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+def test_a_comma_log_with_absolute_pressures_and_a_signed_speed(tmp_path):
+    log = _log(tmp_path, 'Zeit;Drehzahl;Q;PA;PB;T;Hum\n0,0;-600;20;150;12;40;3\n'
+                         '1;-610;21;151;12;41;4\n')
+    mapping = mapping_from_dict(yaml.safe_load("""
+        columns:
+          time: {column: Zeit, unit: s}
+          speed: {column: drehzahl, unit: RPM, sign: -1}
+          flow: {column: Q, unit: l/min}
+          p_in: {column: PA, unit: bar, reference: absolute}
+          p_out: {column: 5, unit: bara}
+          temperature: {column: T, unit: degC}
+        other_columns: keep
+    """))
+    table = read_log(log, mapping)
+    assert table.speed == pytest.approx([600 * RPM, 610 * RPM])
+    assert table.flow[1] == pytest.approx(21 * LPM)
+    assert table.p_in[0] == pytest.approx(150e5 - 101325.0)
+    assert table.p_out[0] == pytest.approx(12e5 - 101325.0)
+    assert table.channels['temperature'][1] == 41.0
+    assert table.channels['Hum'][1] == 4.0  # other_columns: keep
+    assert table.channels['time'][0] == 0.0
+
+
+def test_a_headerless_log_by_column_numbers(tmp_path):
+    log = _log(tmp_path, '1 2 3 4\n5 6 7 8\n')
+    mapping = mapping_from_dict({'file': {'header': 'none'}, 'columns': {
+        'speed': {'column': 1, 'unit': 'rad/s'}, 'flow': {'column': 2, 'unit': 'gpm'},
+        'p_a': {'column': 3, 'unit': 'psi'}, 'p_b': {'column': 4, 'unit': 'psi'}}})
+    table = read_log(log, mapping)
+    assert table.flow[1] == pytest.approx(6 * 231 * INCH ** 3 / 60)
+    assert table.p_out[1] == pytest.approx(8 * PSI)
+
+
+GOOD = {'speed': {'column': 'RPM', 'unit': 'rpm'}, 'flow': {'column': 'Spd', 'area': '2 in^2'},
+        'p_a': 'Up', 'p_b': 'Low'}
+HEAD = '#RPM,Spd(in/s),Up(psig),Low(psig)\n'
+
+
+@pytest.mark.parametrize(('doc', 'text', 'match'), [
+    ({'columns': {**GOOD, 'speeed': 'RPM'}}, None, "columns: unknown field 'speeed'"),
+    ({'colums': GOOD}, None, "unknown key 'colums'"),
+    ({'columns': {**GOOD, 'speed': {'column': 'RPM', 'sign': 2}}}, None,
+     r'columns.speed.sign: 2: use 1 or -1'),
+    ({'columns': {**GOOD, 'speed': {'column': 'RPM', 'area': '1 in^2'}}}, None,
+     'columns.speed.area: only a flow'),
+    ({'columns': {**GOOD, 'flow': {'column': 'Spd', 'area': '2 furlong'}}}, None,
+     "columns.flow.area: unit 'furlong' is not an area unit"),
+    ({'columns': {**GOOD, 'p_a': {'column': 'Up', 'sign': -1}}}, None,
+     'columns.p_a.sign: only speed, flow, torque'),
+    ({'columns': {**GOOD, 'p_a': {'column': 'Up', 'unit': 'psia', 'reference': 'gauge'}}}, None,
+     "columns.p_a.reference: gauge contradicts the unit 'psia'"),
+    ({'file': {'separator': 'pipe'}, 'columns': GOOD}, None, "file.separator: 'pipe'"),
+    ({'columns': {**GOOD, 'p_b': 'Lower'}}, HEAD + '1 2 3 4\n',
+     "columns.p_b: no column 'Lower' in the log \\(has: RPM, Spd, Up, Low\\)"),
+    ({'columns': {**GOOD, 'speed': 'RPM'}}, HEAD + '1 2 3 4\n',
+     "columns.speed: column 'RPM' has no unit in the header"),
+    ({'columns': {**GOOD, 'p_b': {'column': 'Low', 'unit': 'l/min'}}}, HEAD + '1 2 3 4\n',
+     "columns.p_b: unit 'l/min' is not a pressure unit"),
+    ({'columns': {**GOOD, 'flow': {'column': 'Spd', 'unit': 'l/min', 'area': '1 in^2'}}},
+     HEAD + '1 2 3 4\n', "columns.flow: unit 'l/min' is not a piston speed unit"),
+    ({'columns': GOOD}, HEAD + '1 2 -20 4\n2 2 -30 4\n',
+     r"column 'p_a \(Up\)': 2 of 2 values are a gauge pressure below vacuum"),
+    ({'columns': GOOD}, HEAD + '1 2 3 4\n1 2 x 4\n', "column 'Up' row 3: 'x' is not a number"),
+])
+def test_mapping_errors_are_one_line_naming_the_field_and_column(tmp_path, doc, text, match):
+    with pytest.raises(DataError, match=match) as info:
+        mapping = mapping_from_dict(doc, 'm.yaml')
+        read_log(_log(tmp_path, text or HEAD + '1 2 3 4\n'), mapping)
+    assert '\n' not in str(info.value)
+
+
+def test_calibrate_reads_a_log_through_columns_and_fails_in_one_line(tmp_path, capsys):
+    log = _log(tmp_path, HEAD + '1 2 3 4\n')
+    bad = _log(tmp_path, 'columns: {speed: RPM}\nfile: {header: sideways}\n', 'bad.yaml')
+    code = main(['calibrate', str(log), '--columns', str(bad), '--liquid', 'oil',
+                 '--out', str(tmp_path / 'out')])
+    err = capsys.readouterr().err
+    assert code == 1 and err.count('\n') == 1 and "file.header: 'sideways'" in err
+    code = main(['validate', str(log), '--columns', 'no_such_rig', '--liquid', 'oil',
+                 '--out', str(tmp_path / 'out')])
+    err = capsys.readouterr().err
+    assert code == 1 and "--columns 'no_such_rig': no such file" in err
+    (tmp_path / 'bag').mkdir()
+    code = main(['validate', str(tmp_path / 'bag'), '--columns', 'mbari_pto', '--liquid', 'oil',
+                 '--out', str(tmp_path / 'out')])
+    assert code == 1 and 'not a rosbag2' in capsys.readouterr().err
+
+
+def test_packaged_mapping_is_found_by_name_and_by_path():
+    by_name = load_mapping('mbari_pto')
+    assert by_name.fields['flow'].sign == -1.0
+    assert by_name.fields['flow'].area == pytest.approx(1.375 * INCH ** 2)
+    assert load_mapping(by_name.source).fields == by_name.fields
