@@ -9,6 +9,7 @@ import sys
 import pytest
 
 from satmotor_ros.model import losses, speed
+from satmotor_ros.model.families import balawender_losses, paszota_losses
 
 
 @pytest.mark.parametrize('module', ['satmotor_ros.model', 'satmotor_ros.plant',
@@ -19,7 +20,7 @@ def test_layer_imports_without_rclpy(module):
     subprocess.run([sys.executable, '-c', code], check=True)
 
 
-EQUATION_MODULES = [losses, speed]
+EQUATION_MODULES = [losses, speed, balawender_losses, paszota_losses]
 
 
 def _public_functions():

@@ -3,7 +3,10 @@
 Motor specifications from YAML: geometry, validated range and coefficient sets.
 
 The packaged default is ``config/sm075_25.yaml`` (the SM-0,75/25 for oil and
-water). It is found as package data when satmotor_ros is pip-installed and in
+water). A file names its model family with ``family:`` (default
+``sliwinski2017``; see :mod:`.families`): the coefficients are that family's,
+and a family other than ``sliwinski2017`` needs only the ``displacement`` of the
+geometry. It is found as package data when satmotor_ros is pip-installed and in
 ``share/satmotor_ros/config`` when it is built by colcon; any user file can be
 given by path. Every value is checked on load, and an error names the key
 path and the value (``coefficient_sets.oil.coefficients.beta = 2.5 ...``).
@@ -19,9 +22,10 @@ from pathlib import Path
 from typing import Any
 
 from satmotor_ros.model.coefficients import (CoefficientSet, field_names, FieldError, Liquid,
-                                             LossCoefficients, MotorGeometry, ValidRange)
+                                             MotorGeometry, ValidRange)
 from satmotor_ros.model.effects import check_effects, Effect, effect_from_mapping
 from satmotor_ros.model.errors import ConfigError, UnitError
+from satmotor_ros.model.families import DEFAULT_FAMILY, Family, family_named
 from satmotor_ros.model.losses import compressibility_coefficient
 from satmotor_ros.model.units import parse_quantity
 import yaml
@@ -52,6 +56,7 @@ class MotorSpec:
     valid_range: ValidRange
     sets: Mapping[str, CoefficientSet]
     source: str  # file the spec was read from
+    family: str = DEFAULT_FAMILY  # the model family of the sets' coefficients
 
 
 def default_config_path(name: str = DEFAULT_MOTOR) -> Path:
@@ -153,19 +158,36 @@ def motor_from_mapping(doc: Any, source: str = '<mapping>') -> MotorSpec:
 
     """
     doc = _mapping(doc, source, {'motor', 'geometry', 'valid_range', 'coefficient_sets'})
-    geometry = _record(MotorGeometry, doc['geometry'], 'geometry', _GEOMETRY_KINDS)
+    family = family_named(doc.get('family', DEFAULT_FAMILY), 'family')
+    geometry = _geometry(doc['geometry'], family)
     valid_range = _record(ValidRange, doc['valid_range'], 'valid_range', _RANGE_KINDS)
     sets_doc = _mapping(doc['coefficient_sets'], 'coefficient_sets', None)
     if not sets_doc:
         raise ConfigError('coefficient_sets is empty: give at least one liquid')
-    sets = {str(name): coefficient_set_from_mapping(entry, str(name), geometry)
+    sets = {str(name): coefficient_set_from_mapping(entry, str(name), geometry, family)
             for name, entry in sets_doc.items()}
-    return MotorSpec(str(doc['motor']), geometry, valid_range, sets, source)
+    return MotorSpec(str(doc['motor']), geometry, valid_range, sets, source, family.name)
 
 
-def coefficient_set_from_mapping(doc: Any, name: str, geometry: MotorGeometry) -> CoefficientSet:
+def _geometry(doc: Any, family: Family) -> MotorGeometry:
+    """Read the geometry; a family other than the default needs only the displacement."""
+    if family.name == DEFAULT_FAMILY:
+        return _record(MotorGeometry, doc, 'geometry', _GEOMETRY_KINDS)
+    doc = _mapping(doc, 'geometry', {'displacement'})
+    given = _values(doc, 'geometry', field_names(MotorGeometry), _GEOMETRY_KINDS)
+    packaged = load_motor().geometry  # the satellite dimensions this family does not use
+    s = (given['displacement'] / packaged.displacement) ** (1.0 / 3.0)
+    similar = {'module': packaged.module * s, 'height': packaged.height * s,
+               'clearance_rotor': packaged.clearance_rotor,
+               'clearance_satellites': packaged.clearance_satellites,
+               'commutation_diameter': packaged.commutation_diameter * s}
+    return _construct(MotorGeometry, 'geometry', **{**similar, **given})
+
+
+def coefficient_set_from_mapping(doc: Any, name: str, geometry: MotorGeometry,
+                                 family: Family | None = None) -> CoefficientSet:
     """
-    Build one validated coefficient set (liquid plus coefficients).
+    Build one validated coefficient set (liquid plus coefficients of a family).
 
     Parameters
     ----------
@@ -175,6 +197,8 @@ def coefficient_set_from_mapping(doc: Any, name: str, geometry: MotorGeometry) -
         Name of the set, e.g. ``'oil'``, [-]
     geometry : MotorGeometry
         Geometry the set belongs to (checks the split of C), [-]
+    family : Family, optional
+        The model family of the coefficients; ``sliwinski2017`` when omitted, [-]
 
     Returns
     -------
@@ -182,6 +206,7 @@ def coefficient_set_from_mapping(doc: Any, name: str, geometry: MotorGeometry) -
         The validated set.
 
     """
+    family = family if family is not None else family_named(DEFAULT_FAMILY)
     where = f'coefficient_sets.{name}'
     doc = _mapping(doc, where, {'liquid', 'coefficients'})
     unknown = sorted(set(doc) - {'liquid', 'coefficients', 'viscosity_range', 'effects'})
@@ -191,8 +216,17 @@ def coefficient_set_from_mapping(doc: Any, name: str, geometry: MotorGeometry) -
         raise ConfigError(msg)
     liquid = liquid_from_mapping(doc['liquid'], f'{where}.liquid', default_name=name)
     span = _viscosity_range(doc.get('viscosity_range'), f'{where}.viscosity_range')
-    coef = _record(LossCoefficients, doc['coefficients'], f'{where}.coefficients',
-                   _COEFFICIENT_KINDS)
+    coef = _record(family.coefficients_type, doc['coefficients'], f'{where}.coefficients',
+                   {**_COEFFICIENT_KINDS, **family.quantities})
+    if family.name != DEFAULT_FAMILY:
+        effects = _effects(doc.get('effects'), f'{where}.effects', coef)
+        for effect in effects:
+            if effect.kind == 'clearance_wear':
+                msg = (f'{where}.effects.{effect.name}: the {family.name} family has no '
+                       'axial clearances to wear (clearance_wear is for sliwinski2017)')
+                raise ConfigError(msg)
+        return _construct(CoefficientSet, where, name=name, liquid=liquid, coefficients=coef,
+                          viscosity_range=span, effects=effects)
     c_fc = compressibility_coefficient(liquid.bulk_modulus, geometry, coef)
     if c_fc > coef.c:
         msg = (f'{where}.coefficients.compressed_volume_fraction = '
@@ -204,7 +238,7 @@ def coefficient_set_from_mapping(doc: Any, name: str, geometry: MotorGeometry) -
                       viscosity_range=span, effects=effects)
 
 
-def _effects(doc: Any, where: str, coef: LossCoefficients) -> tuple[Effect, ...]:
+def _effects(doc: Any, where: str, coef: Any) -> tuple[Effect, ...]:
     if not doc:
         return ()
     effects = tuple(effect_from_mapping(name, block, where)

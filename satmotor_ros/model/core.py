@@ -10,15 +10,16 @@ wear) build their motors here, so neither needs the other.
 from __future__ import annotations
 
 from satmotor_ros.model.coefficients import CoefficientSet, Liquid, MotorGeometry, ValidRange
-from satmotor_ros.model.composition import Equations
-from satmotor_ros.model.derived import derive
-from satmotor_ros.model.laws import displacement_law
+from satmotor_ros.model.families import family_of
 from satmotor_ros.model.point import PointEvaluator
 
 
 class ModelCore:
     """
     The constants, equations and point evaluator of one motor, coefficient set and liquid.
+
+    The family (:mod:`.families`) is the one the set's coefficients belong to;
+    it derives the constants and composes the equations.
 
     Parameters
     ----------
@@ -31,7 +32,7 @@ class ModelCore:
     liquid : Liquid
         Working liquid, [-]
     law : {'eq33', 'eq39'}
-        Law of Delta q, [-]
+        Law of Delta q (eq. 39 for the ``sliwinski2017`` family only), [-]
 
     """
 
@@ -40,6 +41,7 @@ class ModelCore:
         """Derive the constants and compose the equations."""
         self.geometry, self.coefficient_set = geometry, coefficient_set
         self.valid_range, self.liquid, self.law_name = valid_range, liquid, law
-        self.derived = derive(geometry, coefficient_set, valid_range, liquid)
-        self.eqs = Equations(self.derived, displacement_law(law, self.derived))
+        self.family = family_of(coefficient_set.coefficients)
+        self.eqs = self.family.compose(geometry, coefficient_set, valid_range, liquid, law)
+        self.derived = self.eqs.derived
         self.point = PointEvaluator(self.eqs)

@@ -21,11 +21,25 @@ References
 from __future__ import annotations
 
 import math
+from typing import Protocol
 
 from satmotor_ros.model._numeric import log, maximum
 from satmotor_ros.model._typing import Real
 from satmotor_ros.model.coefficients import Liquid, LossCoefficients, MotorGeometry
 from satmotor_ros.model.units import CM3_PER_MIN, CM3_PER_REV, LPM, MPA, RPM
+
+
+class ChannelCoefficients(Protocol):
+    """The coefficients of eq. (35), as every family that uses it names them."""
+
+    @property
+    def c_t(self) -> float:
+        """Turbulent channel coefficient, Q in l/min -> Pa."""
+
+    @property
+    def c_l(self) -> float:
+        """Laminar channel coefficient, mu in mPa*s, Q in l/min -> Pa."""
+
 
 EMPIRICAL_DP_FLOOR = 1.0 * MPA
 """Chamber drop below which eq. (39) holds its value at this drop, [Pa] (see eq. 39)."""
@@ -556,7 +570,7 @@ def channel_pressure_drop(flow: Real, turbulent: float, laminar: float) -> Real:
     return (turbulent * flow + laminar) * flow
 
 
-def channel_coefficients(liquid: Liquid, coef: LossCoefficients) -> tuple[float, float]:
+def channel_coefficients(liquid: Liquid, coef: ChannelCoefficients) -> tuple[float, float]:
     r"""
     Compute the constants of eq. (35): Delta p_ich = (a Q + b) Q.
 
@@ -566,7 +580,7 @@ def channel_coefficients(liquid: Liquid, coef: LossCoefficients) -> tuple[float,
     ----------
     liquid : Liquid
         The liquid through the channels (rho, mu = rho nu), [-]
-    coef : LossCoefficients
+    coef : LossCoefficients or another family's coefficients
         Coefficient set (C_t, C_l), [-]
 
     Returns

@@ -3,8 +3,11 @@
 The motor model: loss breakdown, forward map Q(n, dp) and inverse map n(Q, dp).
 
 :class:`MotorModel` is a façade over one motor, one coefficient set and one
-liquid: :mod:`.derived` holds the constants of the equations, :mod:`.laws` the
-two laws of Delta q, :mod:`.composition` composes the equation functions,
+liquid, in the model family its coefficients belong to (:mod:`.families`;
+the other families compose their own equations into the same callables). In
+the ``sliwinski2017`` family :mod:`.derived` holds the constants of the
+equations, :mod:`.laws` the two laws of Delta q, :mod:`.composition` composes
+the equation functions,
 :mod:`.inverse` and :mod:`.forward` are the array maps (screened by
 :mod:`.screening`, evaluated by :mod:`.batch`), and :mod:`.point` the
 single-point path. Every array map screens its inputs element by element:
@@ -17,7 +20,7 @@ with ``errors='raise'`` (the default) the first bad element raises
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Literal
+from typing import Any, Literal
 
 from satmotor_ros.model._typing import ArrayLike, Real
 from satmotor_ros.model.coefficients import (CoefficientSet, Liquid, MotorGeometry,
@@ -27,6 +30,8 @@ from satmotor_ros.model.config import load_motor, MotorSpec
 from satmotor_ros.model.core import ModelCore
 from satmotor_ros.model.effects import true_flow, true_speed
 from satmotor_ros.model.errors import ModelError
+from satmotor_ros.model.families import DEFAULT_FAMILY, Family
+from satmotor_ros.model.families.defaults import default_motor
 from satmotor_ros.model.forward import absorbency_map
 from satmotor_ros.model.inverse import speed_map
 from satmotor_ros.model.point import as_float
@@ -52,7 +57,10 @@ def _point_dp(dp: object, dp_i: object) -> tuple[bool, float]:
 
 class MotorModel:
     """
-    The volumetric-loss and speed model of one satellite motor on one liquid.
+    The volumetric-loss and speed model of one motor on one liquid, in one model family.
+
+    The family is the one the coefficients belong to (:attr:`family`); every
+    family gives the same results, statuses and guarantees.
 
     Parameters
     ----------
@@ -67,7 +75,8 @@ class MotorModel:
         the set's fitted coefficients and changes nu, rho and the
         compressibility share of C (eqs. 9-11), [-]
     displacement_law : {'eq33', 'eq39'}
-        Delta q from the physical eq. (33) (default) or the empirical eq. (39), [-]
+        Delta q from the physical eq. (33) (default) or the empirical eq. (39); the
+        other families have their own equations and accept the default only, [-]
     name : str
         Name of the motor, for reports, [-]
 
@@ -93,6 +102,7 @@ class MotorModel:
         self.coef = coefficient_set.coefficients
         self.displacement_law = displacement_law
         core = ModelCore(geometry, coefficient_set, valid_range, self.liquid, displacement_law)
+        self.family: Family = core.family
         self.derived, self.law = core.derived, core.eqs.law
         self._equations, self._point = core.eqs, core.point
         self.effects = coefficient_set.effects
@@ -109,6 +119,11 @@ class MotorModel:
                  '[1/(MPa*rev)].')
     dp_limit = _derived('dp_limit', 'Chamber drop where eq. (1) would start to fall with '
                         'pressure, [Pa].')
+
+    @property
+    def equations(self) -> Any:
+        """Return the composed equations of the model's family (as ``Equations`` has them)."""
+        return self._equations
 
     @classmethod
     def from_spec(cls, spec: MotorSpec, coefficients: str = 'oil', liquid: Liquid | None = None,
@@ -160,6 +175,37 @@ class MotorModel:
 
         """
         return cls.from_spec(load_motor(), coefficients, None, displacement_law)
+
+    @classmethod
+    def for_displacement(cls, displacement: float | None = None, family: str = DEFAULT_FAMILY,
+                         coefficients: str = 'oil') -> MotorModel:
+        """
+        Build a motor with no YAML: a family's documented defaults, to be calibrated.
+
+        Parameters
+        ----------
+        displacement : float, optional
+            Displacement q_t/(2 pi); the SM-0,75/25's when omitted, [m^3/rad]
+        family : {'sliwinski2017', 'balawender', 'paszota'}
+            The model family, [-]
+        coefficients : {'oil', 'water'}
+            The liquid (the packaged SM-0,75/25's), [-]
+
+        Returns
+        -------
+        MotorModel
+            The model (:func:`~satmotor_ros.model.families.defaults.default_motor`).
+
+        Examples
+        --------
+        >>> from satmotor_ros.model.units import CM3_PER_REV, LPM, MPA, RPM
+        >>> f11 = MotorModel.for_displacement(4.92 * CM3_PER_REV, 'paszota')
+        >>> op = f11.speed_point(10 * LPM, dp_i=10 * MPA)
+        >>> 1900 < op.speed / RPM < 2032
+        True
+
+        """
+        return cls.from_spec(default_motor(family, displacement), coefficients)
 
     # -- public maps -----------------------------------------------------------------------
 

@@ -1,0 +1,89 @@
+# SPDX-License-Identifier: Apache-2.0
+"""
+A motor with no YAML: the SM-0,75/25 in any family, or a family's defaults for a displacement.
+
+The liquids (oil and water sets) and the validated range are the packaged
+SM-0,75/25's. A displacement alone gives a geometrically similar motor: module,
+height and commutation diameter scaled by (q/q_SM)^(1/3), clearances kept; the
+coefficients are the family's documented defaults for that displacement
+(:meth:`~satmotor_ros.model.families.Family.default_coefficients`), to be calibrated.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+import math
+
+from satmotor_ros.model.coefficients import MotorGeometry
+from satmotor_ros.model.config import load_motor, MotorSpec
+from satmotor_ros.model.errors import ConfigError
+from satmotor_ros.model.families import DEFAULT_FAMILY, family_named
+from satmotor_ros.model.units import CM3_PER_REV
+
+
+def similar_geometry(base: MotorGeometry, displacement: float) -> MotorGeometry:
+    """
+    Scale a satellite motor's geometry to another displacement, lengths ~ q^(1/3).
+
+    Parameters
+    ----------
+    base : MotorGeometry
+        The motor to scale, [-]
+    displacement : float
+        The new displacement q_t/(2 pi), [m^3/rad]
+
+    Returns
+    -------
+    MotorGeometry
+        Module, height and commutation diameter scaled; clearances kept.
+
+    """
+    s = (displacement / base.displacement) ** (1.0 / 3.0)
+    return replace(base, displacement=displacement, module=base.module * s,
+                   height=base.height * s, commutation_diameter=base.commutation_diameter * s)
+
+
+def default_motor(family: str = DEFAULT_FAMILY, displacement: float | None = None) -> MotorSpec:
+    """
+    Build a motor without a YAML: the SM-0,75/25, or a motor known by its displacement.
+
+    Parameters
+    ----------
+    family : str
+        ``'sliwinski2017'``, ``'balawender'`` or ``'paszota'``, [-]
+    displacement : float, optional
+        Displacement q_t/(2 pi); the SM-0,75/25's when omitted, [m^3/rad]
+
+    Returns
+    -------
+    MotorSpec
+        Sets ``oil`` and ``water`` with the family's default coefficients.
+
+    Raises
+    ------
+    ConfigError
+        For an unknown family or a displacement that is not a finite value > 0.
+
+    Examples
+    --------
+    >>> spec = default_motor('paszota', 4.9e-6 / 6.283185307179586)
+    >>> spec.family, sorted(spec.sets)
+    ('paszota', ['oil', 'water'])
+
+    """
+    fam = family_named(family)
+    packaged = load_motor()
+    if displacement is None:
+        if fam.name == DEFAULT_FAMILY:
+            return packaged
+        displacement, name = packaged.geometry.displacement, f'{packaged.name} ({fam.name})'
+    elif not (math.isfinite(displacement) and 0.0 < displacement < 1.0):
+        msg = f'displacement = {displacement!r} m^3/rad: expected a finite value > 0'
+        raise ConfigError(msg)
+    else:
+        name = (f'{fam.name} motor of {displacement / CM3_PER_REV:.4g} cm^3/rev '
+                '(default coefficients, to be calibrated)')
+    sets = {key: replace(s, coefficients=fam.default_coefficients(s, displacement), effects=())
+            for key, s in packaged.sets.items()}
+    return MotorSpec(name, similar_geometry(packaged.geometry, displacement),
+                     packaged.valid_range, sets, f'<{fam.name} defaults>', fam.name)

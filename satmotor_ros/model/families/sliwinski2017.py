@@ -1,0 +1,120 @@
+# SPDX-License-Identifier: Apache-2.0
+"""
+The ``sliwinski2017`` family: the paper's own model, eqs. (1)-(41), as the model package has it.
+
+Its equations are :mod:`satmotor_ros.model.losses` and
+:mod:`satmotor_ros.model.speed`, composed by
+:class:`~satmotor_ros.model.composition.Equations`; this module only adds what
+every family offers: the linear parts of Q_vl for a fitter, and the defaults
+for a motor known by its displacement alone.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from typing import Any, TYPE_CHECKING
+
+from satmotor_ros.model._typing import FloatArray
+from satmotor_ros.model.coefficients import (CoefficientSet, Liquid, LossCoefficients,
+                                             MotorGeometry, ValidRange)
+from satmotor_ros.model.composition import Equations
+from satmotor_ros.model.derived import derive
+from satmotor_ros.model.families._base import Family, LinearPart, SM_DISPLACEMENT
+from satmotor_ros.model.laws import displacement_law
+
+if TYPE_CHECKING:
+    from satmotor_ros.model.motor import MotorModel
+
+
+class Sliwinski2017(Family):
+    """
+    The paper's model: eqs. (31)-(41) over the components of eqs. (1)-(14) and (24).
+
+    Breakdown: every component of eq. (31); the split of C among eqs. (11)-(13)
+    follows the coefficient set's documented assumption.
+    """
+
+    name = 'sliwinski2017'
+    title = "the paper's own model, eqs. (31)-(41) (default)"
+    equations = 'eqs. (31)-(41)'
+    coefficients_type = LossCoefficients
+    laws = ('eq33', 'eq39')
+
+    def compose(self, geometry: MotorGeometry, coefficient_set: CoefficientSet,
+                valid_range: ValidRange, liquid: Liquid, law: str) -> Equations:
+        """
+        Derive the constants and compose eqs. (1)-(40) for one motor and liquid.
+
+        Parameters
+        ----------
+        geometry : MotorGeometry
+            The motor, [-]
+        coefficient_set : CoefficientSet
+            The coefficients, [-]
+        valid_range : ValidRange
+            Range the coefficients were validated over, [-]
+        liquid : Liquid
+            The working liquid, [-]
+        law : {'eq33', 'eq39'}
+            Law of Delta q, [-]
+
+        Returns
+        -------
+        Equations
+            The composition.
+
+        """
+        derived = derive(geometry, coefficient_set, valid_range, liquid)
+        return Equations(derived, displacement_law(law, derived))
+
+    def linear_parts(self, coefficients: Any) -> tuple[LinearPart, ...]:
+        """
+        Return the parts of Q_vl linear in the coefficients: see :meth:`Family.linear_parts`.
+
+        Parameters
+        ----------
+        coefficients : LossCoefficients
+            The coefficients, [-]
+
+        Returns
+        -------
+        tuple of LinearPart
+            ``leakage`` (A_1 and C_1 of eqs. 1 and 5), ``pressure_speed`` (C of eq. 33),
+            ``inertia`` (C_id of eq. 14) and ``external``: the factors today's fit scales.
+
+        """
+        return (LinearPart('leakage', 'eqs. (1), (5)', ('a1', 'c1'), 0.0),
+                LinearPart('pressure_speed', 'eqs. (11)-(13), (33)', ('c',), 1.0),
+                LinearPart('inertia', 'eqs. (14), (33)', ('c_id',), 0.5),
+                LinearPart('external', 'eq. (24), lumped', ('external_leakage',), 0.0))
+
+    def linear_losses(self, model: MotorModel, speed: FloatArray, dp_i: FloatArray,
+                      p_ex: FloatArray | float = 0.0) -> dict[str, FloatArray]:
+        """Return Q_vl as the named linear parts: see :meth:`Family.linear_losses`."""
+        b = model.breakdown(speed, dp_i, p_ex)
+        return {'leakage': b.flat_clearance + b.commutation,
+                'pressure_speed': b.compressibility + b.deformation + b.backlash,
+                'inertia': b.inertia, 'external': b.external}
+
+    def default_coefficients(self, packaged: CoefficientSet,
+                             displacement: float) -> LossCoefficients:
+        """
+        Return Table 1's set for the liquid, eq. (35) scaled to the displacement.
+
+        Parameters
+        ----------
+        packaged : CoefficientSet
+            The SM-0,75/25's set for the liquid, [-]
+        displacement : float
+            The motor's displacement, [m^3/rad]
+
+        Returns
+        -------
+        LossCoefficients
+            The set; c_t ~ q^(-4/3) and c_l ~ q^(-1) for a geometrically similar
+            motor (flow areas ~ q^(2/3), lengths ~ q^(1/3)).
+
+        """
+        coef = packaged.coefficients
+        ratio = displacement / SM_DISPLACEMENT
+        return replace(coef, c_t=coef.c_t * ratio ** (-4.0 / 3.0), c_l=coef.c_l / ratio)
