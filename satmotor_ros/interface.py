@@ -21,6 +21,8 @@ from typing import NamedTuple
 
 from satmotor_ros.model import load_motor, ModelError, MotorModel
 from satmotor_ros.model.config import MotorSpec
+from satmotor_ros.model.families import DEFAULT_FAMILY, FAMILY_NAMES
+from satmotor_ros.model.families.defaults import default_motor
 from satmotor_ros.model.motor import DisplacementLaw
 from satmotor_ros.model.results import COMPONENTS
 
@@ -119,11 +121,11 @@ class OptionError(ModelError):
 @dataclass(frozen=True)
 class MotorOptions:
     """
-    Which motor, coefficient set, liquid and Delta q law a model is built from.
+    Which motor, model family, coefficient set, liquid and Delta q law a model is built from.
 
     The same options are node parameters (same names) and ``satmotor`` options
-    (``--liquid``, ``--motor``, ``--law``, ``--viscosity``, ``--density``,
-    ``--bulk-modulus``).
+    (``--liquid``, ``--motor``, ``--family``, ``--displacement``, ``--law``,
+    ``--viscosity``, ``--density``, ``--bulk-modulus``).
 
     Parameters
     ----------
@@ -141,6 +143,14 @@ class MotorOptions:
         Density of a user liquid; 0: the set's own, [kg/m^3]
     bulk_modulus : float
         Bulk modulus of a user liquid; 0: the set's own, [Pa]
+    family : str
+        Model family: ``'sliwinski2017'``, ``'balawender'`` or ``'paszota'``; empty:
+        the motor file's own (``sliwinski2017`` without a file). Without a motor
+        file, the SM-0,75/25 (or a motor of `displacement`) with the family's
+        default coefficients, [-]
+    displacement : float
+        Displacement of a motor that has no YAML (the family's default
+        coefficients, to be calibrated); 0: the motor file's, [m^3/rad]
 
     """
 
@@ -150,9 +160,19 @@ class MotorOptions:
     viscosity: float = 0.0  # [m^2/s]; 0: the set's own
     density: float = 0.0  # [kg/m^3]; 0: the set's own
     bulk_modulus: float = 0.0  # [Pa]; 0: the set's own
+    family: str = ''  # '': the motor file's own
+    displacement: float = 0.0  # [m^3/rad]; 0: the motor file's
 
     def __post_init__(self) -> None:
-        """Reject a law or a liquid property that cannot be, naming the option."""
+        """Reject a family, law, displacement or liquid property that cannot be, naming it."""
+        if self.family not in ('', *FAMILY_NAMES):
+            raise OptionError('family', self.family, f'use one of {", ".join(FAMILY_NAMES)}')
+        if not (math.isfinite(self.displacement) and 0.0 <= self.displacement < 1.0):
+            raise OptionError('displacement', self.displacement,
+                              'must be a finite value > 0 (0: the motor file\'s)')
+        if self.displacement and self.motor_file:
+            raise OptionError('displacement', self.displacement, 'a motor file has its own: '
+                              'give the file or the displacement, not both')
         if self.displacement_law not in DISPLACEMENT_LAWS:
             raise OptionError('displacement_law', self.displacement_law,
                               f'use one of {", ".join(DISPLACEMENT_LAWS)}')
@@ -163,7 +183,7 @@ class MotorOptions:
 
     def spec(self) -> MotorSpec:
         """
-        Load the motor file and check that it has the coefficient set.
+        Load the motor file, or build a motor of the family, and check that it has the set.
 
         Returns
         -------
@@ -173,11 +193,18 @@ class MotorOptions:
         Raises
         ------
         ModelError
-            If the file cannot be read (the message names it) or lacks the set
+            If the file cannot be read (the message names it), is of another family
+            than `family` (:class:`OptionError` on ``family``) or lacks the set
             (:class:`OptionError` on ``liquid``).
 
         """
-        spec = load_motor(self.motor_file or None)
+        if self.motor_file:
+            spec = load_motor(self.motor_file)
+            if self.family and self.family != spec.family:
+                raise OptionError('family', self.family, f'{self.motor_file} is a '
+                                  f'{spec.family} motor (omit the family, or convert the file)')
+        else:
+            spec = default_motor(self.family or DEFAULT_FAMILY, self.displacement or None)
         if self.liquid not in spec.sets:
             raise OptionError('liquid', self.liquid, f'not a coefficient set of {spec.name} '
                               f'(has: {", ".join(spec.sets)})')

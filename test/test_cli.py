@@ -126,3 +126,46 @@ def test_every_model_subcommand_takes_the_same_motor_options_as_the_nodes(capsys
     code, _, _ = _run(capsys, 'characteristics', '--out', str(tmp_path), '--points', '3',
                       '--law', 'eq39', '--density', '900')
     assert code == 0
+
+
+@pytest.mark.parametrize('family', ['sliwinski2017', 'balawender', 'paszota'])
+def test_operating_point_of_each_family_labels_its_own_components(capsys, family):
+    from satmotor_ros.interface import MotorOptions
+    from satmotor_ros.model.families import FAMILIES
+    code, out, _ = _run(capsys, 'operating-point', '--flow', '10', '--dp', '10', '--family',
+                        family, '--json')
+    assert code == 0 and json.loads(out)['family'] == family
+    model = MotorOptions(family=family).build_model()
+    assert json.loads(out)['speed_rad_s'] == pytest.approx(
+        model.speed_point(10 / 60000, 10e6).speed, rel=1e-12)
+    code, out, _ = _run(capsys, 'operating-point', '--flow', '10', '--dp', '10', '--family',
+                        family)
+    labels = FAMILIES[family].components
+    assert all(label in out for label in labels.values())
+    assert ('Q_C, eq. (5)' in out) == (family == 'sliwinski2017')
+
+
+def test_displacement_builds_a_motor_with_no_yaml(capsys, tmp_path):
+    code, out, _ = _run(capsys, 'operating-point', '--flow', '10', '--dp', '10', '--family',
+                        'paszota', '--displacement', '0.30in^3/rev', '--json')
+    assert code == 0
+    result = json.loads(out)
+    assert result['motor'].startswith('paszota motor of 4.916 cm^3/rev')
+    assert 1900 < result['speed_rpm'] < 10 / 0.0049161
+    code, _, _ = _run(capsys, 'characteristics', '--out', str(tmp_path), '--points', '3',
+                      '--family', 'balawender', '--displacement', '5')
+    assert code == 0 and (tmp_path / 'water_oil_ratio.png').is_file()
+    assert not (tmp_path / 'displacement_change.png').exists()  # eqs. (33), (39): not its own
+
+
+@pytest.mark.parametrize(('argv', 'message'), [
+    (['--displacement', '0'], "--displacement '0': must be a finite value > 0"),
+    (['--displacement', '5', '--motor', 'x.yaml'], '--displacement 7.9577'),
+    (['--family', 'paszota', '--motor', 'config/sm075_25.yaml'],
+     "--family 'paszota': config/sm075_25.yaml is a sliwinski2017 motor"),
+    (['--family', 'paszota', '--law', 'eq39'], "the paszota family has 'eq33'"),
+])
+def test_family_options_refuse_with_one_line_naming_the_option(capsys, argv, message):
+    code, out, err = _run(capsys, 'operating-point', '--flow', '5', '--dp', '2', *argv)
+    assert code == 1 and out == ''
+    assert err.count('\n') == 1 and message in err, err

@@ -11,6 +11,7 @@ from typing import Any
 
 from satmotor_ros.interface import DISPLACEMENT_LAWS, MotorOptions, OptionError
 from satmotor_ros.model.errors import UnitError
+from satmotor_ros.model.families import FAMILIES
 from satmotor_ros.model.units import parse_quantity
 
 
@@ -18,13 +19,15 @@ class CliError(Exception):
     """A user-facing error: printed as one line, exit code 1."""
 
 
-MOTOR_FLAGS = {'liquid': '--liquid', 'motor_file': '--motor', 'displacement_law': '--law',
+MOTOR_FLAGS = {'liquid': '--liquid', 'motor_file': '--motor', 'family': '--family',
+               'displacement': '--displacement', 'displacement_law': '--law',
                'viscosity': '--viscosity', 'density': '--density',
                'bulk_modulus': '--bulk-modulus'}
 """Each :class:`MotorOptions` field and its ``satmotor`` option."""
 
-_USER_LIQUID = {'viscosity': ('viscosity', 'cSt'), 'density': ('density', 'kg/m^3'),
-                'bulk_modulus': ('pressure', 'MPa')}  # option -> (kind, default unit)
+_QUANTITIES = {'viscosity': ('viscosity', 'cSt'), 'density': ('density', 'kg/m^3'),
+               'bulk_modulus': ('pressure', 'MPa'),
+               'displacement': ('displacement', 'cm^3/rev')}  # option -> (kind, default unit)
 _PREFIX = 'motor_options.'  # the argparse dest of a motor option: prefix + field
 
 
@@ -74,6 +77,16 @@ def add_motor_options(parser: argparse.ArgumentParser, *, liquid_required: bool 
     group.add_argument('--motor', dest=_PREFIX + 'motor_file', default='', metavar='YAML',
                        help='motor specification or calibrated coefficients file (default: '
                             'the packaged SM-0,75/25)')
+    group.add_argument('--family', dest=_PREFIX + 'family', default=MotorOptions.family,
+                       choices=tuple(FAMILIES), metavar='NAME',
+                       help='model family: ' + '; '.join(f'{name}: {f.title}'
+                                                         for name, f in FAMILIES.items())
+                       + ". Default: the motor file's own; without --motor, the SM-0,75/25 "
+                         "(or a motor of --displacement) with the family's defaults")
+    group.add_argument('--displacement', dest=_PREFIX + 'displacement', default=None,
+                       metavar='Q', help='displacement of a motor with no YAML (default '
+                                         "cm^3/rev; e.g. 0.30in^3/rev): the family's default "
+                                         'coefficients, to be calibrated')
     if not model_options:
         return
     group.add_argument('--law', dest=_PREFIX + 'displacement_law', choices=DISPLACEMENT_LAWS,
@@ -104,17 +117,21 @@ def take_motor_options(args: dict[str, Any]) -> dict[str, Any]:
     Raises
     ------
     CliError
-        If a user-liquid property cannot be parsed or is not > 0, naming the option.
+        If a quantity (user-liquid property, displacement) cannot be parsed or is not > 0,
+        naming the option.
 
     """
     typed = {k[len(_PREFIX):]: args.pop(k) for k in list(args) if k.startswith(_PREFIX)}
     if not typed:
         return args
-    for name, (kind, unit) in _USER_LIQUID.items():
+    for name, (kind, unit) in _QUANTITIES.items():
         text = typed.pop(name, None)
         if text is not None:
             typed[name] = quantity(MOTOR_FLAGS[name], text, kind, unit, positive=True)
-    return {**args, 'options': MotorOptions(**typed)}
+    try:
+        return {**args, 'options': MotorOptions(**typed)}
+    except OptionError as err:
+        raise CliError(f'{MOTOR_FLAGS[err.option]} {err.value!r}: {err.reason}') from None
 
 
 def quantity(flag: str, text: str, kind: str, default_unit: str, *,

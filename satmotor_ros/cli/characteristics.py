@@ -12,7 +12,8 @@ import numpy as np
 
 from satmotor_ros.cli._common import add_motor_options, CliError, fail
 from satmotor_ros.interface import MotorOptions
-from satmotor_ros.model import load_motor, ModelError, MotorModel
+from satmotor_ros.model import ModelError, MotorModel
+from satmotor_ros.model.families import DEFAULT_FAMILY
 from satmotor_ros.model.losses import (displacement_change, displacement_change_empirical,
                                        EMPIRICAL_DP_FLOOR)
 from satmotor_ros.model.units import LPM, MPA, RPM
@@ -74,10 +75,12 @@ def command(out: str, points: int, options: MotorOptions) -> int:
             raise CliError(f'--points {points}: need at least 2')
         model = options.build_model()
         dp_i = np.linspace(0.5 * MPA, model.valid_range.dp_max, points)
-        figures = [*constant_flow(model, dp_i), constant_speed(model, dp_i),
-                   displacement(model, dp_i)]
-        others = {name: MotorOptions(name, options.motor_file,
-                                     options.displacement_law).build_model()
+        figures = [*constant_flow(model, dp_i), constant_speed(model, dp_i)]
+        if model.family.name == DEFAULT_FAMILY:  # eqs. (33) and (39) are that family's
+            figures.append(displacement(model, dp_i))
+        others = {name: MotorOptions(name, options.motor_file, options.displacement_law,
+                                     family=options.family,
+                                     displacement=options.displacement).build_model()
                   for name in ('oil', 'water')} if _has_both(options) else None
         if others is not None:
             figures.append(water_against_oil(others['water'], others['oil'], dp_i))
@@ -96,7 +99,7 @@ def command(out: str, points: int, options: MotorOptions) -> int:
 
 
 def _has_both(options: MotorOptions) -> bool:
-    return {'oil', 'water'} <= set(load_motor(options.motor_file or None).sets)
+    return {'oil', 'water'} <= set(options.spec().sets)
 
 
 def constant_flow(model: MotorModel, dp_i: np.ndarray) -> tuple[Figure, Figure]:

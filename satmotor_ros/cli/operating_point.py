@@ -11,24 +11,15 @@ from satmotor_ros.cli._common import add_motor_options, CliError, fail, quantity
 from satmotor_ros.interface import MotorOptions
 from satmotor_ros.model import (COMPONENTS, describe_status, ModelError, MotorModel,
                                 OperatingPoints, PointStatus)
+from satmotor_ros.model.families import DEFAULT_FAMILY, FAMILIES
 from satmotor_ros.model.units import LPM, MPA, RPM
-
-_LABELS = {
-    'flat_clearance': 'flat clearances Q_Lfg, eq. (1)',
-    'commutation': 'commutation unit Q_C, eq. (5)',
-    'compressibility': 'compressibility dQ_fc, eq. (11)',
-    'deformation': 'deformation dQ_dch, eq. (12)',
-    'backlash': 'backlash dQ_b, eq. (13)',
-    'inertia': 'inertia dQ_id, eq. (14)',
-    'external': 'external Q_ex, eq. (24)',
-    'total': 'total Q_vl, eq. (31)',
-}
 
 
 class PointReport(TypedDict):
     """The operating point as ``--json`` prints it, in hydraulic units."""
 
     motor: str
+    family: str
     coefficients: str
     liquid: str
     displacement_law: str
@@ -45,7 +36,8 @@ class PointReport(TypedDict):
 
 HELP = 'speed and losses at one flow and pressure drop'
 DESCRIPTION = ('Effective speed (eq. 40), speed loss (eq. 41) and the volumetric-loss breakdown '
-               '(eq. 31) at one operating point. Quantities take an optional unit: --flow '
+               '(eq. 31, or the components of the chosen --family) at one operating point. '
+               'Quantities take an optional unit: --flow '
                '8.3e-5m^3/s, --dp 250bar.')
 
 
@@ -109,6 +101,7 @@ def _result(model: MotorModel, op: OperatingPoints) -> PointReport:
     status = int(op.status)
     return {
         'motor': model.name,
+        'family': model.family.name,
         'coefficients': model.coefficient_set.name,
         'liquid': model.liquid.name,
         'displacement_law': model.displacement_law,
@@ -138,7 +131,8 @@ def _warnings(status: int) -> list[str]:
 def _table(r: PointReport) -> str:
     lines = [
         f'{r["motor"]} on {r["liquid"]} ({r["coefficients"]} coefficients), '
-        f'displacement law {r["displacement_law"]}',
+        + (f'displacement law {r["displacement_law"]}' if r['family'] == DEFAULT_FAMILY
+           else f'{r["family"]} family'),
         f'  flow Q               {r["flow_lpm"]:10.3f} l/min',
         f'  dp between ports     {r["dp_MPa"]:10.3f} MPa',
         f'  dp_i in chambers     {r["dp_i_MPa"]:10.3f} MPa',
@@ -146,7 +140,9 @@ def _table(r: PointReport) -> str:
         f'  speed loss n_i       {r["speed_loss_rpm"]:10.2f} rpm  (eq. 41)',
         '  volumetric losses [l/min]',
     ]
-    lines += [f'    {_LABELS[name]:34s} {value:10.4f}' for name, value in r['losses_lpm'].items()]
+    labels = FAMILIES[r['family']].components  # the components the family has
+    lines += [f'    {labels[name]:38s} {value:10.4f}'
+              for name, value in r['losses_lpm'].items() if name in labels]
     lines.append(f'  status: {r["status"]}')
     lines += [f'  warning: {note}' for note in r['warnings']]
     return '\n'.join(lines)

@@ -117,6 +117,10 @@ def loss_parts(model: MotorModel, table: BenchTable) -> tuple[LossParts, np.ndar
         If no point is usable.
 
     """
+    if model.family.name != 'sliwinski2017':  # the fit below scales that family's parts
+        msg = (f'calibrating the {model.family.name} family is not supported yet '
+               '(its linear parts: model.family.linear_parts); use --family sliwinski2017')
+        raise IdentificationError(msg)
     coef = model.coef
     flow, speed, dp = table.flow, table.speed, table.dp
     d = model.derived

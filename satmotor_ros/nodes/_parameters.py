@@ -23,6 +23,7 @@ from rclpy.exceptions import InvalidParameterTypeException, InvalidParameterValu
 from rclpy.node import Node
 from rclpy.parameter import AllowableParameterValue, Parameter
 from satmotor_ros.interface import DISPLACEMENT_LAWS, MotorOptions
+from satmotor_ros.model.families import FAMILY_NAMES
 
 RosParameter: TypeAlias = Parameter[AllowableParameterValue]
 """A parameter as rclpy hands it to the set-parameter callbacks."""
@@ -185,6 +186,13 @@ MOTOR_PARAMETERS = (
               "bulk modulus of a user liquid; 0: the set's own", 'Pa', 0.0, 1.0e12),
     ParamSpec('motor_file', MotorOptions.motor_file, 'motor specification or calibrated '
               'coefficients YAML; empty: the packaged SM-0,75/25'),
+    ParamSpec('family', MotorOptions.family, "model family; empty: the motor file's own "
+              '(sliwinski2017 without one); without motor_file, the SM-0,75/25 or a motor of '
+              "displacement with the family's default coefficients",
+              choices=('', *FAMILY_NAMES)),
+    ParamSpec('displacement', MotorOptions.displacement, 'displacement of a motor with no '
+              "motor_file (the family's default coefficients, to be calibrated); 0: the "
+              "motor file's", 'm^3/rad', 0.0, 1.0e-2),
     ParamSpec('displacement_law', MotorOptions.displacement_law, 'change of displacement: '
               'physical eq. (33) or empirical eq. (39)', choices=DISPLACEMENT_LAWS),
 )

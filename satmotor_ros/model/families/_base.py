@@ -237,6 +237,7 @@ class Family(ABC):
     equations = ''  # the equations of the paper it implements, e.g. 'eqs. (29)-(30)'
     coefficients_type: type = object  # the frozen coefficient dataclass
     quantities: Mapping[str, tuple[str, str]] = {}  # YAML field -> (unit kind, SI unit)
+    components: Mapping[str, str] = {}  # breakdown component it has -> label with its eq.
     laws: tuple[str, ...] = ('eq33',)  # the displacement_law names it accepts
 
     def check_law(self, law: str) -> None:

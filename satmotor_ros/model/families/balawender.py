@@ -193,6 +193,10 @@ class Balawender(Family):
     title = 'the earlier literature model, eqs. (15)-(28), with its low-viscosity variant'
     equations = 'eqs. (15)-(28)'
     coefficients_type = BalawenderCoefficients
+    components = {'flat_clearance': 'clearances Q_l + Q_t, eqs. (20)-(23)',
+                  'compressibility': 'pressure x speed dQ_vl, eqs. (17)-(19)',
+                  'external': 'external Q_ex, eqs. (16), (24)',
+                  'total': 'total Q_vl, eqs. (15)-(16)'}
     quantities = {'oil_viscosity': ('viscosity', 'm^2/s'), 'oil_density': ('density', 'kg/m^3'),
                   'oil_bulk_modulus': ('pressure', 'Pa'),
                   'low_viscosity_below': ('viscosity', 'm^2/s')}

@@ -154,6 +154,7 @@ class Paszota(Family):
     title = "Paszota and Maczyszyn's model of any constant-displacement motor, eqs. (29)-(30)"
     equations = 'eqs. (29)-(30)'
     coefficients_type = PaszotaCoefficients
+    components = {'external': 'external Q_ex, eq. (24)', 'total': 'total Q_l, eq. (29)'}
     quantities = {'p_n': ('pressure', 'Pa'), 'n_t': ('speed', 'rad/s'),
                   'nu_n': ('viscosity', 'm^2/s')}
 

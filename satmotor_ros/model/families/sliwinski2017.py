@@ -38,6 +38,12 @@ class Sliwinski2017(Family):
     title = "the paper's own model, eqs. (31)-(41) (default)"
     equations = 'eqs. (31)-(41)'
     coefficients_type = LossCoefficients
+    components = {'flat_clearance': 'flat clearances Q_Lfg, eq. (1)',
+                  'commutation': 'commutation unit Q_C, eq. (5)',
+                  'compressibility': 'compressibility dQ_fc, eq. (11)',
+                  'deformation': 'deformation dQ_dch, eq. (12)',
+                  'backlash': 'backlash dQ_b, eq. (13)', 'inertia': 'inertia dQ_id, eq. (14)',
+                  'external': 'external Q_ex, eq. (24)', 'total': 'total Q_vl, eq. (31)'}
     laws = ('eq33', 'eq39')
 
     def compose(self, geometry: MotorGeometry, coefficient_set: CoefficientSet,
