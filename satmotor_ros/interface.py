@@ -169,7 +169,7 @@ class MotorOptions:
             raise OptionError('family', self.family, f'use one of {", ".join(FAMILY_NAMES)}')
         if not (math.isfinite(self.displacement) and 0.0 <= self.displacement < 1.0):
             raise OptionError('displacement', self.displacement,
-                              'must be a finite value > 0 (0: the motor file\'s)')
+                              "must be a finite value > 0 (0: the motor file's)")
         if self.displacement and self.motor_file:
             raise OptionError('displacement', self.displacement, 'a motor file has its own: '
                               'give the file or the displacement, not both')

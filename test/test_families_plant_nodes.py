@@ -122,3 +122,35 @@ def test_every_family_builds_from_the_packaged_liquids():
         for liquid in ('oil', 'water'):
             model = MotorModel.for_displacement(None, family, liquid)
             assert model.speed_point(10 * LPM, 10 * MPA).status & 0xF8 == 0
+
+
+def test_calibration_refuses_a_family_the_fitter_does_not_take_yet():
+    from satmotor_ros.identify.errors import IdentificationError
+    from satmotor_ros.identify.parts import loss_parts
+    with pytest.raises(IdentificationError, match='paszota family is not supported yet'):
+        loss_parts(MotorOptions(family='paszota').build_model(), None)
+
+
+@pytest.mark.parametrize('family', ['balawender', 'paszota'])
+def test_effects_of_a_coefficient_set_work_in_every_family(family, tmp_path):
+    from satmotor_ros.model.config import motor_from_mapping
+    doc = {'motor': 'x', 'family': family, 'geometry': {'displacement': '10 cm^3/rev'},
+           'valid_range': {'dp_max': '25 MPa', 'speed_max': '2000 rpm'},
+           'coefficient_sets': {'oil': {
+               'liquid': {'kinematic_viscosity': '40 cSt', 'density': 873,
+                          'bulk_modulus': '1.6 GPa'},
+               'coefficients': {'external_leakage': 1e-12},
+               'effects': {
+                   'external_leakage': {'regressor': 'p_case', 'coefficient': 1e-12},
+                   'viscosity_temperature': {'regressor': 'temperature', 'coefficient': 3.68,
+                                             'law': 'walther', 'reference_temperature': 40.0,
+                                             'reference_viscosity': 40e-6}}}}}
+    model = MotorModel.from_spec(motor_from_mapping(doc))
+    assert model.family.name == family and set(model.channels) == {'p_case', 'temperature'}
+    cool = model.absorbency_point(1000 * 0.10471975511965977, 10 * MPA,
+                                  channels={'p_case': 2e5, 'temperature': 40.0})
+    hot = model.absorbency_point(1000 * 0.10471975511965977, 10 * MPA,
+                                 channels={'p_case': 2e5, 'temperature': 70.0})
+    assert cool.status & 0xF8 == 0 and hot.status & 0xF8 == 0
+    assert cool.external == pytest.approx(1e-12 * 2e5)
+    assert hot.total > cool.total  # thinner oil leaks more

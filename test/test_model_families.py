@@ -10,9 +10,9 @@ import pytest
 from satmotor_ros.model import (ConfigError, INVALID, InvalidInputError, ModelError,
                                 MotorModel, PointStatus)
 from satmotor_ros.model.config import motor_from_mapping
-from satmotor_ros.model.families import (BalawenderCoefficients, FAMILIES, FAMILY_NAMES,
-                                         family_named, PaszotaCoefficients)
 from satmotor_ros.model.families import balawender_losses as bal
+from satmotor_ros.model.families import (BalawenderCoefficients, FAMILIES, family_named,
+                                         FAMILY_NAMES, PaszotaCoefficients)
 from satmotor_ros.model.families import paszota_losses as pas
 from satmotor_ros.model.families.defaults import default_motor
 from satmotor_ros.model.units import CM3_PER_REV, CST, LPM, MPA, RPM
@@ -322,7 +322,7 @@ def test_an_unknown_family_is_refused_naming_the_key_and_value():
     with pytest.raises(ConfigError, match=r"family = 'wilson': unknown model family \(use "
                                           r'sliwinski2017, balawender, paszota\)'):
         motor_from_mapping(doc)
-    with pytest.raises(ConfigError, match="family = 3"):
+    with pytest.raises(ConfigError, match='family = 3'):
         family_named(3)
 
 
