@@ -81,7 +81,7 @@ def test_unreadable_and_malformed_files_are_config_errors(tmp_path):
         load_motor(tmp_path / 'absent.yaml')
     bad = tmp_path / 'bad.yaml'
     bad.write_text('geometry: [unclosed\n', encoding='utf-8')
-    with pytest.raises(ConfigError, match=r"^motor config '.*bad\.yaml' is not valid YAML"):
+    with pytest.raises(ConfigError, match=r"^motor config '.*bad\.yaml': not valid YAML \(line 2"):
         load_motor(bad)
 
 

@@ -34,7 +34,7 @@ import numpy.typing as npt
 
 from satmotor_ros.bags.decode import pack_payloads
 from satmotor_ros.bags.errors import BagError
-import yaml
+from satmotor_ros.bounded_yaml import read_yaml, YamlLimitError
 
 if TYPE_CHECKING:
     from rosbags.interfaces import ConnectionExtRosbag2
@@ -365,7 +365,7 @@ def _storage_of(path: Path) -> str:
 
 def _parse_metadata(path: Path) -> tuple[str, list[str], dict[str, TopicInfo], str]:
     try:
-        doc = yaml.safe_load(path.read_text(encoding='utf-8'))
+        doc = read_yaml(path)
         info = doc['rosbag2_bagfile_information']
         storage = str(info['storage_identifier'])
         files = [str(f).strip() for f in info['relative_file_paths']]
@@ -377,8 +377,8 @@ def _parse_metadata(path: Path) -> tuple[str, list[str], dict[str, TopicInfo], s
                                              int(entry.get('message_count', 0)))
         mode = str(info.get('compression_mode') or '')
         fmt = str(info.get('compression_format') or '')
-    except yaml.YAMLError as err:
-        raise BagError(f'{path}: not valid YAML ({str(err).splitlines()[0]})') from None
+    except YamlLimitError as err:
+        raise BagError(f'{path}: {err}') from None
     except (KeyError, TypeError, ValueError, AttributeError) as err:
         raise BagError(f'{path}: not rosbag2 metadata (missing or malformed {err})') from None
     if mode and mode.upper() != 'NONE' and fmt != 'zstd':
@@ -429,6 +429,8 @@ def open_bag(path: str | Path) -> Bag:
     files = []
     for name in names:
         file = path / name
+        if Path(name).is_absolute() or not file.resolve().is_relative_to(path.resolve()):
+            raise BagError(f'{meta_path} lists {name!r}, which is outside the bag directory')
         if not file.is_file():
             raise BagError(f'{meta_path} lists {name!r}, which is not in {path}')
         if _storage_of(file) != storage:

@@ -40,6 +40,17 @@ def _check(owner: str, name: str, value: float, low: float, high: float,
         raise FieldError(owner, name, f'{value!r} is outside {bracket}{low}, {high})')
 
 
+LIQUID_RANGES = {'kinematic_viscosity': (1.0e-8, 1.0), 'density': (10.0, 1.0e5),
+                 'bulk_modulus': (1.0e5, 1.0e12)}
+"""
+Open ranges of a liquid's properties, [SI].
+
+Wide enough for any liquid a motor runs on (water at 100 degC has 2.9e-7 m^2/s;
+oil with entrained air a bulk modulus of about 1e8 Pa), narrow enough that no
+property turns a loss into inf or NaN (a bulk modulus of 5e-324 Pa would).
+"""
+
+
 @dataclass(frozen=True)
 class Liquid:
     """A working liquid, described by the three properties the model uses."""
@@ -51,9 +62,8 @@ class Liquid:
 
     def __post_init__(self) -> None:
         """Reject non-physical properties, naming the field."""
-        _check(self.name, 'kinematic_viscosity', self.kinematic_viscosity, 0.0, 1.0)
-        _check(self.name, 'density', self.density, 0.0, 1.0e5)
-        _check(self.name, 'bulk_modulus', self.bulk_modulus, 0.0, 1.0e12)
+        for name, (low, high) in LIQUID_RANGES.items():
+            _check(self.name, name, getattr(self, name), low, high)
 
     @property
     def dynamic_viscosity(self) -> float:

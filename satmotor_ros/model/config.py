@@ -21,6 +21,7 @@ import math
 from pathlib import Path
 from typing import Any
 
+from satmotor_ros.bounded_yaml import read_yaml, YamlLimitError
 from satmotor_ros.model.coefficients import (CoefficientSet, field_names, FieldError, Liquid,
                                              MotorGeometry, ValidRange)
 from satmotor_ros.model.effects import check_effects, Effect, effect_from_mapping
@@ -28,7 +29,6 @@ from satmotor_ros.model.errors import ConfigError, UnitError
 from satmotor_ros.model.families import DEFAULT_FAMILY, Family, family_named
 from satmotor_ros.model.losses import compressibility_coefficient
 from satmotor_ros.model.units import parse_quantity
-import yaml
 
 DEFAULT_MOTOR = 'sm075_25.yaml'
 """File name of the packaged SM-0,75/25 specification."""
@@ -130,12 +130,12 @@ def load_motor(path: str | Path | None = None) -> MotorSpec:
     """
     file = Path(path) if path is not None else default_config_path()
     try:
-        doc = yaml.safe_load(file.read_text(encoding='utf-8'))
+        doc = read_yaml(file)
     except OSError as err:
         msg = f'cannot read motor config {str(file)!r}: {err.strerror}'
         raise ConfigError(msg) from None
-    except yaml.YAMLError as err:
-        msg = f'motor config {str(file)!r} is not valid YAML: {err}'
+    except YamlLimitError as err:
+        msg = f'motor config {str(file)!r}: {err}'
         raise ConfigError(msg) from None
     return motor_from_mapping(doc, source=str(file))
 

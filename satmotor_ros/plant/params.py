@@ -193,7 +193,7 @@ class PlantParams(Bounded):
     sensors: SensorSet = field(default_factory=SensorSet)
     active_load: bool = parameter(
         False, 'load torque drives the shaft (True) or brakes it (False)')
-    seed: int = parameter(0, 'seed of the sensor noise')
+    seed: int = parameter(0, 'seed of the sensor noise', '-', 0, 2 ** 63 - 1)
     rebuild_tolerance: float = parameter(
         0.005, 'relative change of nu or h that rebuilds the model', '-', 1.0e-6, 0.5)
 

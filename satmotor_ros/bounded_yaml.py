@@ -1,0 +1,175 @@
+# SPDX-License-Identifier: Apache-2.0
+"""
+YAML files read with bounded work: size, nesting, alias expansion, integer digits.
+
+Every YAML file the package reads (motor files, column mappings, a bag's
+``metadata.yaml``) goes through :func:`read_yaml`. A small hostile file must
+not take unbounded memory or time, nor end in a traceback: a file larger than
+:data:`MAX_BYTES` (``/dev/zero`` included), nesting deeper than
+:data:`MAX_DEPTH`, aliases that would expand to more than :data:`MAX_NODES`
+nodes (a "billion laughs" bomb), an integer of more than :data:`MAX_DIGITS`
+digits and a key given twice are each refused with one line. The document is
+never expanded into an error message. The caps are overridable through the
+environment variables named beside them.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+
+def _cap(name: str, default: int) -> int:
+    text = os.environ.get(name, '')
+    return int(text) if text.isdigit() and int(text) > 0 else default
+
+
+MAX_BYTES = _cap('SATMOTOR_YAML_MAX_BYTES', 1 << 20)
+"""Largest YAML file read, [byte] (``SATMOTOR_YAML_MAX_BYTES``)."""
+
+MAX_DEPTH = _cap('SATMOTOR_YAML_MAX_DEPTH', 64)
+"""Deepest nesting of mappings and sequences, [-] (``SATMOTOR_YAML_MAX_DEPTH``)."""
+
+MAX_NODES = _cap('SATMOTOR_YAML_MAX_NODES', 100_000)
+"""Most nodes of the document with every alias expanded, [-] (``SATMOTOR_YAML_MAX_NODES``)."""
+
+MAX_DIGITS = 40
+"""Most digits of an integer; no physical quantity needs more, [-]."""
+
+
+class YamlLimitError(ValueError):
+    """A YAML file is malformed or exceeds a cap; the message is one line without the document."""
+
+
+class _BoundedLoader(yaml.SafeLoader):
+    """A safe loader that counts depth and expanded size while it composes."""
+
+    def __init__(self, stream: str) -> None:
+        super().__init__(stream)
+        self._depth = 0
+        self._sizes: dict[int, int] = {}
+
+    def compose_node(self, parent: Any, index: Any) -> Any:
+        self._depth += 1
+        if self._depth > MAX_DEPTH:
+            raise YamlLimitError(f'nesting deeper than {MAX_DEPTH} levels')
+        try:
+            node = super().compose_node(parent, index)
+        finally:
+            self._depth -= 1
+        return node
+
+    def compose_document(self) -> Any:
+        node = super().compose_document()
+        if node is not None and self._expanded(node) > MAX_NODES:
+            raise YamlLimitError(f'aliases expand to more than {MAX_NODES} nodes')
+        return node
+
+    def _expanded(self, node: Any) -> int:
+        """Count the nodes with every alias expanded, each shared node once (memoised)."""
+        known = self._sizes.get(id(node))
+        if known is not None:
+            return known
+        size = 1
+        if isinstance(node, yaml.SequenceNode):
+            size += sum(self._expanded(child) for child in node.value)
+        elif isinstance(node, yaml.MappingNode):
+            size += sum(self._expanded(k) + self._expanded(v) for k, v in node.value)
+        self._sizes[id(node)] = size = min(size, MAX_NODES + 1)
+        return size
+
+    def construct_yaml_int(self, node: Any) -> Any:
+        digits = sum(c.isdigit() for c in str(node.value))
+        if digits > MAX_DIGITS:
+            raise YamlLimitError(f'line {node.start_mark.line + 1}: an integer of {digits} '
+                                 f'digits (at most {MAX_DIGITS})')
+        return super().construct_yaml_int(node)
+
+    def construct_mapping(self, node: Any, deep: bool = False) -> Any:
+        seen: set[Any] = set()
+        for key_node, _ in node.value:
+            key = self.construct_object(key_node, deep=deep)
+            if isinstance(key, (str, int, float, bool)) and key in seen:
+                raise YamlLimitError(f'line {key_node.start_mark.line + 1}: key {key!r} is '
+                                     'given twice')
+            seen.add(key)
+        return super().construct_mapping(node, deep=deep)
+
+
+_BoundedLoader.add_constructor('tag:yaml.org,2002:int', _BoundedLoader.construct_yaml_int)
+
+
+def parse_yaml(text: str) -> Any:
+    """
+    Parse one YAML document with the caps of this module.
+
+    Parameters
+    ----------
+    text : str
+        The document, [-]
+
+    Returns
+    -------
+    Any
+        The parsed document (mappings, lists, str, int, float, bool, None).
+
+    Raises
+    ------
+    YamlLimitError
+        If the text is not valid YAML or exceeds a cap; one line, without the document.
+
+    """
+    if len(text) > MAX_BYTES:
+        raise YamlLimitError(f'larger than {MAX_BYTES} bytes')
+    loader = _BoundedLoader(text)
+    try:
+        return loader.get_single_data()
+    except yaml.YAMLError as err:
+        problem = getattr(err, 'problem', None) or str(err).splitlines()[0]
+        mark = getattr(err, 'problem_mark', None)
+        where = f'line {mark.line + 1}: ' if mark is not None else ''
+        raise YamlLimitError(f'not valid YAML ({where}{problem})') from None
+    except RecursionError:
+        raise YamlLimitError(f'nesting deeper than {MAX_DEPTH} levels') from None
+    finally:
+        loader.dispose()
+
+
+def read_yaml(path: str | Path) -> Any:
+    """
+    Read and parse a YAML file, reading at most :data:`MAX_BYTES` + 1 bytes.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The file, [-]
+
+    Returns
+    -------
+    Any
+        The parsed document.
+
+    Raises
+    ------
+    OSError
+        If the file cannot be read.
+    YamlLimitError
+        If it is not UTF-8 YAML or exceeds a cap; one line, without the document.
+
+    """
+    with open(path, 'rb') as file:
+        data = file.read(MAX_BYTES + 1)
+    if len(data) > MAX_BYTES:
+        raise YamlLimitError(f'larger than {MAX_BYTES} bytes')
+    try:
+        text = data.decode('utf-8')
+    except UnicodeDecodeError as err:
+        raise YamlLimitError(f'not UTF-8 text (byte {err.start})') from None
+    return parse_yaml(text)
+
+
+__all__ = ['MAX_BYTES', 'MAX_DEPTH', 'MAX_DIGITS', 'MAX_NODES', 'YamlLimitError', 'parse_yaml',
+           'read_yaml']
