@@ -131,3 +131,22 @@ def test_calibrate_unknown_liquid_is_one_line(tmp_path, capsys):
     data = _csv(tmp_path / 'b.csv', generate(Plan(), Injection(), seed=0))
     code, _, err = _run(capsys, 'calibrate', data, '--liquid', 'glycol', '--out', tmp_path)
     assert code == 1 and "--liquid 'glycol'" in err
+
+
+def test_calibrate_replaces_its_own_output_but_no_user_file_and_no_input(leak_run, tmp_path,
+                                                                         capsys):
+    _, out, _ = leak_run
+    data = out.parent / 'bench.csv'
+    before = (out / 'calibration.json').read_bytes()
+    code, _, err = _run(capsys, 'calibrate', data, '--liquid', 'water', '--out', out)
+    assert code == 0 and err == ''
+    assert (out / 'calibration.json').read_bytes() == before  # deterministic rerun
+    mine = tmp_path / 'mine'
+    mine.mkdir()
+    (mine / 'report.md').write_text('my notes')
+    code, _, err = _run(capsys, 'calibrate', data, '--liquid', 'water', '--out', mine)
+    assert code == 1 and len(err.strip().splitlines()) == 1 and '--force' in err
+    assert sorted(p.name for p in mine.iterdir()) == ['report.md']
+    code, _, err = _run(capsys, 'calibrate', data, '--liquid', 'water', '--out', data)
+    assert code == 1 and 'is or contains the input' in err
+    assert data.read_bytes().startswith(b'time [s]')

@@ -6,7 +6,7 @@ import errno
 
 import pytest
 
-from satmotor_ros.cli._bench import load_data, output_dir, run_bench_command
+from satmotor_ros.cli._bench import load_data, run_bench_command
 from satmotor_ros.cli.main import build_parser, SUBCOMMANDS
 from satmotor_ros.identify import DataError
 from satmotor_ros.model import ModelError
@@ -46,12 +46,6 @@ def test_other_errors_propagate():
 def test_missing_data_is_a_data_error(tmp_path):
     with pytest.raises(DataError, match='no such file or directory'):
         load_data(str(tmp_path / 'missing.csv'))
-
-
-def test_output_dir_creates_parents(tmp_path):
-    target = output_dir(str(tmp_path / 'a' / 'b'))
-    assert target.is_dir()
-    assert output_dir(str(target)) == target
 
 
 def test_every_subcommand_is_registered_with_its_command():

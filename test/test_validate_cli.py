@@ -9,6 +9,7 @@ import sys
 import numpy as np
 import pytest
 
+from satmotor_ros.cli._output import MARKER
 from satmotor_ros.cli import validate as validate_cli
 from satmotor_ros.identify import calibrate, Errors, write_csv
 from satmotor_ros.identify.output import write_yaml
@@ -94,7 +95,7 @@ def test_report_and_plot_of_the_residual_against_each_channel(calibrated, capsys
     liquid, _, _, tmp, _, second = calibrated
     out = tmp / 'plots'
     assert _validate(capsys, second, out, liquid, tmp / 'coefficients.yaml')[0] == 0
-    assert sorted(os.listdir(out)) == ['report.md', 'residuals.png', 'validation.json']
+    assert sorted(os.listdir(out)) == [MARKER, 'report.md', 'residuals.png', 'validation.json']
     assert (out / 'residuals.png').read_bytes()[:8] == b'\x89PNG\r\n\x1a\n'
     report = (out / 'report.md').read_text()
     assert '![residuals](residuals.png)' in report

@@ -8,7 +8,7 @@ from collections.abc import Callable
 from pathlib import Path
 import sys
 
-from satmotor_ros.cli._common import fail
+from satmotor_ros.cli._common import CliError, fail
 from satmotor_ros.identify import BenchTable, DataError, IdentificationError, read_csv
 from satmotor_ros.identify.columns import load_mapping, read_log
 from satmotor_ros.identify.table import IMPOSSIBLE
@@ -26,7 +26,11 @@ def add_data_arguments(parser: argparse.ArgumentParser) -> None:
 
     """
     parser.add_argument('data', metavar='DATA', help='bench CSV or rosbag2 directory')
-    parser.add_argument('--out', required=True, metavar='DIR', help='output directory')
+    parser.add_argument('--out', required=True, metavar='DIR',
+                        help='output directory, written whole or not at all; an existing one '
+                             'is replaced only if this command wrote it')
+    parser.add_argument('--force', action='store_true',
+                        help='replace an existing --out that this command did not write')
     parser.add_argument('--mode', choices=('auto', 'points', 'series'), default='auto',
                         help='rows are steady points, a time series, or decide from the data '
                              '(default: auto)')
@@ -77,13 +81,6 @@ def load_data(data: str, columns: str = '') -> BenchTable:
     return table
 
 
-def output_dir(out: str) -> Path:
-    """Create ``--out`` (and its parents) if it does not exist, and return it."""
-    target = Path(out)
-    target.mkdir(parents=True, exist_ok=True)
-    return target
-
-
 def run_bench_command(out: str, run: Callable[[], str]) -> int:
     """
     Run a bench command and print its summary line, or fail with one line on stderr.
@@ -94,7 +91,8 @@ def run_bench_command(out: str, run: Callable[[], str]) -> int:
         Output directory as typed, named in an error writing it, [-]
     run : callable
         Loads the data, builds the model, writes the outputs and returns the line to print;
-        raises :class:`IdentificationError`, :class:`ModelError` or :class:`OSError`, [-]
+        raises :class:`CliError`, :class:`IdentificationError`, :class:`ModelError` or
+        :class:`OSError`, [-]
 
     Returns
     -------
@@ -104,7 +102,7 @@ def run_bench_command(out: str, run: Callable[[], str]) -> int:
     """
     try:
         line = run()
-    except (IdentificationError, ModelError) as err:
+    except (CliError, IdentificationError, ModelError) as err:
         return fail(err)
     except OSError as err:
         return fail(f'--out {out!r}: {err.strerror}')
@@ -112,4 +110,4 @@ def run_bench_command(out: str, run: Callable[[], str]) -> int:
     return 0
 
 
-__all__ = ['add_data_arguments', 'load_data', 'output_dir', 'run_bench_command']
+__all__ = ['add_data_arguments', 'load_data', 'run_bench_command']

@@ -4,9 +4,11 @@
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
-from satmotor_ros.cli._bench import add_data_arguments, load_data, output_dir, run_bench_command
+from satmotor_ros.cli._bench import add_data_arguments, load_data, run_bench_command
 from satmotor_ros.cli._common import add_motor_options
+from satmotor_ros.cli._output import check_target, output_dir, written_by
 from satmotor_ros.identify import calibrate, Options
 from satmotor_ros.identify.output import write_json, write_yaml
 from satmotor_ros.identify.pipeline import Mode
@@ -33,7 +35,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def command(data: str, out: str, mode: Mode, alpha: float, folds: int,
-            options: MotorOptions, columns: str = '') -> int:
+            options: MotorOptions, columns: str = '', force: bool = False) -> int:
     """
     Calibrate and write the three outputs.
 
@@ -48,6 +50,8 @@ def command(data: str, out: str, mode: Mode, alpha: float, folds: int,
         Cross-validation folds, [-]
     options : MotorOptions
         The motor and the coefficient set to calibrate (its own liquid), [-]
+    force : bool
+        Replace an existing ``--out`` that calibrate did not write, [-]
 
     Returns
     -------
@@ -57,19 +61,22 @@ def command(data: str, out: str, mode: Mode, alpha: float, folds: int,
 
     """
     return run_bench_command(out, lambda: _calibrate(data, out, mode, alpha, folds, options,
-                                                     columns))
+                                                     columns, force))
 
 
 def _calibrate(data: str, out: str, mode: Mode, alpha: float, folds: int,
-               options: MotorOptions, columns: str) -> str:
+               options: MotorOptions, columns: str, force: bool) -> str:
     """Calibrate, write the outputs and return the summary line."""
+    inputs = [name for name in (data, options.motor_file, columns) if name]
+    check_target('--out', Path(out), inputs, force, written_by('calibrate'), 'calibrate')
     spec = options.spec()
     table = load_data(data, columns)
     cal = calibrate(table, options.liquid, spec, Options(alpha=alpha, n_folds=folds, mode=mode))
-    target = output_dir(out)
-    summary = write_json(cal, target / 'calibration.json')
-    write_yaml(cal, target / 'coefficients.yaml')
-    write_report(cal, target, summary)
+    with output_dir('--out', out, 'calibrate', inputs, force) as tmp:
+        summary = write_json(cal, tmp / 'calibration.json')
+        write_yaml(cal, tmp / 'coefficients.yaml')
+        write_report(cal, tmp, summary)
+    target = Path(out)
     effect = summary['effect']
     before, after = summary['error_before']['rmse_lpm'], summary['error_after']['rmse_lpm']
     line = f'effect: {effect}'
@@ -82,3 +89,4 @@ def _calibrate(data: str, out: str, mode: Mode, alpha: float, folds: int,
     return (f'{line}; out-of-sample RMSE of Q_vl {before:.4g} -> {after:.4g} l/min over '
             f'{summary["n_points"]} points; wrote {target}/calibration.json, '
             'coefficients.yaml, report.md')
+

@@ -4,9 +4,11 @@
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
-from satmotor_ros.cli._bench import add_data_arguments, load_data, output_dir, run_bench_command
+from satmotor_ros.cli._bench import add_data_arguments, load_data, run_bench_command
 from satmotor_ros.cli._common import add_motor_options
+from satmotor_ros.cli._output import check_target, output_dir, written_by
 from satmotor_ros.identify.pipeline import Mode
 from satmotor_ros.identify.validate import validate
 from satmotor_ros.identify.validation_report import write_validation
@@ -25,7 +27,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_motor_options(parser, liquid_required=True)
 
 
-def command(data: str, out: str, mode: Mode, options: MotorOptions, columns: str = '') -> int:
+def command(data: str, out: str, mode: Mode, options: MotorOptions, columns: str = '',
+            force: bool = False) -> int:
     """
     Validate the model on the data and write the three outputs.
 
@@ -36,6 +39,8 @@ def command(data: str, out: str, mode: Mode, options: MotorOptions, columns: str
         them, [-]
     options : MotorOptions
         The model to validate, [-]
+    force : bool
+        Replace an existing ``--out`` that validate did not write, [-]
 
     Returns
     -------
@@ -43,15 +48,19 @@ def command(data: str, out: str, mode: Mode, options: MotorOptions, columns: str
         0 with the error on stdout; 1 with one line on stderr for unusable data or options.
 
     """
-    return run_bench_command(out, lambda: _validate(data, out, mode, options, columns))
+    return run_bench_command(out, lambda: _validate(data, out, mode, options, columns, force))
 
 
-def _validate(data: str, out: str, mode: Mode, options: MotorOptions, columns: str) -> str:
+def _validate(data: str, out: str, mode: Mode, options: MotorOptions, columns: str,
+              force: bool) -> str:
     """Validate, write the outputs and return the summary line."""
+    inputs = [name for name in (data, options.motor_file, columns) if name]
+    check_target('--out', Path(out), inputs, force, written_by('validate'), 'validate')
     model = options.build_model()
     result = validate(load_data(data, columns), model, options.liquid, mode)
-    target = output_dir(out)
-    summary = write_validation(result, target)
+    with output_dir('--out', out, 'validate', inputs, force) as tmp:
+        summary = write_validation(result, tmp)
+    target = Path(out)
     error = summary['error']
     return (f'{model.name}, set {options.liquid}, effects: {result.describe_effects()}; '
             f'RMSE of Q_vl {error["rmse_lpm"]:.4g} l/min, mean {error["mean_abs_pct"]:.3g} %, '

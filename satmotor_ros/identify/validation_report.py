@@ -1,10 +1,9 @@
 # SPDX-License-Identifier: Apache-2.0
-"""Write ``validation.json``, ``report.md`` and ``residuals.png``: all of them or none."""
+"""Write ``validation.json``, ``report.md`` and ``residuals.png``."""
 
 from __future__ import annotations
 
 import json
-import os
 from pathlib import Path
 from typing import Any
 
@@ -46,7 +45,10 @@ def _report(val: Validation, summary: dict[str, Any]) -> str:
 
 def write_validation(val: Validation, out: Path) -> dict[str, Any]:
     """
-    Write :data:`FILES` into `out`: each first under a temporary name, then all into place.
+    Write :data:`FILES` into `out`.
+
+    The command writes into a temporary directory that becomes ``--out`` only when
+    complete (:mod:`satmotor_ros.cli._output`), so a failure leaves no partial result.
 
     Parameters
     ----------
@@ -60,25 +62,11 @@ def write_validation(val: Validation, out: Path) -> dict[str, Any]:
     dict
         The validation.json object.
 
-    Raises
-    ------
-    OSError
-        If a file cannot be written; no output file is then left behind.
-
     """
     summary = val.summary()
-    temporary = {name: out / f'.{name}.partial' for name in FILES}
-    try:
-        temporary['validation.json'].write_text(json.dumps(summary, indent=2) + '\n',
-                                                encoding='utf-8')
-        temporary['report.md'].write_text(_report(val, summary), encoding='utf-8')
-        _plot_residuals(val, temporary['residuals.png'])
-        for name, path in temporary.items():
-            os.replace(path, out / name)
-    except BaseException:
-        for path in temporary.values():
-            path.unlink(missing_ok=True)
-        raise
+    (out / 'validation.json').write_text(json.dumps(summary, indent=2) + '\n', encoding='utf-8')
+    (out / 'report.md').write_text(_report(val, summary), encoding='utf-8')
+    _plot_residuals(val, out / 'residuals.png')
     return summary
 
 

@@ -1,0 +1,207 @@
+# SPDX-License-Identifier: Apache-2.0
+"""
+Outputs that replace nothing they were not made for, and appear whole or not at all.
+
+Every file and directory a subcommand writes goes through :func:`output_file` or
+:func:`output_dir`. The output is first written under a hidden temporary name
+beside its target and renamed into place only when complete, so an interrupted
+run (SIGINT, a crash, a full disk) leaves the previous result intact and nothing
+that looks complete. An existing target is replaced only when it is an earlier
+output of the same subcommand (a directory with a :data:`MARKER` naming it, a
+file the subcommand's own check recognises) or with ``--force``; an output is
+never one of the command's inputs.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
+import json
+import os
+from pathlib import Path
+import shutil
+
+from satmotor_ros.cli._common import CliError
+
+MARKER = '.satmotor-output.json'
+"""File in every output directory naming the subcommand that wrote it."""
+
+
+def _temporary(target: Path) -> Path:
+    return target.with_name(f'.{target.name}.partial-{os.getpid()}')
+
+
+def check_target(option: str, target: Path, inputs: Sequence[str | Path], force: bool,
+                 ours: Callable[[Path], bool], command: str) -> None:
+    """
+    Refuse a target that is an input, or that exists and is not an earlier output of ours.
+
+    Parameters
+    ----------
+    option : str
+        The option that named the target, for the message (``'--out'``), [-]
+    target : pathlib.Path
+        File or directory to write, [-]
+    inputs : sequence of path
+        What the command reads, [-]
+    force : bool
+        Replace an existing target whatever it is (never an input), [-]
+    ours : callable
+        Whether an existing target is an earlier output of this subcommand, [-]
+    command : str
+        The subcommand, for the message, [-]
+
+    Raises
+    ------
+    CliError
+        One line naming the option, the path and what to do.
+
+    """
+    resolved = target.resolve()
+    for item in inputs:
+        source = Path(item).resolve()
+        if resolved == source or source.is_relative_to(resolved) \
+                or resolved.is_relative_to(source):
+            raise CliError(f'{option} {str(target)!r}: is or contains the input {str(item)!r}; '
+                           'choose another path')
+    if (target.exists() or target.is_symlink()) and not force and not ours(target):
+        raise CliError(f'{option} {str(target)!r} exists and is not an earlier output of '
+                       f'satmotor {command}; choose a new path or pass --force to replace it')
+
+
+def written_by(command: str) -> Callable[[Path], bool]:
+    """Return the check that a directory holds an earlier output of `command` (its marker)."""
+    def ours(path: Path) -> bool:
+        try:
+            marker = json.loads((path / MARKER).read_text(encoding='utf-8'))
+        except (OSError, ValueError):
+            return False
+        return isinstance(marker, dict) and marker.get('command') == command
+    return ours
+
+
+def _replace(temporary: Path, target: Path) -> None:
+    """Move `temporary` onto `target`; an old target is removed only once the new one is in."""
+    if target.is_dir() and not target.is_symlink():
+        old = target.with_name(f'.{target.name}.old-{os.getpid()}')
+        os.replace(target, old)
+        os.replace(temporary, target)
+        shutil.rmtree(old, ignore_errors=True)
+    else:
+        os.replace(temporary, target)
+
+
+@contextmanager
+def output_dir(option: str, out: str | Path, command: str, inputs: Sequence[str | Path] = (),
+               force: bool = False) -> Iterator[Path]:
+    """
+    Yield a temporary directory that becomes `out`, whole, when the block completes.
+
+    Parameters
+    ----------
+    option : str
+        The option that named it (``'--out'``), [-]
+    out : str or pathlib.Path
+        The output directory, [-]
+    command : str
+        The subcommand writing it, recorded in :data:`MARKER`, [-]
+    inputs : sequence of path
+        What the command reads, never replaced, [-]
+    force : bool
+        Replace an existing directory that is not an earlier output of `command`, [-]
+
+    Yields
+    ------
+    pathlib.Path
+        Where to write; it is renamed to `out` when the block ends without an exception.
+
+    Raises
+    ------
+    CliError
+        If `out` is an input or exists and may not be replaced.
+
+    """
+    target = Path(out)
+    check_target(option, target, inputs, force, written_by(command), command)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    temporary = _temporary(target)
+    shutil.rmtree(temporary, ignore_errors=True)
+    temporary.mkdir()
+    try:
+        yield temporary
+        (temporary / MARKER).write_text(json.dumps({'command': command}) + '\n',
+                                        encoding='utf-8')
+        _replace(temporary, target)
+    except BaseException:
+        shutil.rmtree(temporary, ignore_errors=True)
+        raise
+
+
+@contextmanager
+def output_file(option: str, out: str | Path, command: str, ours: Callable[[Path], bool],
+                inputs: Sequence[str | Path] = (), force: bool = False) -> Iterator[Path]:
+    """
+    Yield a temporary file name that becomes `out` when the block completes.
+
+    Parameters
+    ----------
+    option : str
+        The option that named it (``'--out'``), [-]
+    out : str or pathlib.Path
+        The output file (or directory written as one piece, e.g. a bag), [-]
+    command : str
+        The subcommand writing it, for the message, [-]
+    ours : callable
+        Whether an existing `out` is an earlier output of `command`, [-]
+    inputs : sequence of path
+        What the command reads, never replaced, [-]
+    force : bool
+        Replace an existing `out` that is not an earlier output of `command`, [-]
+
+    Yields
+    ------
+    pathlib.Path
+        Where to write; renamed to `out` when the block ends without an exception.
+
+    Raises
+    ------
+    CliError
+        If `out` is an input or exists and may not be replaced.
+
+    """
+    target = Path(out)
+    check_target(option, target, inputs, force, ours, command)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    temporary = _temporary(target)
+    try:
+        yield temporary
+        _replace(temporary, target)
+    except BaseException:
+        if temporary.is_dir():
+            shutil.rmtree(temporary, ignore_errors=True)
+        else:
+            temporary.unlink(missing_ok=True)
+        raise
+
+
+def png_by(command: str) -> Callable[[Path], bool]:
+    """Return the check that a PNG was written by `command` (its ``Software`` text chunk)."""
+    needle = f'Software\0satmotor {command}'.encode('latin-1')
+
+    def ours(path: Path) -> bool:
+        try:
+            with path.open('rb') as file:
+                head = file.read(4096)
+        except OSError:
+            return False
+        return head.startswith(b'\x89PNG') and needle in head
+    return ours
+
+
+def png_metadata(command: str) -> dict[str, str]:
+    """Return the PNG metadata that marks a figure as written by `command`."""
+    return {'Software': f'satmotor {command}'}
+
+
+__all__ = ['MARKER', 'check_target', 'output_dir', 'output_file', 'png_by', 'png_metadata',
+           'written_by']
