@@ -96,3 +96,9 @@ def test_file_output_is_renamed_into_place_and_checked(tmp_path):
         raise RuntimeError
     assert ours(target)
     assert sorted(p.name for p in tmp_path.iterdir()) == ['speed.png']
+
+
+def test_an_empty_directory_is_used(tmp_path):
+    with output_dir('--out', tmp_path, 'characteristics') as tmp:
+        _write(tmp, 'x')
+    assert (tmp_path / 'report.md').read_text() == 'x'

@@ -125,7 +125,8 @@ def test_replay_topic_map_renames_bag_topics(tmp_path, capsys):
     (['--mode', 'rate', '--rate', '0'], 'rate = 0.0 Hz'),
     (['--liquid', 'mercury'], "--liquid 'mercury'"),
     (['--topic-map', 'a:b'], "--topic-map 'a:b': use OLD:=NEW"),
-    (['--out-bag', '{tmp}'], 'already exists'),
+    (['--out-bag', '{tmp}'], 'is or contains the input'),
+    (['--out', '{tmp}/bag/metadata.yaml'], 'is or contains the input'),
 ])
 def test_replay_bad_options_exit_1_with_one_line(tmp_path, capsys, args, text):
     _bag(tmp_path / 'bag')
@@ -155,3 +156,23 @@ def test_replay_of_every_foreign_bag_fails_cleanly_with_one_line(name, capsys):
     assert 'Traceback' not in captured.err
     assert ('no messages on flow_command, inlet_pressure, outlet_pressure' in captured.err
             or 'metadata.yaml and storage disagree' in captured.err)
+
+
+def test_replay_replaces_only_its_own_outputs(tmp_path, capsys):
+    _bag(tmp_path / 'bag')
+    csv, png, bag_out = tmp_path / 'run.csv', tmp_path / 'run_speed.png', tmp_path / 'out_bag'
+    argv = ['replay', str(tmp_path / 'bag'), '--out', str(csv), '--out-bag', str(bag_out)]
+    assert main(argv) == 0
+    first = csv.read_bytes(), png.read_bytes()
+    assert main(argv) == 0  # its own earlier outputs are replaced
+    assert csv.read_bytes() == first[0] and png.read_bytes()[:8] == b'\x89PNG\r\n\x1a\n'
+    capsys.readouterr()
+    csv.write_text('my own table\n')
+    assert main(argv) == 1
+    err = capsys.readouterr().err
+    assert err.count('\n') == 1 and "--out '" in err and '--force' in err
+    assert csv.read_text() == 'my own table\n'
+    assert main([*argv, '--force']) == 0
+    assert csv.read_bytes() == first[0]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ['bag', 'out_bag', 'run.csv',
+                                                          'run_speed.png']

@@ -8,8 +8,8 @@ beside its target and renamed into place only when complete, so an interrupted
 run (SIGINT, a crash, a full disk) leaves the previous result intact and nothing
 that looks complete. An existing target is replaced only when it is an earlier
 output of the same subcommand (a directory with a :data:`MARKER` naming it, a
-file the subcommand's own check recognises) or with ``--force``; an output is
-never one of the command's inputs.
+file the subcommand's own check recognises), an empty directory, or with
+``--force``; an output is never one of the command's inputs.
 """
 
 from __future__ import annotations
@@ -64,9 +64,14 @@ def check_target(option: str, target: Path, inputs: Sequence[str | Path], force:
                 or resolved.is_relative_to(source):
             raise CliError(f'{option} {str(target)!r}: is or contains the input {str(item)!r}; '
                            'choose another path')
-    if (target.exists() or target.is_symlink()) and not force and not ours(target):
+    if (target.exists() or target.is_symlink()) and not force and not ours(target) \
+            and not _empty_dir(target):
         raise CliError(f'{option} {str(target)!r} exists and is not an earlier output of '
                        f'satmotor {command}; choose a new path or pass --force to replace it')
+
+
+def _empty_dir(path: Path) -> bool:
+    return path.is_dir() and not path.is_symlink() and next(path.iterdir(), None) is None
 
 
 def written_by(command: str) -> Callable[[Path], bool]:

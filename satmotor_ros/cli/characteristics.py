@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from satmotor_ros.cli._common import add_motor_options, CliError, fail
+from satmotor_ros.cli._output import output_dir
 from satmotor_ros.interface import MotorOptions
 from satmotor_ros.model import ModelError, MotorModel
 from satmotor_ros.model.families import DEFAULT_FAMILY
@@ -46,12 +47,16 @@ DESCRIPTION = ("Characteristics of the paper's Figs. 8-16 kind over the chamber 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Add the options of ``satmotor characteristics``."""
-    parser.add_argument('--out', required=True, metavar='DIR', help='output directory')
+    parser.add_argument('--out', required=True, metavar='DIR',
+                        help='output directory, written whole; an existing one is replaced '
+                             'only if this command wrote it')
+    parser.add_argument('--force', action='store_true',
+                        help='replace an existing --out that this command did not write')
     parser.add_argument('--points', type=int, default=60, help='points per curve (default 60)')
     add_motor_options(parser)
 
 
-def command(out: str, points: int, options: MotorOptions) -> int:
+def command(out: str, points: int, options: MotorOptions, force: bool = False) -> int:
     """
     Write the characteristics of one liquid, plus water against oil.
 
@@ -63,6 +68,8 @@ def command(out: str, points: int, options: MotorOptions) -> int:
         Points per curve, [-]
     options : MotorOptions
         Motor, liquid and Delta q law, [-]
+    force : bool
+        Replace an existing ``--out`` that characteristics did not write, [-]
 
     Returns
     -------
@@ -84,17 +91,18 @@ def command(out: str, points: int, options: MotorOptions) -> int:
                   for name in ('oil', 'water')} if _has_both(options) else None
         if others is not None:
             figures.append(water_against_oil(others['water'], others['oil'], dp_i))
-        directory = Path(out)
-        directory.mkdir(parents=True, exist_ok=True)
+        label = f'{model.name}, {model.liquid.name}, {model.displacement_law}'
+        inputs = [options.motor_file] if options.motor_file else []
+        with output_dir('--out', out, 'characteristics', inputs, force) as directory:
+            for figure in figures:
+                _write_csv(directory / f'{figure.name}.csv', figure, dp_i)
+                _plot(directory / f'{figure.name}.png', figure, dp_i, label)
     except (CliError, ModelError) as err:
         return fail(err)
     except OSError as err:
         return fail(CliError(f'--out {out!r}: {err.strerror}'))
-    label = f'{model.name}, {model.liquid.name}, {model.displacement_law}'
     for figure in figures:
-        _write_csv(directory / f'{figure.name}.csv', figure, dp_i)
-        _plot(directory / f'{figure.name}.png', figure, dp_i, label)
-        print(directory / f'{figure.name}.png')
+        print(Path(out) / f'{figure.name}.png')
     return 0
 
 

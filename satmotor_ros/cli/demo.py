@@ -19,6 +19,7 @@ import time
 from typing import Any
 
 from satmotor_ros.cli._common import CliError, fail
+from satmotor_ros.cli._output import output_dir
 from satmotor_ros.plant.config import parameter_specs, params_from_flat
 from satmotor_ros.plant.scenario import default_cycle
 
@@ -47,7 +48,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              'of water [K]; Walther B of oil: 3.68), clearance_wear=1e-9, '
                              'flow_sensor_gain=0.03 (repeatable)')
     parser.add_argument('--out', default='out/demo', metavar='DIR',
-                        help='output directory (default out/demo)')
+                        help='output directory (default out/demo), written whole; an existing '
+                             'one is replaced only if the demo wrote it')
+    parser.add_argument('--force', action='store_true',
+                        help='replace an existing --out that the demo did not write')
     parser.add_argument('--quiet', action='store_true', help='no progress bar')
 
 
@@ -93,7 +97,8 @@ def parse_effects(items: list[str]) -> dict[str, Any]:
     return {f'effects.{k}': v for k, v in values.items()}
 
 
-def command(liquid: str, duration: str, effect: list[str], out: str, quiet: bool) -> int:
+def command(liquid: str, duration: str, effect: list[str], out: str, quiet: bool,
+            force: bool = False) -> int:
     """
     Run the demo.
 
@@ -109,6 +114,8 @@ def command(liquid: str, duration: str, effect: list[str], out: str, quiet: bool
         Output directory, [-]
     quiet : bool
         Suppress the progress bar, [-]
+    force : bool
+        Replace an existing ``--out`` that the demo did not write, [-]
 
     Returns
     -------
@@ -124,28 +131,25 @@ def command(liquid: str, duration: str, effect: list[str], out: str, quiet: bool
         if not 2.0 <= seconds <= 3600.0:
             raise CliError(f'--duration {duration!r}: must be within 2..3600 s')
         effects = parse_effects(effect)
-        out_dir = Path(out)
-        bags = out_dir / 'bags'
         liquids = LIQUIDS if liquid == 'both' else (liquid,)
-        existing = [bags / f'{q}_{ff}' for q in liquids for ff in FEEDFORWARDS
-                    if (bags / f'{q}_{ff}').exists()]
-        if existing:
-            raise CliError(f'--out {out!r}: {existing[0]} exists; choose a new directory')
-        out_dir.mkdir(parents=True, exist_ok=True)
+        cycle = default_cycle().scaled(seconds)
+        os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
+        from satmotor_ros.cli import _demo_report as report
+        from satmotor_ros.cli._demo_ros import run_cycle
+        runs = []
+        steps = len(liquids) * len(FEEDFORWARDS) * cycle.duration
+        progress = None if quiet else Progress(steps)
+        with output_dir('--out', out, 'demo', (), force) as out_dir:
+            for q in liquids:
+                for ff in FEEDFORWARDS:
+                    runs.append(run_cycle(q, ff, cycle, effects, out_dir / 'bags' / f'{q}_{ff}',
+                                          progress))
+            if progress is not None:
+                progress.done()
+            report.write_report(out_dir, runs, cycle, effects)
     except (CliError, OSError) as err:
         return fail(err)
-    cycle = default_cycle().scaled(seconds)
-    os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
-    from satmotor_ros.cli import _demo_report as report
-    from satmotor_ros.cli._demo_ros import run_cycle
-    runs = []
-    progress = None if quiet else Progress(len(liquids) * len(FEEDFORWARDS) * cycle.duration)
-    for q in liquids:
-        for ff in FEEDFORWARDS:
-            runs.append(run_cycle(q, ff, cycle, effects, bags / f'{q}_{ff}', progress))
-    if progress is not None:
-        progress.done()
-    path = report.write_report(out_dir, runs, cycle, effects)
+    path, bags = Path(out) / 'report.md', Path(out) / 'bags'
     wall = sum(r.wall for r in runs)
     sim = sum(r.sim for r in runs)
     print(f'satmotor demo: {len(runs)} runs, {sim:.0f} s simulated in {wall:.1f} s '

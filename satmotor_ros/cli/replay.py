@@ -11,6 +11,7 @@ holds the recorded and the predicted topics side by side.
 from __future__ import annotations
 
 import argparse
+import json
 from pathlib import Path
 import time
 
@@ -21,6 +22,8 @@ from satmotor_ros.bags import (BagError, describe_topics, encode_many, FLOAT64, 
                                read_series, Series, write_bag)
 from satmotor_ros.cli import _fastcsv as fastcsv
 from satmotor_ros.cli._common import add_motor_options, CliError, fail
+from satmotor_ros.cli._output import (check_target, MARKER, output_file, png_by, png_metadata,
+                                      written_by)
 from satmotor_ros.interface import (CHANNELS, JOINT_NAME, LOSS_COMPONENTS, LOSSES_PREFIX,
                                     MotorOptions, PREDICTED_JOINT_STATE, SPEED_RESIDUAL)
 from satmotor_ros.model import describe_status, ModelError, MotorModel
@@ -41,6 +44,9 @@ _OUTPUT_COLUMNS = (('dp', 'dp [MPa]', MPA, 9), ('dp_i', 'dp_i [MPa]', MPA, 9),
                    ('residual', 'residual [rpm]', RPM, 9))
 
 
+COMMAND = 'replay'
+_CSV_START = b'log_time [ns],time [s]'
+
 HELP = "run the motor_model node's prediction over a recorded bag"
 DESCRIPTION = ("Replay a rosbag2 bag (sqlite3 or MCAP) through the motor_model node's "
                'prediction, as fast as it can: the inputs are combined in log-time order by the '
@@ -59,6 +65,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help='plot of predicted and measured speed (default: beside --out, '
                              'else <bag>_speed.png here; only with a measured speed)')
     parser.add_argument('--no-plot', action='store_true', help='do not plot')
+    parser.add_argument('--force', action='store_true',
+                        help='replace existing outputs that replay did not write')
     parser.add_argument('--topic-map', action='append', default=[], metavar='OLD:=NEW',
                         help='match bag topic OLD as NEW (repeatable), e.g. '
                              '/rig/p1:=inlet_pressure')
@@ -77,7 +85,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def command(bag: str, out: str | None, out_bag: str | None, plot: str | None, no_plot: bool,
             topic_map: list[str], timeout: float, mode: str, rate: float, joint: str,
-            options: MotorOptions) -> int:
+            options: MotorOptions, force: bool = False) -> int:
     """
     Replay a bag through the prediction and report.
 
@@ -105,6 +113,8 @@ def command(bag: str, out: str | None, out_bag: str | None, plot: str | None, no
         Joint of the measured speed, [-]
     options : MotorOptions
         Motor, liquid and Delta q law, as the node's parameters, [-]
+    force : bool
+        Replace existing outputs that replay did not write (never the bag), [-]
 
     Returns
     -------
@@ -117,7 +127,13 @@ def command(bag: str, out: str | None, out_bag: str | None, plot: str | None, no
         rule = Rule(timeout=timeout, mode=mode, rate=rate)
     except ValueError as err:
         return fail(CliError(f'--{str(err).split(" ", 1)[0]} {err}'))
+    inputs = [bag, options.motor_file] if options.motor_file else [bag]
+    targets = {'--out': (out, _csv_by_replay), '--out-bag': (out_bag, written_by(COMMAND)),
+               '--plot': (plot if not no_plot else None, png_by(COMMAND))}
     try:
+        for option, (target, ours) in targets.items():
+            if target is not None:
+                check_target(option, Path(target), inputs, force, ours, COMMAND)
         model = options.build_model()
         renames = parse_topic_map(topic_map)
         series = read_series(bag, [TOPICS[name] for name in INPUTS], renames, joint,
@@ -128,18 +144,27 @@ def command(bag: str, out: str | None, out_bag: str | None, plot: str | None, no
             raise CliError(f'{bag}: none of {len(batch)} predictions could be made; the '
                            f'first: {batch.message(0)}')
         if out_bag is not None:
-            _write_bag(Path(out_bag), series, batch, joint)
+            with output_file('--out-bag', out_bag, COMMAND, written_by(COMMAND), inputs,
+                             force) as tmp:
+                _write_bag(tmp, series, batch, joint)
+                (tmp / MARKER).write_text(json.dumps({'command': COMMAND}) + '\n',
+                                          encoding='utf-8')
     except (BagError, CliError, ModelError) as err:
         return fail(err)
     except OSError as err:
         return fail(CliError(f'{err.filename}: {err.strerror}'))
     try:
         if out is not None:
-            write_csv(Path(out), batch)
+            with output_file('--out', out, COMMAND, _csv_by_replay, inputs, force) as tmp:
+                write_csv(tmp, batch)
         picture = _plot_path(bag, out, plot, no_plot, series)
         if picture is not None:
-            plot_speed(picture, batch, f'{Path(bag).name}: {model.liquid.name}, '
+            with output_file('--plot', picture, COMMAND, png_by(COMMAND), inputs,
+                             force) as tmp:
+                plot_speed(tmp, batch, f'{Path(bag).name}: {model.liquid.name}, '
                                        f'{model.displacement_law}')
+    except CliError as err:
+        return fail(err)
     except OSError as err:
         return fail(CliError(f'{err.filename}: {err.strerror}'))
     print(summary(bag, batch, time.perf_counter() - started))
@@ -282,6 +307,15 @@ def _status_names(batch: PredictionBatch) -> list[str]:
     return [names[i] for i in inverse.reshape(-1).tolist()]
 
 
+def _csv_by_replay(path: Path) -> bool:
+    """Whether `path` is a CSV that replay wrote (its header)."""
+    try:
+        with path.open('rb') as file:
+            return file.read(len(_CSV_START)) == _CSV_START
+    except OSError:
+        return False
+
+
 def write_csv(path: Path, batch: PredictionBatch) -> None:
     """
     Write one row per driving message, hydraulic units in the header.
@@ -303,7 +337,7 @@ def write_csv(path: Path, batch: PredictionBatch) -> None:
     """
     snaps = batch.snapshots
     t_ns = snaps.stamp_ns
-    header = ['log_time [ns]', 'time [s]']
+    header = _CSV_START.decode('ascii').split(',')
     fields = [fastcsv.fixed_point(t_ns, 0),
               fastcsv.fixed_point((t_ns - (t_ns[0] if len(t_ns) else 0)) / 1e9, 9)]
     for name, title, unit, decimals in _INPUT_COLUMNS:
@@ -408,5 +442,5 @@ def plot_speed(path: Path, batch: PredictionBatch, label: str, max_points: int =
                  label='no prediction (ERROR)')
         top.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(path)
+    fig.savefig(path, format='png', metadata=png_metadata(COMMAND))
     pyplot.close(fig)
