@@ -5,39 +5,20 @@ YAML files read with bounded work: size, nesting, alias expansion, integer digit
 Every YAML file the package reads (motor files, column mappings, a bag's
 ``metadata.yaml``) goes through :func:`read_yaml`. A small hostile file must
 not take unbounded memory or time, nor end in a traceback: a file larger than
-:data:`MAX_BYTES` (``/dev/zero`` included), nesting deeper than
-:data:`MAX_DEPTH`, aliases that would expand to more than :data:`MAX_NODES`
-nodes (a "billion laughs" bomb), an integer of more than :data:`MAX_DIGITS`
+``YAML_MAX_BYTES`` (``/dev/zero`` included), nesting deeper than
+``YAML_MAX_DEPTH``, aliases that would expand to more than ``YAML_MAX_NODES``
+nodes (a "billion laughs" bomb), an integer of more than ``YAML_MAX_DIGITS``
 digits and a key given twice are each refused with one line. The document is
-never expanded into an error message. The caps are overridable through the
-environment variables named beside them.
+never expanded into an error message. The caps live in :mod:`satmotor_ros.limits`.
 """
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 from typing import Any
 
+from satmotor_ros.limits import YAML_MAX_BYTES, YAML_MAX_DEPTH, YAML_MAX_DIGITS, YAML_MAX_NODES
 import yaml
-
-
-def _cap(name: str, default: int) -> int:
-    text = os.environ.get(name, '')
-    return int(text) if text.isdigit() and int(text) > 0 else default
-
-
-MAX_BYTES = _cap('SATMOTOR_YAML_MAX_BYTES', 1 << 20)
-"""Largest YAML file read, [byte] (``SATMOTOR_YAML_MAX_BYTES``)."""
-
-MAX_DEPTH = _cap('SATMOTOR_YAML_MAX_DEPTH', 64)
-"""Deepest nesting of mappings and sequences, [-] (``SATMOTOR_YAML_MAX_DEPTH``)."""
-
-MAX_NODES = _cap('SATMOTOR_YAML_MAX_NODES', 100_000)
-"""Most nodes of the document with every alias expanded, [-] (``SATMOTOR_YAML_MAX_NODES``)."""
-
-MAX_DIGITS = 40
-"""Most digits of an integer; no physical quantity needs more, [-]."""
 
 
 class YamlLimitError(ValueError):
@@ -54,8 +35,8 @@ class _BoundedLoader(yaml.SafeLoader):
 
     def compose_node(self, parent: Any, index: Any) -> Any:
         self._depth += 1
-        if self._depth > MAX_DEPTH:
-            raise YamlLimitError(f'nesting deeper than {MAX_DEPTH} levels')
+        if self._depth > YAML_MAX_DEPTH:
+            raise YamlLimitError(f'nesting deeper than {YAML_MAX_DEPTH} levels')
         try:
             node = super().compose_node(parent, index)
         finally:
@@ -64,8 +45,8 @@ class _BoundedLoader(yaml.SafeLoader):
 
     def compose_document(self) -> Any:
         node = super().compose_document()
-        if node is not None and self._expanded(node) > MAX_NODES:
-            raise YamlLimitError(f'aliases expand to more than {MAX_NODES} nodes')
+        if node is not None and self._expanded(node) > YAML_MAX_NODES:
+            raise YamlLimitError(f'aliases expand to more than {YAML_MAX_NODES} nodes')
         return node
 
     def _expanded(self, node: Any) -> int:
@@ -78,14 +59,14 @@ class _BoundedLoader(yaml.SafeLoader):
             size += sum(self._expanded(child) for child in node.value)
         elif isinstance(node, yaml.MappingNode):
             size += sum(self._expanded(k) + self._expanded(v) for k, v in node.value)
-        self._sizes[id(node)] = size = min(size, MAX_NODES + 1)
+        self._sizes[id(node)] = size = min(size, YAML_MAX_NODES + 1)
         return size
 
     def construct_yaml_int(self, node: Any) -> Any:
         digits = sum(c.isdigit() for c in str(node.value))
-        if digits > MAX_DIGITS:
+        if digits > YAML_MAX_DIGITS:
             raise YamlLimitError(f'line {node.start_mark.line + 1}: an integer of {digits} '
-                                 f'digits (at most {MAX_DIGITS})')
+                                 f'digits (at most {YAML_MAX_DIGITS})')
         return super().construct_yaml_int(node)
 
     def construct_mapping(self, node: Any, deep: bool = False) -> Any:
@@ -122,8 +103,8 @@ def parse_yaml(text: str) -> Any:
         If the text is not valid YAML or exceeds a cap; one line, without the document.
 
     """
-    if len(text) > MAX_BYTES:
-        raise YamlLimitError(f'larger than {MAX_BYTES} bytes')
+    if len(text) > YAML_MAX_BYTES:
+        raise YamlLimitError(f'larger than {YAML_MAX_BYTES} bytes')
     loader = _BoundedLoader(text)
     try:
         return loader.get_single_data()
@@ -133,14 +114,14 @@ def parse_yaml(text: str) -> Any:
         where = f'line {mark.line + 1}: ' if mark is not None else ''
         raise YamlLimitError(f'not valid YAML ({where}{problem})') from None
     except RecursionError:
-        raise YamlLimitError(f'nesting deeper than {MAX_DEPTH} levels') from None
+        raise YamlLimitError(f'nesting deeper than {YAML_MAX_DEPTH} levels') from None
     finally:
         loader.dispose()
 
 
 def read_yaml(path: str | Path) -> Any:
     """
-    Read and parse a YAML file, reading at most :data:`MAX_BYTES` + 1 bytes.
+    Read and parse a YAML file, reading at most ``YAML_MAX_BYTES`` + 1 bytes.
 
     Parameters
     ----------
@@ -161,9 +142,9 @@ def read_yaml(path: str | Path) -> Any:
 
     """
     with open(path, 'rb') as file:
-        data = file.read(MAX_BYTES + 1)
-    if len(data) > MAX_BYTES:
-        raise YamlLimitError(f'larger than {MAX_BYTES} bytes')
+        data = file.read(YAML_MAX_BYTES + 1)
+    if len(data) > YAML_MAX_BYTES:
+        raise YamlLimitError(f'larger than {YAML_MAX_BYTES} bytes')
     try:
         text = data.decode('utf-8')
     except UnicodeDecodeError as err:
@@ -171,5 +152,4 @@ def read_yaml(path: str | Path) -> Any:
     return parse_yaml(text)
 
 
-__all__ = ['MAX_BYTES', 'MAX_DEPTH', 'MAX_DIGITS', 'MAX_NODES', 'YamlLimitError', 'parse_yaml',
-           'read_yaml']
+__all__ = ['YamlLimitError', 'parse_yaml', 'read_yaml']

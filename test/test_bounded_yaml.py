@@ -7,8 +7,9 @@ import time
 import pytest
 
 from satmotor_ros.bags import BagError, open_bag
-from satmotor_ros.bounded_yaml import MAX_BYTES, parse_yaml, read_yaml, YamlLimitError
+from satmotor_ros.bounded_yaml import parse_yaml, read_yaml, YamlLimitError
 from satmotor_ros.interface import MotorOptions
+from satmotor_ros.limits import YAML_MAX_BYTES
 from satmotor_ros.model import ConfigError, load_motor
 from satmotor_ros.model.config import default_config_path
 from satmotor_ros.plant.errors import PlantError
@@ -50,7 +51,7 @@ def test_aliases_that_stay_small_are_read():
 
 def test_endless_file_is_cut_at_the_cap():
     before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-    with pytest.raises(YamlLimitError, match=f'larger than {MAX_BYTES} bytes'):
+    with pytest.raises(YamlLimitError, match=f'larger than {YAML_MAX_BYTES} bytes'):
         read_yaml('/dev/zero')
     grown_kib = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before
     assert grown_kib < 64 * 1024

@@ -9,8 +9,8 @@ import sys
 import numpy as np
 import pytest
 
-from satmotor_ros.cli._output import MARKER
 from satmotor_ros.cli import validate as validate_cli
+from satmotor_ros.cli._output import MARKER
 from satmotor_ros.identify import calibrate, Errors, write_csv
 from satmotor_ros.identify.output import write_yaml
 from satmotor_ros.identify.synthetic import generate, Injection, Plan

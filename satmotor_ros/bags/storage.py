@@ -22,7 +22,6 @@ from dataclasses import dataclass, field
 import gc
 from pathlib import Path
 import re
-import shutil
 import sqlite3
 import struct
 import sys
@@ -35,6 +34,7 @@ import numpy.typing as npt
 from satmotor_ros.bags.decode import pack_payloads
 from satmotor_ros.bags.errors import BagError
 from satmotor_ros.bounded_yaml import read_yaml, YamlLimitError
+from satmotor_ros.limits import bag_budget
 
 if TYPE_CHECKING:
     from rosbags.interfaces import ConnectionExtRosbag2
@@ -113,6 +113,7 @@ class Bag:
     files: list[Path]
     metadata: dict[str, TopicInfo] | None  # from metadata.yaml; None when absent
     _tmp: tempfile.TemporaryDirectory[str] | None = field(default=None, repr=False)
+    _budget: _Budget | None = field(default=None, repr=False)
 
     def topics(self) -> dict[str, TopicInfo]:
         """
@@ -157,8 +158,12 @@ class Bag:
         wanted = set(names)
         infos: dict[str, TopicInfo] = {}
         messages: dict[str, tuple[list[int], list[bytes]]] = {}
+        budget = self._budget = _Budget(self.files)
         for path in self.files:
-            for topic in _read_file(self._uncompressed(path), wanted, path.name):
+            plain = self._uncompressed(path, budget)
+            if plain.name.endswith('.mcap'):
+                budget.check_chunks(plain, path.name)
+            for topic in _read_file(plain, wanted, path.name):
                 info, seen = topic.info, infos.get(topic.info.name)
                 if seen is not None and seen.msgtype != info.msgtype:
                     raise BagError(f'{info.name} is {seen.msgtype} in one storage file and '
@@ -169,23 +174,30 @@ class Bag:
                     t_ns.extend(topic.t_ns)
                     payloads.extend(topic.payloads)
         self._check_metadata(infos)
-        return infos, {name: _packed(t_ns, _decompressed(payloads, name))
+        return infos, {name: _packed(t_ns, _decompressed(payloads, name, budget))
                        for name, (t_ns, payloads) in messages.items()}
 
-    def _uncompressed(self, path: Path) -> Path:
+    def _uncompressed(self, path: Path, budget: _Budget) -> Path:
         """Undo zstd FILE compression into a temporary file that lives as long as the bag."""
         if path.suffix != '.zstd':
             return path
         if self._tmp is None:
             self._tmp = tempfile.TemporaryDirectory(prefix='satmotor_bag_')
         target = Path(self._tmp.name) / path.name.removesuffix('.zstd')
-        if not target.exists():
-            try:
-                with zstd.open(path, 'rb') as source, target.open('wb') as sink:
-                    shutil.copyfileobj(source, sink)
-            except (zstd.ZstdError, EOFError) as err:
-                target.unlink(missing_ok=True)
-                raise BagError(f'{path.name}: not a complete zstd file ({err})') from None
+        if target.exists():
+            budget.spend(target.stat().st_size, path.name)
+            return target
+        try:
+            with zstd.open(path, 'rb') as source, target.open('wb') as sink:
+                while block := source.read(1 << 20):
+                    budget.spend(len(block), path.name)
+                    sink.write(block)
+        except (zstd.ZstdError, EOFError) as err:
+            target.unlink(missing_ok=True)
+            raise BagError(f'{path.name}: not a complete zstd file ({err})') from None
+        except BagError:
+            target.unlink(missing_ok=True)
+            raise
         return target
 
     def _check_metadata(self, infos: dict[str, TopicInfo]) -> None:
@@ -338,15 +350,69 @@ def _read_with_mcap(path: Path, wanted: set[str]) -> list[FileTopic]:
             for k, c in channels.items()]
 
 
-def _decompressed(payloads: list[bytes], name: str) -> list[bytes]:
+class _Budget:
+    """
+    What a bag may still decompress to (:func:`satmotor_ros.limits.bag_budget`), [byte].
+
+    Parameters
+    ----------
+    files : list of pathlib.Path
+        The bag's storage files as stored, [-]
+
+    """
+
+    def __init__(self, files: list[Path]) -> None:
+        """Start from the budget of the stored size."""
+        self.total = self.left = bag_budget(sum(f.stat().st_size for f in files))
+
+    def spend(self, size: int, name: str) -> None:
+        """Take `size` bytes, or raise :class:`BagError` naming `name` and the cap."""
+        self.left -= size
+        if self.left < 0:
+            raise BagError(f'{name}: decompresses to more than {self.total} bytes (the cap for '
+                           'a bag of this size; SATMOTOR_BAG_MAX_BYTES, SATMOTOR_BAG_MAX_RATIO)')
+
+    def check_chunks(self, path: Path, name: str) -> None:
+        """Refuse an MCAP file whose chunks say they decompress beyond the budget."""
+        from mcap.exceptions import McapError, RecordLengthLimitExceeded
+        from mcap.records import Chunk
+        from mcap.stream_reader import StreamReader
+
+        size = 0
+        try:
+            with path.open('rb') as stream:
+                for record in StreamReader(stream, emit_chunks=True,
+                                           record_size_limit=self.total).records:
+                    if isinstance(record, Chunk) and record.compression:
+                        size += record.uncompressed_size
+                        if size > self.left:
+                            self.spend(size, name)
+        except RecordLengthLimitExceeded:
+            self.spend(self.left + 1, name)
+        except McapError:
+            return  # damaged: the reader says how
+        if size > self.left:
+            self.spend(size, name)
+
+
+def _decompressed(payloads: list[bytes], name: str, budget: _Budget) -> list[bytes]:
     """Undo zstd MESSAGE compression, recognised by the zstd magic of each payload."""
     if not payloads or not payloads[0].startswith(_ZSTD_MAGIC):
         return payloads
+    out = []
     try:
-        return [zstd.decompress(p) if p.startswith(_ZSTD_MAGIC) else p for p in payloads]
+        for p in payloads:
+            if p.startswith(_ZSTD_MAGIC):
+                decompressor = zstd.ZstdDecompressor()
+                p = decompressor.decompress(p, max_length=max(budget.left, 0) + 1)
+                budget.spend(len(p), name)
+                if not decompressor.eof:
+                    raise BagError(f'{name}: a zstd-compressed message is incomplete')
+            out.append(p)
     except zstd.ZstdError as err:
         raise BagError(f'{name}: a zstd-compressed message cannot be decompressed '
                        f'({err})') from None
+    return out
 
 
 def _split_key(path: Path) -> tuple[int, str]:
