@@ -39,6 +39,9 @@ BAG_MAX_RATIO = _cap('SATMOTOR_BAG_MAX_RATIO', 200)
 BAG_FLOOR_BYTES = 64 << 20
 """Bytes any bag may decompress to, however small it is, [byte]."""
 
+RATE_MAX_PREDICTIONS = _cap('SATMOTOR_RATE_MAX_PREDICTIONS', 20_000_000)
+"""Most predictions ``replay --mode rate`` makes (5.5 h at 1 kHz; about 5 GB of results), [-]."""
+
 
 def bag_budget(stored_bytes: int) -> int:
     """
@@ -58,5 +61,6 @@ def bag_budget(stored_bytes: int) -> int:
     return min(BAG_MAX_BYTES, max(BAG_FLOOR_BYTES, BAG_MAX_RATIO * stored_bytes))
 
 
-__all__ = ['BAG_FLOOR_BYTES', 'BAG_MAX_BYTES', 'BAG_MAX_RATIO', 'YAML_MAX_BYTES',
+__all__ = ['BAG_FLOOR_BYTES', 'BAG_MAX_BYTES', 'BAG_MAX_RATIO', 'RATE_MAX_PREDICTIONS',
+           'YAML_MAX_BYTES',
            'YAML_MAX_DEPTH', 'YAML_MAX_DIGITS', 'YAML_MAX_NODES', 'bag_budget']

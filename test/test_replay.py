@@ -123,6 +123,8 @@ def test_replay_topic_map_renames_bag_topics(tmp_path, capsys):
 @pytest.mark.parametrize(('args', 'text'), [
     (['--timeout', '-1'], 'timeout = -1.0 s'),
     (['--mode', 'rate', '--rate', '0'], 'rate = 0.0 Hz'),
+    (['--mode', 'rate', '--rate', '1e-300'], 'rate = 1e-300 Hz: must be in [0.001, 10000]'),
+    (['--timeout', '1e308'], 'timeout = 1e+308 s: must be in (0, 86400]'),
     (['--liquid', 'mercury'], "--liquid 'mercury'"),
     (['--topic-map', 'a:b'], "--topic-map 'a:b': use OLD:=NEW"),
     (['--out-bag', '{tmp}'], 'is or contains the input'),
@@ -176,3 +178,20 @@ def test_replay_replaces_only_its_own_outputs(tmp_path, capsys):
     assert csv.read_bytes() == first[0]
     assert sorted(p.name for p in tmp_path.iterdir()) == ['bag', 'out_bag', 'run.csv',
                                                           'run_speed.png']
+
+
+def test_rate_mode_over_a_long_gap_is_refused_at_the_cap(tmp_path, capsys, monkeypatch):
+    from satmotor_ros.prediction import rule
+    _bag(tmp_path / 'bag')
+    monkeypatch.setattr(rule, 'RATE_MAX_PREDICTIONS', 100)
+    assert main(['replay', str(tmp_path / 'bag'), '--no-plot', '--mode', 'rate']) == 1
+    err = capsys.readouterr().err
+    assert err.count('\n') == 1 and 'predictions, more than 100' in err, err
+
+
+def test_plot_must_be_a_png(tmp_path, capsys):
+    _bag(tmp_path / 'bag')
+    assert main(['replay', str(tmp_path / 'bag'), '--plot', str(tmp_path / 'x.yaml')]) == 1
+    err = capsys.readouterr().err
+    assert err.count('\n') == 1 and "x.yaml': a plot is written as PNG" in err, err
+    assert not (tmp_path / 'x.yaml').exists()

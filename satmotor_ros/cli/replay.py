@@ -131,6 +131,8 @@ def command(bag: str, out: str | None, out_bag: str | None, plot: str | None, no
     targets = {'--out': (out, _csv_by_replay), '--out-bag': (out_bag, written_by(COMMAND)),
                '--plot': (plot if not no_plot else None, png_by(COMMAND))}
     try:
+        if plot is not None and not no_plot and Path(plot).suffix.lower() != '.png':
+            raise CliError(f'--plot {plot!r}: a plot is written as PNG; name it *.png')
         for option, (target, ours) in targets.items():
             if target is not None:
                 check_target(option, Path(target), inputs, force, ours, COMMAND)
@@ -210,7 +212,10 @@ def _predict(model: MotorModel, rule: Rule, series: dict[str, Series]) -> Predic
     inputs = inputs_of(series)
     first = min(int(t[0]) for t, _ in inputs.values())
     last = max(int(t[-1]) for t, _ in inputs.values())
-    stamps = driving_times(rule, inputs['flow'][0], first, last)
+    try:
+        stamps = driving_times(rule, inputs['flow'][0], first, last)
+    except ValueError as err:
+        raise CliError(f'--mode rate: {err}') from None
     snaps = combine_batch(rule, stamps, inputs)
     return predict(model, snaps, rule.timeout, Progress().advance(snaps))
 

@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from satmotor_ros.bounded_yaml import read_yaml, YamlLimitError
 from satmotor_ros.identify.errors import DataError
 from satmotor_ros.identify.table import (BenchTable, column_to_si, KNOWN_KINDS,
                                          table_from_columns)
@@ -24,7 +25,6 @@ from satmotor_ros.model.config import default_config_path
 from satmotor_ros.model.errors import ConfigError, UnitError
 from satmotor_ros.model.units import (ATMOSPHERE, parse_quantity, pressure_reference,
                                       to_si, units_of)
-import yaml
 
 FIELDS = ('time', 'speed', 'flow', 'p_in', 'p_out', 'p_a', 'p_b', 'temperature', 'p_case',
           'torque')
@@ -205,12 +205,12 @@ def load_mapping(name: str | Path) -> ColumnMapping:
             msg = f'--columns {str(name)!r}: no such file and no packaged mapping of that name'
             raise DataError(msg) from None
     try:
-        doc = yaml.safe_load(path.read_text(encoding='utf-8'))
+        doc = read_yaml(path)
     except OSError as err:
         msg = f'--columns {str(name)!r}: {err.strerror}'
         raise DataError(msg) from None
-    except yaml.YAMLError as err:
-        msg = f'{path}: not valid YAML ({str(err).splitlines()[0]})'
+    except YamlLimitError as err:
+        msg = f'{path}: {err}'
         raise DataError(msg) from None
     return mapping_from_dict(doc, str(path))
 

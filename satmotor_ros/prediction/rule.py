@@ -24,6 +24,7 @@ import numpy as np
 import numpy.typing as npt
 
 from satmotor_ros.interface import CHANNELS, PREDICTION_INPUTS
+from satmotor_ros.limits import RATE_MAX_PREDICTIONS
 
 INPUTS = PREDICTION_INPUTS
 """The inputs of a prediction, in the order of every per-input tuple and array."""
@@ -88,12 +89,12 @@ class Rule:
 
     def __post_init__(self) -> None:
         """Reject values the rule cannot run with, naming the field."""
-        if not (math.isfinite(self.timeout) and self.timeout > 0.0):
-            raise ValueError(f'timeout = {self.timeout!r} s: must be a finite value > 0')
+        if not (math.isfinite(self.timeout) and 0.0 < self.timeout <= 86400.0):
+            raise ValueError(f'timeout = {self.timeout!r} s: must be in (0, 86400]')
         if self.mode not in MODES:
             raise ValueError(f'mode = {self.mode!r}: use one of {", ".join(MODES)}')
-        if not (math.isfinite(self.rate) and 0.0 < self.rate <= 10000.0):
-            raise ValueError(f'rate = {self.rate!r} Hz: must be in (0, 10000]')
+        if not (math.isfinite(self.rate) and 1.0e-3 <= self.rate <= 10000.0):
+            raise ValueError(f'rate = {self.rate!r} Hz: must be in [0.001, 10000]')
 
     @property
     def timeout_ns(self) -> int:
@@ -267,11 +268,21 @@ def driving_times(rule: Rule, flow_t_ns: npt.NDArray[np.int64], first_ns: int,
         Every flow_command's time (``'on_flow'``), or ticks of the rate from the first
         message on (``'rate'``), [ns]
 
+    Raises
+    ------
+    ValueError
+        If the rate asks for more than :data:`~satmotor_ros.limits.RATE_MAX_PREDICTIONS`.
+
     """
     if rule.mode == 'on_flow':
         return np.asarray(flow_t_ns, dtype=np.int64).copy()
     if last_ns < first_ns:
         return np.zeros(0, dtype=np.int64)
+    count = (last_ns - first_ns) // rule.period_ns + 1
+    if count > RATE_MAX_PREDICTIONS:
+        raise ValueError(f'rate = {rule.rate:g} Hz over {(last_ns - first_ns) / 1e9:.6g} s asks '
+                         f'for {count} predictions, more than {RATE_MAX_PREDICTIONS} '
+                         '(SATMOTOR_RATE_MAX_PREDICTIONS)')
     return np.arange(first_ns, last_ns + 1, rule.period_ns, dtype=np.int64)
 
 
