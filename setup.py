@@ -60,9 +60,9 @@ setup(
     entry_points={
         'console_scripts': [
             'satmotor = satmotor_ros.cli:main',
-            'motor_model = satmotor_ros.nodes.motor_model:main',
-            'virtual_motor = satmotor_ros.nodes.virtual_motor:main',
-            'speed_controller = satmotor_ros.nodes.speed_controller:main',
+            'motor_model = satmotor_ros.nodes.launch:motor_model',
+            'virtual_motor = satmotor_ros.nodes.launch:virtual_motor',
+            'speed_controller = satmotor_ros.nodes.launch:speed_controller',
         ],
     },
 )

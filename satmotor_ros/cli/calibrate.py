@@ -89,4 +89,3 @@ def _calibrate(data: str, out: str, mode: Mode, alpha: float, folds: int,
     return (f'{line}; out-of-sample RMSE of Q_vl {before:.4g} -> {after:.4g} l/min over '
             f'{summary["n_points"]} points; wrote {target}/calibration.json, '
             'coefficients.yaml, report.md')
-

@@ -53,10 +53,12 @@ def node_main(make_node: Callable[[], Node], name: str) -> NodeMain:
     """
     Make a node's ``main`` (its console script): run the node until shut down.
 
-    The ``main`` initialises rclpy, builds the node and spins it. Ctrl-C and an
-    external shutdown end the run quietly. Bad start-up parameters (a ValueError or
-    OSError from `make_node`) print one line and exit with status 1, without a
-    traceback. The node is destroyed and rclpy shut down in every case.
+    The ``main`` initialises rclpy, builds the node and spins it. Ctrl-C, SIGTERM and an
+    external shutdown end the run quietly, also while the node is being built (rclpy's
+    signal handler shuts the context down, and building the rest of the node then fails:
+    that failure is the signal's doing, not an error). Bad start-up parameters (a
+    ValueError or OSError from `make_node`) print one line and exit with status 1,
+    without a traceback. The node is destroyed and rclpy shut down in every case.
 
     Parameters
     ----------
@@ -72,15 +74,20 @@ def node_main(make_node: Callable[[], Node], name: str) -> NodeMain:
 
     """
     def main(args: list[str] | None = None) -> None:
-        rclpy.init(args=args)
-        node = None
+        node, initialised = None, False
         try:
+            rclpy.init(args=args)
+            initialised = True
             node = make_node()
             spin(node)
         except (KeyboardInterrupt, ExternalShutdownException):
             pass
-        except (ValueError, OSError) as err:  # bad start-up parameters: one line, no traceback
-            print(f'{name}: {err}')
+        except Exception as err:
+            if initialised and not rclpy.ok():  # a signal shut rclpy down during the build
+                return
+            if not isinstance(err, (ValueError, OSError)):
+                raise
+            print(f'{name}: {err}')  # bad start-up parameters: one line, no traceback
             raise SystemExit(1) from None
         finally:
             if node is not None:

@@ -1,0 +1,35 @@
+# SPDX-License-Identifier: Apache-2.0
+"""
+The nodes' console scripts (what ``ros2 run satmotor_ros NODE`` starts).
+
+A node module imports rclpy and numpy, which takes a good part of a second. A
+Ctrl-C in that window would end in a KeyboardInterrupt traceback; here it ends
+the start-up quietly with status 130, as a shell reports an interrupted program.
+"""
+
+from __future__ import annotations
+
+import importlib
+
+
+def _launch(module: str) -> None:
+    try:
+        main = importlib.import_module(f'satmotor_ros.nodes.{module}').main
+    except KeyboardInterrupt:
+        raise SystemExit(130) from None
+    main()
+
+
+def motor_model() -> None:
+    """Run the motor_model node."""
+    _launch('motor_model')
+
+
+def virtual_motor() -> None:
+    """Run the virtual_motor node."""
+    _launch('virtual_motor')
+
+
+def speed_controller() -> None:
+    """Run the speed_controller node."""
+    _launch('speed_controller')
