@@ -129,7 +129,8 @@ def test_calibrate_unusable_data_is_one_line_and_exit_1(tmp_path, capsys, text, 
 
 def test_calibrate_unknown_liquid_is_one_line(tmp_path, capsys):
     data = _csv(tmp_path / 'b.csv', generate(Plan(), Injection(), seed=0))
-    code, _, err = _run(capsys, 'calibrate', data, '--liquid', 'glycol', '--out', tmp_path)
+    code, _, err = _run(capsys, 'calibrate', data, '--liquid', 'glycol', '--out',
+                        tmp_path / 'out')
     assert code == 1 and "--liquid 'glycol'" in err
 
 
