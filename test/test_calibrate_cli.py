@@ -13,7 +13,7 @@ from satmotor_ros.model import load_motor, MotorModel
 from satmotor_ros.model.units import LPM, MPA, RPM
 
 FIELDS = ['liquid', 'n_points', 'effect', 'regressor', 'coefficient', 'ci95', 'unit',
-          'error_before', 'error_after', 'candidates']
+          'error_before', 'error_after', 'effects', 'outliers', 'candidates']
 
 
 def _csv(path, table, extra=()):

@@ -12,6 +12,7 @@ import pytest
 from satmotor_ros.identify import calibrate
 from satmotor_ros.identify.synthetic import generate, generate_series, Injection, Plan, REALISTIC
 from satmotor_ros.model import MotorModel
+from satmotor_ros.model.effects.term import exponents
 from satmotor_ros.model.units import LPM
 
 GAINS = {'flow_sensor_gain', 'speed_sensor_gain'}
@@ -30,6 +31,11 @@ def _check(cal, effect, noise):
         # reported as the runner-up
         assert chosen in GAINS
         assert runner is not None and runner.candidate.effect in GAINS - {chosen}
+    elif effect.startswith('term:'):
+        # the exponents are fitted: the form found, within the data's resolution
+        assert chosen.startswith('term:'), cal.selection.verdict
+        found = exponents(chosen.partition(':')[2], chosen)
+        assert np.allclose(found, exponents(effect.partition(':')[2], effect), atol=0.35)
     else:
         assert chosen == effect, cal.selection.verdict
     before, after = cal.error_before.rmse_lpm, cal.error_after.rmse_lpm

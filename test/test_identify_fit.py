@@ -61,6 +61,8 @@ def test_fit_predict_before_fit_is_an_error():
 
 def test_fit_names_a_coefficient_the_points_cannot_move():
     parts = _parts()
-    zero = replace(parts, inertia=np.zeros_like(parts.inertia))
+    leakage, c, c_id = parts.components
+    dead = replace(c_id, pieces=(('', np.zeros(len(parts))),))
+    zero = replace(parts, components=(leakage, c, dead))
     with pytest.raises(IdentificationError, match='c_id_scale is not determined'):
         LossFit().fit(zero).report()

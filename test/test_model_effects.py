@@ -185,7 +185,10 @@ def test_sensor_effects_convert_readings_only():
 @pytest.mark.parametrize('effects, match', [
     ({'leakage': {'coefficient': 1.0}}, 'unknown effect'),
     ({'channel': {'coefficient': 1.0, 'reference': 0.0}}, 'unknown effect'),
-    ({'term:dp^3': {'coefficient': 1.0}}, "unknown term 'dp\\^3'"),
+    ({'term:dp^x': {'coefficient': 1.0}}, "term 'dp\\^x' is not a product of powers"),
+    ({'term:dp^2': {'coefficient': 1.0, 'exponents': {'dp': 3.0}}}, "the id says 'dp\\^2'"),
+    ({'threshold:dp': {'coefficient': 1.0}}, 'missing key.*reference'),
+    ({'threshold:n': {'coefficient': 1.0, 'reference': 1e7}}, 'use threshold:dp'),
     ({'clearance_wear': {'coefficient': 1e-9, 'regressor': 'hours', 'reference': 0.0}},
      "regressor = 'hours'"),
     ({'clearance_wear': {'coefficient': 1e-9, 'regressor': 'time'}}, 'missing key.*reference'),

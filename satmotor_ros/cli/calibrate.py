@@ -86,6 +86,10 @@ def _calibrate(data: str, out: str, mode: Mode, alpha: float, folds: int,
     runner = cal.selection.runner_up
     if runner is not None:
         line += f', near tie with {runner.label}'
+    if len(summary['effects']) > 1:
+        line += ', then ' + ', '.join(e['effect'] for e in summary['effects'][1:])
+    if summary['outliers']:
+        line += f'; {len(summary["outliers"])} outlier(s) left out'
     return (f'{line}; out-of-sample RMSE of Q_vl {before:.4g} -> {after:.4g} l/min over '
             f'{summary["n_points"]} points; wrote {target}/calibration.json, '
             'coefficients.yaml, report.md')

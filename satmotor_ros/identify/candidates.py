@@ -16,7 +16,7 @@ from collections.abc import Mapping
 
 from satmotor_ros.identify.parts import LossParts
 from satmotor_ros.model._typing import FloatArray
-from satmotor_ros.model.effects import build_candidates, Candidate, CandidateData, TERMS
+from satmotor_ros.model.effects import build_candidates, Candidate, CandidateData
 from satmotor_ros.model.viscosity import ViscosityLaw
 
 
@@ -45,4 +45,4 @@ def build_library(parts: LossParts, channels: Mapping[str, FloatArray],
     return build_candidates(CandidateData(parts, channels, law, frozenset()))
 
 
-__all__ = ['Candidate', 'TERMS', 'build_library']
+__all__ = ['Candidate', 'build_library']

@@ -1,35 +1,44 @@
 # SPDX-License-Identifier: Apache-2.0
 """
-Bounded least-squares fit of the model's identifiable coefficients (and one effect).
+Bounded, weighted and robust least-squares fit of the model's identifiable coefficients.
 
 Of the 14 coefficients of Table 1 most are not identifiable from Q, n and dp
 alone: A_1, A_2 and K of eq. (1) only appear as one product, C of eq. (33) is
 a lump of three, and the exponents (beta, gamma) and the clearance law of
 eq. (2) trade off against each other within any bench's noise. Following the
 paper's own procedure (C and C_id from the speed-dependent part, the
-leakage from the pressure-only part), the fit frees three factors on the
-packaged values: s_L on the leakage of eqs. (1) and (5) (A_1 and C_1), s_C
-on C and s_id on C_id, plus the coefficient of at most one candidate
-effect. The exponents stay as packaged.
+leakage from the pressure-only part), the fit frees one factor per named
+component of the model's Q_vl (:attr:`LossParts.components`: for eqs.
+(31)-(33) s_L on the leakage of eqs. (1) and (5), s_C on C and s_id on
+C_id), the coefficients of the nuisance regressors (:attr:`LossParts.nuisance`,
+linear, without a prior) and the coefficients and shape parameters of any
+number of effects. The exponents of Table 1 stay as packaged.
 
-Even these three trade off against a constant or a gain within a few tens of
+The factors trade off against a constant or a gain within a few tens of
 noise levels (a flowmeter offset is mimicked by a larger C_id and leakage),
 so the fit carries a weak Gaussian prior that each factor is 1 with a
 standard deviation :data:`PRIOR_SD`: the packaged values are what the paper
 measured, and a factor moves away from 1 only as far as the data insist.
+
+Residuals are divided by each point's noise (a noise model estimated from the
+data, :mod:`.noise`) and, when ``robust`` is set, pass through Huber's loss:
+a gross outlier pulls the fit by a bounded amount instead of its square.
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
+import itertools
 import math
 from typing import TYPE_CHECKING
 
 import numpy as np
 from satmotor_ros.identify.candidates import Candidate
 from satmotor_ros.identify.errors import IdentificationError
-from satmotor_ros.identify.parts import LossParts, NO_EFFECT, predict_flow, SCALES
+from satmotor_ros.identify.parts import LossParts, NO_EFFECT, predict_flow
 from satmotor_ros.model._typing import FloatArray
+from satmotor_ros.model.effects import Effect, Modifier
 from satmotor_ros.model.units import LPM, MPA, RPM
 from scipy import optimize, special
 
@@ -47,6 +56,9 @@ PRIOR_SD = 0.3
 
 SCALE_MAX = 20.0
 """Largest factor on a packaged coefficient the fit may return, [-]."""
+
+HUBER = 1.345
+"""Huber's constant in noise standard deviations: 95 % efficiency on Gaussian noise, [-]."""
 
 
 def check_identifiable(parts: LossParts) -> None:
@@ -82,58 +94,136 @@ def check_identifiable(parts: LossParts) -> None:
             raise IdentificationError(msg)
 
 
+def huber_root(z: FloatArray, c: float) -> FloatArray:
+    """
+    Return sign(z) sqrt(rho(z)), Huber's rho: z^2 within c, 2 c |z| - c^2 beyond.
+
+    Least squares on these minimise the sum of rho; the map is smooth at |z| = c.
+
+    Parameters
+    ----------
+    z : ndarray
+        Standardised residuals, [-]
+    c : float
+        Huber's constant, [-]
+
+    Returns
+    -------
+    ndarray
+        The transformed residuals, [-]
+
+    """
+    a = np.abs(z)
+    return np.where(a <= c, z, np.sign(z) * np.sqrt(np.maximum(2.0 * c * a - c * c, 0.0)))
+
+
 @dataclass(frozen=True)
 class FitReport:
-    """Fitted coefficients with 95 % confidence intervals."""
+    """Fitted parameters with 95 % confidence intervals and their correlations."""
 
-    names: tuple[str, ...]  # SCALES, then the effect's label if any
-    values: FloatArray  # [-] for the scales, the effect's unit for its coefficient
+    names: tuple[str, ...]  # components' factors, nuisance, then each effect and its shape
+    values: FloatArray  # [-] for the factors, the unit of each coefficient or shape
     ci95: FloatArray  # shape (p, 2), same units
     rss: float  # residual sum of squares [(m^3/s)^2]
     n_points: int  # points fitted [-]
+    covariance: FloatArray  # (p, p), of the values [their units squared]
+
+    @property
+    def correlation(self) -> FloatArray:
+        """Return the correlation matrix of the fitted parameters, [-]."""
+        sd = np.sqrt(np.maximum(np.diag(self.covariance), 1e-300))
+        return np.clip(self.covariance / np.outer(sd, sd), -1.0, 1.0)
 
 
 class LossFit:
     """
-    Fit s_L, s_C, s_id and one effect coefficient by bounded least squares.
+    Fit the components' factors, the nuisance terms and any effects by bounded least squares.
 
     Parameters
     ----------
-    candidate : Candidate, optional
-        The effect to fit with the model; none gives the baseline, [-]
-    c_floor : float
-        Smallest factor on C: the compressibility share C_fc beta_l of
-        eqs. (9)-(11) is known from the bulk modulus, [-]
-    noise : float
-        Noise of the measured flow that weighs the prior against the data
-        (the prior residual is (s - 1) noise / PRIOR_SD); 0 fits without
-        the prior, [m^3/s]
+    effects : sequence of Candidate
+        The effects to fit with the model, in order; none gives the baseline, [-]
+    sigma : float or ndarray, optional
+        Noise of the measured flow at each point: residuals are divided by it and
+        the factors get their prior; None fits in l/min without the prior, [m^3/s]
+    robust : float
+        Huber's constant applied to the standardised residuals; 0 for plain least
+        squares, [-]
 
     """
 
-    def __init__(self, candidate: Candidate | None = None, c_floor: float = 0.0,
-                 noise: float = 0.0) -> None:
+    def __init__(self, effects: Sequence[Candidate] = (), sigma: FloatArray | float | None = None,
+                 robust: float = 0.0) -> None:
         """Store the hyperparameters; nothing is fitted yet."""
-        if not 0.0 <= c_floor < SCALE_MAX:
-            msg = f'c_floor = {c_floor!r}: must be in [0, {SCALE_MAX})'
+        if sigma is not None and not np.all(np.asarray(sigma) > 0.0):
+            msg = 'sigma: the noise must be > 0 at every point'
             raise IdentificationError(msg)
-        if not noise >= 0.0:
-            msg = f'noise = {noise!r}: must be >= 0'
+        if not robust >= 0.0:
+            msg = f'robust = {robust!r}: must be >= 0'
             raise IdentificationError(msg)
-        self.candidate = candidate
-        self.c_floor = c_floor
-        self.noise = noise
+        self.effects = tuple(effects)
+        self.sigma = sigma
+        self.robust = robust
 
-    def _unpack(self, u: FloatArray) -> tuple[FloatArray, float]:
-        coef = u[3] * self.candidate.typical if self.candidate is not None else 0.0
-        return u[:3], coef
+    @property
+    def candidate(self) -> Candidate | None:
+        """Return the last effect (the one tested on top of the others), or None."""
+        return self.effects[-1] if self.effects else None
+
+    def _layout(self, parts: LossParts) -> None:
+        self.m_ = len(parts.components)
+        self.names_ = parts.names
+        self.typical_ = np.array([LPM / max(float(np.max(np.abs(x))), 1e-300)
+                                  for x in parts.nuisance.values()])
+        self.nuisance_names_ = tuple(parts.nuisance)
+
+    def _effect_values(self, u: FloatArray) -> list[tuple[Candidate, float, tuple[float, ...]]]:
+        out = []
+        i = self.m_ + self.typical_.size
+        for c in self.effects:
+            theta = tuple(s_.to_unit[0] + s_.to_unit[1] * float(v)
+                          for s_, v in zip(c.shape, u[i + 1:i + 1 + len(c.shape)]))
+            out.append((c, float(u[i]) * c.typical, theta))
+            i += 1 + len(c.shape)
+        return out
+
+    def _modifier(self, u: FloatArray) -> Modifier:
+        mod = NO_EFFECT
+        for c, k, theta in self._effect_values(u):
+            mod = c.modify(k, *theta) if mod is NO_EFFECT else mod + c.modify(k, *theta)
+        return mod
 
     def _predict(self, parts: LossParts, u: FloatArray) -> FloatArray:
-        scales, coef = self._unpack(u)
-        mod = self.candidate.modify(coef) if self.candidate is not None else NO_EFFECT
-        return predict_flow(parts, scales, mod)
+        q = self.typical_.size
+        return predict_flow(parts, u[:self.m_], self._modifier(u),
+                            u[self.m_:self.m_ + q] * self.typical_ if q else None)
 
-    def fit(self, parts: LossParts, index: np.ndarray | None = None) -> Self:
+    def _starts(self, parts: LossParts, start: FloatArray | None) -> tuple[list, list, list]:
+        lower = [c.floor for c in parts.components] + [-np.inf] * self.typical_.size
+        upper = [SCALE_MAX] * self.m_ + [np.inf] * self.typical_.size
+        base = [max(1.0, c.floor + 1e-6) for c in parts.components] + [0.0] * self.typical_.size
+        options: list[tuple[float, ...]] = [(v,) for v in base]
+        for c in self.effects:
+            lo, hi = c.bounds
+            lower.append(lo / c.typical)
+            upper.append(hi / c.typical)
+            options.append((min(max(c.start / c.typical, lo / c.typical), hi / c.typical),))
+            for s_ in c.shape:
+                lower.append(s_.bounds[0])
+                upper.append(s_.bounds[1])
+                options.append(tuple(min(max(v, s_.bounds[0]), s_.bounds[1])
+                                     for v in s_.starts))
+        starts = [np.array(u, dtype=float) for u in itertools.product(*options)]
+        if start is not None:
+            k = len(start)
+            for u in starts:
+                u[:k] = np.clip(start, np.array(lower[:k]), np.array(upper[:k]))
+            if k == len(lower):
+                starts = starts[:1]
+        return lower, upper, starts
+
+    def fit(self, parts: LossParts, index: np.ndarray | None = None,
+            start: FloatArray | None = None) -> Self:
         """
         Fit on the points in `index` (all when omitted).
 
@@ -143,49 +233,58 @@ class LossFit:
             Components at the points, [-]
         index : ndarray of int, optional
             Points to fit on, [-]
+        start : ndarray, optional
+            Initial values of the first parameters (e.g. a fit of the same model, or of
+            the model without its last effect); the rest start from each combination of
+            the shape parameters' starting values, [-]
 
         Returns
         -------
         LossFit
-            Self, with ``u_``, ``rss_``, ``n_`` and ``jac_`` set.
+            Self, with ``u_``, ``rss_``, ``objective_``, ``n_`` and ``jac_`` set.
 
         """
+        self._layout(parts)
         index = np.arange(len(parts)) if index is None else index
         flow = parts.flow[index]
-        lower = [0.0, self.c_floor, 0.0]
-        upper = [SCALE_MAX] * 3
-        u0 = [1.0, max(1.0, self.c_floor + 1e-6), 1.0]
-        if self.candidate is not None:
-            lo, hi = self.candidate.bounds
-            typ = self.candidate.typical
-            lower.append(lo / typ)
-            upper.append(hi / typ)
-            u0.append(min(max(self.candidate.start / typ, lo / typ), hi / typ))
-
-        weight = self.noise / PRIOR_SD / LPM
-        n_data = index.size
+        prior = self.sigma is not None
+        sigma = np.broadcast_to(np.asarray(LPM if self.sigma is None else self.sigma,
+                                           dtype=float), parts.flow.shape)[index]
+        lower, upper, starts = self._starts(parts, start)
+        m, c = self.m_, self.robust
 
         def residual(u: FloatArray) -> FloatArray:
-            data = (flow - self._predict(parts, u)[index]) / LPM
-            return np.concatenate((data, (u[:3] - 1.0) * weight)) if weight else data
+            z = (flow - self._predict(parts, u)[index]) / sigma
+            if c:
+                z = huber_root(z, c)
+            return np.concatenate((z, (u[:m] - 1.0) / PRIOR_SD)) if prior else z
 
+        best = None
         with np.errstate(all='ignore'):
-            result = optimize.least_squares(residual, np.array(u0), bounds=(lower, upper),
-                                            method='trf', x_scale=1.0, xtol=1e-10, ftol=1e-10)
-        if not np.all(np.isfinite(result.fun)):
+            for u0 in starts:
+                result = optimize.least_squares(residual, u0, bounds=(lower, upper),
+                                                method='trf', x_scale=1.0, xtol=1e-8,
+                                                ftol=1e-8)
+                if np.all(np.isfinite(result.fun)) and (best is None or result.cost < best.cost):
+                    best = result
+        if best is None:
             msg = 'the fit produced non-finite residuals: the data are outside the model'
             raise IdentificationError(msg)
-        self.u_ = result.x
-        self.jac_ = np.asarray(result.jac, dtype=float)
-        self.rss_ = float(np.sum(result.fun[:n_data] ** 2)) * LPM ** 2
+        self.u_ = best.x
+        self.fun_ = np.asarray(best.fun, dtype=float)
+        self.bounds_ = (np.array(lower, dtype=float), np.array(upper, dtype=float))
+        self.jac_ = np.asarray(best.jac, dtype=float)
         self.n_ = int(index.size)
+        self.objective_ = float(np.sum(best.fun[:self.n_] ** 2))
+        self.rss_ = float(np.sum((flow - self._predict(parts, best.x)[index]) ** 2))
         return self
 
     def _check_fitted(self) -> None:
         if not hasattr(self, 'u_'):
             raise IdentificationError('LossFit is not fitted yet: call fit() first')
 
-    def predict(self, parts: LossParts, index: np.ndarray | None = None) -> FloatArray:
+    def predict(self, parts: LossParts, index: np.ndarray | None = None,
+                u: FloatArray | None = None) -> FloatArray:
         """
         Predict the measured flow at the points in `index`.
 
@@ -195,6 +294,8 @@ class LossFit:
             Components at the points, [-]
         index : ndarray of int, optional
             Points to predict, [-]
+        u : ndarray, optional
+            Parameters other than the fitted ones (e.g. :meth:`without`), [-]
 
         Returns
         -------
@@ -203,44 +304,89 @@ class LossFit:
 
         """
         self._check_fitted()
-        flow = self._predict(parts, self.u_)
+        flow = self._predict(parts, self.u_ if u is None else u)
         return flow if index is None else flow[index]
+
+    def without(self, drop: np.ndarray) -> FloatArray:
+        """
+        Return the parameters refitted without some of the fitted points, by one Gauss-Newton step.
+
+        From the fit's own optimum, one step on the remaining rows of its Jacobian
+        (the prior's rows kept) is the exact refit of a model linear in its
+        parameters and a close one otherwise: cross-validation without refitting.
+
+        Parameters
+        ----------
+        drop : ndarray of int
+            Positions among the fitted points (not table rows) to leave out, [-]
+
+        Returns
+        -------
+        ndarray
+            The parameters, within their bounds, [-]
+
+        """
+        self._check_fitted()
+        keep = np.ones(self.fun_.size, dtype=bool)
+        keep[drop] = False
+        step = np.linalg.lstsq(self.jac_[keep], -self.fun_[keep], rcond=None)[0]
+        return np.clip(self.u_ + step, *self.bounds_)
+
+    def found(self) -> list[tuple[Candidate, Effect]]:
+        """Return each effect's candidate with the effect at the fitted values (for the YAML)."""
+        self._check_fitted()
+        return [(c, c.as_effect(k, *theta)) for c, k, theta in self._effect_values(self.u_)]
 
     @property
     def effect_coefficient(self) -> float:
-        """Return the fitted coefficient of the candidate effect, in its unit (no interval)."""
+        """Return the fitted coefficient of the last effect, in its unit (no interval)."""
         self._check_fitted()
-        if self.candidate is None:
+        if not self.effects:
             return math.nan
-        return float(self.u_[3] * self.candidate.typical)
+        return self.found()[-1][1].coefficient
 
     @property
     def n_params(self) -> int:
-        """Return the number of fitted coefficients."""
-        return 3 + (self.candidate is not None)
+        """Return the number of fitted parameters."""
+        self._check_fitted()
+        return int(self.u_.size)
+
+    def _names_and_units(self) -> tuple[tuple[str, ...], FloatArray, FloatArray]:
+        names = list(self.names_)
+        unit = [1.0] * self.m_ + list(self.typical_)
+        offset = [0.0] * (self.m_ + self.typical_.size)
+        names += [f'nuisance:{n}' for n in self.nuisance_names_]
+        for c in self.effects:
+            names.append(c.label)
+            unit.append(c.typical)
+            offset.append(0.0)
+            for s_ in c.shape:
+                names.append(f'{c.label} {s_.name}')
+                unit.append(s_.to_unit[1])
+                offset.append(s_.to_unit[0])
+        return tuple(names), np.array(unit), np.array(offset)
 
     def report(self) -> FitReport:
         """
-        Summarise the fit with 95 % confidence intervals from the Jacobian.
+        Summarise the fit with 95 % confidence intervals and correlations from the Jacobian.
 
-        The covariance is s^2 (J^T J)^-1 with s^2 = RSS / (N - p), and the
+        The covariance is s^2 (J^T J)^-1 with s^2 = sum rho / (N - p), and the
         half-width t_{0.975, N-p} times its root diagonal; J includes the
         prior's rows, so an interval never exceeds what the prior allows.
 
         Returns
         -------
         FitReport
-            Coefficients (scales [-], effect in its unit) and intervals.
+            Parameters (factors [-], coefficients and shapes in their units) and intervals.
 
         Raises
         ------
         IdentificationError
-            If a coefficient is not determined (singular Jacobian); the
-            message names it.
+            If a parameter is not determined (singular Jacobian); the message names it.
 
         """
         self._check_fitted()
-        names = SCALES + ((self.candidate.label,) if self.candidate is not None else ())
+        names, unit, offset = self._names_and_units()
         dof = max(self.n_ - self.n_params, 1)
         jac = self.jac_
         data_jac = jac[:self.n_]
@@ -255,12 +401,9 @@ class LossFit:
             msg = (f'{which} is not determined by the data: it trades off exactly against '
                    f'the other coefficients at these points')
             raise IdentificationError(msg)
-        s2 = self.rss_ / LPM ** 2 / dof
-        cov = s2 * np.linalg.inv(jac.T @ jac)
+        s2 = self.objective_ / dof
+        cov = s2 * np.linalg.pinv(jac.T @ jac) * np.outer(unit, unit)
         half = special.stdtrit(dof, 0.975) * np.sqrt(np.maximum(np.diag(cov), 0.0))
-        unit = np.ones(self.n_params)
-        if self.candidate is not None:
-            unit[3] = self.candidate.typical
-        values = self.u_ * unit
-        ci = np.column_stack([values - half * unit, values + half * unit])
-        return FitReport(names, values, ci, self.rss_, self.n_)
+        values = offset + self.u_ * unit
+        ci = np.column_stack([values - half, values + half])
+        return FitReport(names, values, ci, self.rss_, self.n_, cov)

@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 from satmotor_ros.identify.pipeline import Calibration
 from satmotor_ros.model import LossCoefficients
-from satmotor_ros.model.effects import effect_to_mapping
+from satmotor_ros.model.effects import effect_to_mapping, kind_of
 import yaml
 
 
@@ -56,38 +56,37 @@ def write_json(cal: Calibration, path: str | Path) -> dict[str, Any]:
 
 def fitted_coefficients(cal: Calibration) -> LossCoefficients:
     """
-    Apply the fitted factors (and an external leakage) to the packaged coefficients.
+    Apply the fitted factors (and what the effects set, e.g. k_ex) to the packaged coefficients.
 
     Parameters
     ----------
     cal : Calibration
-        Its final fit holds s_L, s_C and s_id first, then the effect's coefficient, [-]
+        Its final fit holds s_L, s_C and s_id first, then the effects, [-]
 
     Returns
     -------
     LossCoefficients
-        a1 and c1 times s_L, c times s_C, c_id times s_id, and
-        external_leakage = k_ex when that effect was chosen.
+        a1 and c1 times s_L, c times s_C, c_id times s_id, and each effect's
+        numbers (:meth:`~satmotor_ros.model.effects.EffectKind.coefficients`).
 
     """
     coef = cal.model.coef
     s_l, s_c, s_id = (float(v) for v in cal.final.values[:3])
-    changes = {'a1': coef.a1 * s_l, 'c1': coef.c1 * s_l, 'c': coef.c * s_c,
-               'c_id': coef.c_id * s_id}
-    chosen = cal.chosen
-    if chosen is not None and chosen.effect == 'external_leakage':
-        changes['external_leakage'] = float(cal.final.values[3])
-    return replace(coef, **changes)
+    coef = replace(coef, a1=coef.a1 * s_l, c1=coef.c1 * s_l, c=coef.c * s_c,
+                   c_id=coef.c_id * s_id)
+    for effect in cal.effects():
+        coef = kind_of(effect).coefficients(effect, coef)
+    return coef
 
 
 def effect_block(cal: Calibration) -> dict[str, Any]:
     """
-    Describe the chosen effect as data for the ``effects:`` block.
+    Describe the effects found as data for the ``effects:`` block, in the order found.
 
     Parameters
     ----------
     cal : Calibration
-        The result; nothing to describe when it chose no effect, [-]
+        The result; nothing to describe when it found no effect, [-]
 
     Returns
     -------
@@ -95,15 +94,13 @@ def effect_block(cal: Calibration) -> dict[str, Any]:
         ``{effect id: {...}}``; empty when no effect was found.
 
     """
-    chosen = cal.chosen
-    if chosen is None:
-        return {}
-    value = float(cal.final.values[3])
-    entry = effect_to_mapping(chosen.as_effect(value))
-    entry.update(unit=chosen.unit, ci95=[float(v) for v in cal.final.ci95[3]],
-                 source=chosen.source)
-    entry['evaluation'] = entry.pop('evaluation')
-    return {chosen.effect: entry}
+    block = {}
+    for effect, row, score in zip(cal.effects(), cal.effect_rows(), cal.found):
+        entry = effect_to_mapping(effect)
+        entry.update(unit=row['unit'], ci95=row['ci95'], source=score.candidate.source)
+        entry['evaluation'] = entry.pop('evaluation')
+        block[effect.name] = entry
+    return block
 
 
 def _document(cal: Calibration) -> dict[str, Any]:
@@ -136,13 +133,12 @@ def _document(cal: Calibration) -> dict[str, Any]:
 def _viscosity_span(cal: Calibration) -> list[float] | None:
     """Return the viscosity span the fit covers: the law over the data's temperatures."""
     packaged = cal.model.coefficient_set.viscosity_range
-    chosen = cal.chosen
-    if chosen is None or chosen.effect != 'viscosity_temperature':
+    slope = [e.coefficient for e in cal.effects() if e.kind == 'viscosity_temperature']
+    if not slope:
         return None if packaged is None else [float(v) for v in packaged]
     temperature = cal.table.channels['temperature']
     law = cal.law
-    nu = law.viscosity(np.array([np.min(temperature), np.max(temperature)]),
-                       float(cal.final.values[3]))
+    nu = law.viscosity(np.array([np.min(temperature), np.max(temperature)]), slope[0])
     low, high = sorted(float(v) for v in nu)
     return [min(low, law.reference_viscosity), max(high, law.reference_viscosity)]
 

@@ -11,7 +11,8 @@ measured flow, so no equation has to be solved per point.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -22,8 +23,27 @@ from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.effects import Modifier
 from satmotor_ros.model.losses import channel_pressure_drop, clearance_height
 
-SCALES = ('leakage_scale', 'c_scale', 'c_id_scale')
-"""The identifiable model coefficients, as factors on the packaged values."""
+@dataclass(frozen=True)
+class Component:
+    """
+    One named part of the model's Q_vl that the fit scales by a factor of its own.
+
+    A motor family supplies its Q_vl as a tuple of these (:attr:`LossParts.components`);
+    the fitter frees one factor per component, with a weak prior at 1.
+    """
+
+    name: str  # the factor's name, e.g. 'leakage_scale'
+    pieces: tuple[tuple[str, FloatArray], ...]  # (Modifier field scaling it or '', Q [m^3/s])
+    speed_power: float = 0.0  # it grows as n^power at a fixed dp_i (how a speed gain acts) [-]
+    floor: float = 0.0  # least factor: a share known otherwise (e.g. C_fc beta_l) [-]
+    describes: str = ''  # what the factor multiplies, for the report
+
+    def flow(self, mod: Modifier) -> FloatArray:
+        """Return the component at factor 1 under an effect's modifier, [m^3/s]."""
+        total = 0.0
+        for factor, column in self.pieces:
+            total = total + (getattr(mod, factor) * column if factor else column)
+        return total / mod.speed_gain ** self.speed_power if self.speed_power else total
 
 
 @dataclass(frozen=True)
@@ -35,16 +55,15 @@ class LossParts:
     dp: FloatArray  # port drop [Pa]
     dp_i: FloatArray  # chamber drop, eq. (34) [Pa]
     displacement: FloatArray  # q_t n [m^3/s]
-    flat_clearance: FloatArray  # Q_Lfg, eq. (1) [m^3/s]
-    commutation: FloatArray  # Q_C, eq. (5) [m^3/s]
-    pressure_speed: FloatArray  # dQ_fc + dQ_dch + dQ_b, eqs. (11)-(13) [m^3/s]
-    inertia: FloatArray  # dQ_id, eq. (14) [m^3/s]
     clearance: FloatArray  # h, eq. (2) [m]
     clearance_satellites: float  # h_S [m]
     h_exponent: float  # Q_Lfg ~ h^(3/(2-beta)), eq. (1) [-]
     hs_exponent: float  # Q_C ~ h_S^C_2, eq. (5) [-]
     nu_exponent_lfg: float  # Q_Lfg ~ nu^(-beta/(2-beta)), eq. (1) [-]
     nu_exponent_c: float  # Q_C ~ nu^(-gamma), eq. (5) [-]
+    components: tuple[Component, ...] = ()  # the fitted parts of Q_vl, one factor each
+    nuisance: Mapping[str, FloatArray] = field(default_factory=dict)  # name -> x (SI), fitted
+    # linearly without a prior in every fit (e.g. dp/dt of a time series)
 
     @property
     def loss(self) -> FloatArray:
@@ -55,27 +74,45 @@ class LossParts:
         """Return the number of points."""
         return int(self.flow.size)
 
+    @property
+    def names(self) -> tuple[str, ...]:
+        """Return the components' factor names."""
+        return tuple(c.name for c in self.components)
+
+    def with_nuisance(self, nuisance: Mapping[str, FloatArray]) -> LossParts:
+        """Return these parts with nuisance regressors (name -> x at the points, SI) added."""
+        for name, x in nuisance.items():
+            if np.shape(x) != self.flow.shape or not np.all(np.isfinite(x)):
+                msg = f'nuisance regressor {name!r}: need {self.flow.size} finite values'
+                raise IdentificationError(msg)
+        return replace(self, nuisance={**self.nuisance, **nuisance})
+
 
 NO_EFFECT = Modifier()
 """The model as it is."""
 
 
-def predict_flow(parts: LossParts, scales: FloatArray, mod: Modifier = NO_EFFECT) -> FloatArray:
+def predict_flow(parts: LossParts, scales: FloatArray, mod: Modifier = NO_EFFECT,
+                 nuisance: FloatArray | None = None) -> FloatArray:
     r"""
-    Predict the measured flow from the scaled components and an effect, eq. (36).
+    Predict the measured flow from the scaled components and the effects, eq. (36).
 
-    .. math:: Q_m = G_Q\left[\frac{q_t n_m}{G_n} + s_L(Q_{Lfg} \phi_L + Q_C \phi_C)
-        + s_C \frac{\Delta Q_{C}}{G_n} + \frac{s_{id}\,\Delta Q_{id}}{\sqrt{G_n}}
-        + Q_{add}\right] + b
+    .. math:: Q_m = G_Q\left[\frac{q_t n_m}{G_n} + \sum_j s_j \frac{\sum_k \phi_{jk}
+        Q_{jk}}{G_n^{e_j}} + Q_{add} + \sum_l \beta_l x_l\right] + b
+
+    For eqs. (31)-(33) the components are the leakage s_L (Q_Lfg phi_L + Q_C phi_C),
+    s_C dQ_C / G_n and s_id dQ_id / sqrt(G_n).
 
     Parameters
     ----------
     parts : LossParts
         Components at the measured points, [-]
     scales : ndarray
-        Factors on the leakage, C and C_id, [-]
+        Factors on the components, in their order, [-]
     mod : Modifier
-        The effect's gains, factors and extra terms, [-]
+        The effects' gains, factors and extra terms, [-]
+    nuisance : ndarray, optional
+        Coefficients beta of the nuisance regressors, in their order, [SI]
 
     Returns
     -------
@@ -83,12 +120,12 @@ def predict_flow(parts: LossParts, scales: FloatArray, mod: Modifier = NO_EFFECT
         Predicted measured flow, [m^3/s]
 
     """
-    g = mod.speed_gain
-    inner = (parts.displacement / g
-             + scales[0] * (parts.flat_clearance * mod.flat_clearance
-                            + parts.commutation * mod.commutation)
-             + scales[1] * parts.pressure_speed / g
-             + scales[2] * parts.inertia / np.sqrt(g) + mod.additive)
+    inner = parts.displacement / mod.speed_gain + mod.additive
+    for scale, component in zip(scales, parts.components):
+        inner = inner + scale * component.flow(mod)
+    if nuisance is not None:
+        for beta, x in zip(nuisance, parts.nuisance.values()):
+            inner = inner + beta * x
     return mod.flow_gain * inner + mod.offset
 
 
@@ -134,13 +171,20 @@ def loss_parts(model: MotorModel, table: BenchTable) -> tuple[LossParts, np.ndar
     n, dpi = speed[usable], dp_i[usable]
     losses = model.breakdown(n, dpi)
     beta = coef.beta
+    pressure_speed = losses.compressibility + losses.deformation + losses.backlash
+    components = (
+        Component('leakage_scale', (('flat_clearance', losses.flat_clearance),
+                                    ('commutation', losses.commutation)), 0.0, 0.0,
+                  'A_1 (eq. 1) and C_1 (eq. 5)'),
+        Component('c_scale', (('', pressure_speed),), 1.0,
+                  model.c_fc_beta / model.c if model.c > 0 else 0.0, 'C (eq. 33)'),
+        Component('c_id_scale', (('', losses.inertia),), 0.5, 0.0, 'C_id (eq. 14)'))
     parts = LossParts(
         flow=flow[usable].copy(), speed=n.copy(), dp=dp[usable].copy(), dp_i=dpi.copy(),
         displacement=model.geometry.displacement * n,
-        flat_clearance=losses.flat_clearance, commutation=losses.commutation,
-        pressure_speed=losses.compressibility + losses.deformation + losses.backlash,
-        inertia=losses.inertia, clearance=clearance_height(dpi, d.h0, d.compliance),
+clearance=clearance_height(dpi, d.h0, d.compliance),
         clearance_satellites=model.geometry.clearance_satellites,
         h_exponent=3.0 / (2.0 - beta), hs_exponent=coef.c2,
-        nu_exponent_lfg=-beta / (2.0 - beta), nu_exponent_c=-coef.gamma)
+        nu_exponent_lfg=-beta / (2.0 - beta), nu_exponent_c=-coef.gamma,
+        components=components)
     return parts, usable

@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: Apache-2.0
 """
-Calibration end to end: steady points, baseline fit, candidate selection, refit.
+Calibration end to end: steady points, baseline fit, forward selection of effects, refit.
 
 The pieces stay apart (PySINDy style): :mod:`.candidates` builds the
 library, :mod:`.fit` fits, :mod:`.selection` chooses; this module only
@@ -18,11 +18,14 @@ from satmotor_ros.identify.candidates import build_library, Candidate
 from satmotor_ros.identify.errors import DataError, IdentificationError
 from satmotor_ros.identify.fit import check_identifiable, FitReport
 from satmotor_ros.identify.parts import loss_parts, LossParts, predict_flow
-from satmotor_ros.identify.selection import CrossValidatedSelector, Errors, Selection
+from satmotor_ros.identify.selection import (CrossValidatedSelector, Errors, Forward, Score,
+                                             Selection)
 from satmotor_ros.identify.steady import extract_steady, looks_like_series, SteadyTolerance
 from satmotor_ros.identify.table import BenchTable
 from satmotor_ros.model import load_motor, MotorModel, MotorSpec
+from satmotor_ros.model.effects import Effect
 from satmotor_ros.model.revolutions import sampled_revolutions
+from satmotor_ros.model.units import LPM
 from satmotor_ros.model.viscosity import standard_law, ViscosityLaw
 
 Mode = Literal['auto', 'points', 'series']
@@ -36,6 +39,7 @@ class Options:
     n_folds: int = 5  # cross-validation folds [-]
     min_gain: float = 0.05  # least cut of the cross-validated error [-]
     tie: float = 0.05  # near-tie margin of cross-validated error [-]
+    max_effects: int = 4  # most effects the forward selection adds [-]
     mode: Mode = 'auto'  # rows are steady points, a time series, or decide from the data
     seed: int = 0  # fold shuffle [-]
     steady: SteadyTolerance = field(default_factory=SteadyTolerance)
@@ -53,17 +57,96 @@ class Calibration:
     law: ViscosityLaw  # the liquid's viscosity-temperature law
     candidates: tuple[Candidate, ...]  # the library built for the data
     skipped: tuple[str, ...]  # candidates not offered, and why
-    selection: Selection  # ranking and choice
+    forward: Forward  # every step of the forward selection, the final model, the outliers
     baseline: FitReport  # the model refitted without an effect
-    final: FitReport  # the model refitted with the chosen effect (or the baseline)
+    final: FitReport  # the model refitted with every effect found (or the baseline)
     error_packaged: Errors  # the packaged model, in sample
-    error_before: Errors  # baseline, out of sample
-    error_after: Errors  # with the effect, out of sample
+    error_before: Errors  # baseline, out of sample (outliers left out)
+    error_after: Errors  # with every effect, out of sample (outliers left out)
+    rows: np.ndarray | None  # row of the table each point came from (None: a time series)
 
     @property
-    def chosen(self) -> Candidate | None:
-        """Return the chosen effect's candidate, or None."""
-        return self.selection.chosen.candidate if self.selection.chosen else None
+    def selection(self) -> Selection:
+        """Return the first step of the forward selection (the first effect, or none)."""
+        return self.forward.steps[0]
+
+    @property
+    def found(self) -> tuple[Score, ...]:
+        """Return the effects found, in order."""
+        return self.forward.found
+
+    @property
+    def chosen(self) -> Score | None:
+        """Return the first effect found (its ``effect`` and ``label`` as fitted), or None."""
+        return self.found[0] if self.found else None
+
+    def effects(self) -> tuple[Effect, ...]:
+        """Return the effects found at their fitted values, in order (for the YAML)."""
+        return tuple(e for _, e in self.forward.final.fit.found())
+
+    @property
+    def inliers(self) -> np.ndarray:
+        """Return which points are not outliers under the final model."""
+        return ~self.forward.outliers
+
+    def errors(self, score: Score) -> Errors:
+        """Return a score's out-of-sample errors at the points that are not outliers."""
+        at = self.inliers
+        return Errors.of(score.cv_error[at], self.parts.loss[at])
+
+    def effect_rows(self) -> list[dict[str, Any]]:
+        """
+        Describe each effect found, in order, for ``calibration.json``.
+
+        Returns
+        -------
+        list of dict
+            effect, regressor, coefficient, ci95, unit, p_value and error_after (of
+            its step); expression and exponents of a term, threshold of a threshold.
+
+        """
+        rows = []
+        position = len(self.parts.components) + len(self.parts.nuisance)
+        for score, effect in zip(self.found, self.effects()):
+            candidate = score.candidate
+            value, ci95 = _coefficient_interval(self.final, position, candidate)
+            row: dict[str, Any] = {
+                'effect': effect.name if candidate.shape else candidate.effect,
+                'regressor': effect.regressor if candidate.shape else candidate.regressor,
+                'coefficient': _round(value), 'ci95': [_round(v) for v in ci95],
+                'unit': candidate.unit, 'p_value': float(f'{score.p_value:.3g}'),
+                'error_after': self.errors(score).as_dict()}
+            if effect.kind == 'term':
+                row['expression'] = effect.suffix
+                row['exponents'] = {k: _round(effect.option(k)) for k in ('dp', 'n')}
+                row['exponents_ci95'] = {
+                    s_.name.split()[0]: [_round(v) for v in self.final.ci95[position + 1 + j]]
+                    for j, s_ in enumerate(candidate.shape)}
+            if effect.kind == 'threshold':
+                row['threshold'] = {'regressor': 'dp', 'value': _round(effect.reference),
+                                    'unit': 'Pa',
+                                    'ci95': [_round(v) for v in self.final.ci95[position + 1]]}
+                row['exponent'] = _round(effect.option('exponent'))
+            rows.append(row)
+            position += 1 + len(candidate.shape)
+        return rows
+
+    def outlier_rows(self) -> list[dict[str, Any]]:
+        """Return each outlier: row (or time), measured flow and residual [l/min]."""
+        out = []
+        residual = self.parts.flow - self.forward.final.fit.predict(self.parts)
+        time = self.table.channels.get('time')
+        for i in np.flatnonzero(self.forward.outliers):
+            row: dict[str, Any] = {}
+            if self.rows is not None:
+                row['row'] = int(self.rows[i])
+            if time is not None:
+                row['time'] = _round(time[i])
+            row.update(flow_lpm=_round(self.parts.flow[i] / LPM),
+                       residual_lpm=_round(residual[i] / LPM),
+                       noise_sd=_round(abs(residual[i]) / self.forward.sigma[i]))
+            out.append(row)
+        return out
 
     def summary(self) -> dict[str, Any]:
         """
@@ -73,30 +156,52 @@ class Calibration:
         -------
         dict
             liquid, n_points, effect, regressor, coefficient, ci95, unit,
-            error_before, error_after, candidates. With no effect, regressor,
-            coefficient, ci95 and unit are null.
+            error_before, error_after, effects, outliers, candidates. The
+            top-level effect fields are those of the first effect; with no
+            effect, regressor, coefficient, ci95 and unit are null.
 
         """
-        chosen = self.chosen
-        coefficient = ci95 = None
-        if chosen is not None:
-            coefficient = _round(self.final.values[3])
-            ci95 = [_round(v) for v in self.final.ci95[3]]
+        effects = self.effect_rows()
+        first = effects[0] if effects else {}
         ranked = [self.selection.baseline, *self.selection.ranking]
         ranked.sort(key=lambda s: s.cv_rmse)
         return {
             'liquid': self.liquid, 'n_points': len(self.parts),
-            'effect': chosen.effect if chosen else 'none',
-            'regressor': chosen.regressor if chosen else None,
-            'coefficient': coefficient, 'ci95': ci95,
-            'unit': chosen.unit if chosen else None,
+            'effect': first.get('effect', 'none'), 'regressor': first.get('regressor'),
+            'coefficient': first.get('coefficient'), 'ci95': first.get('ci95'),
+            'unit': first.get('unit'),
             'error_before': self.error_before.as_dict(),
             'error_after': self.error_after.as_dict(),
+            'effects': effects, 'outliers': self.outlier_rows(),
             'candidates': [
-                {'effect': s.candidate.effect if s.candidate else 'none',
-                 'regressor': s.candidate.regressor if s.candidate else None,
-                 'cv_rmse_lpm': _round(s.cv_rmse / 1.0e-3 * 60.0)} for s in ranked],
+                {'effect': s.effect, 'regressor': s.candidate.regressor if s.candidate else None,
+                 'cv_rmse_lpm': _round(s.cv_rmse / LPM)} for s in ranked],
         }
+
+
+def _coefficient_interval(report: FitReport, position: int,
+                          candidate: Candidate) -> tuple[float, tuple[float, float]]:
+    """Return an effect's coefficient as written and its 95 % interval (delta method)."""
+    size = 1 + len(candidate.shape)
+    values = report.values[position:position + size]
+    if not candidate.shape:
+        return float(values[0]), tuple(float(v) for v in report.ci95[position])
+    cov = report.covariance[position:position + size, position:position + size]
+    sd = np.sqrt(np.maximum(np.diag(cov), 0.0))
+    t = (report.ci95[position, 1] - values[0]) / max(sd[0], 1e-300)
+
+    def coefficient(x: np.ndarray) -> float:
+        return candidate.as_effect(*x).coefficient
+
+    grad = np.empty(size)
+    for j in range(size):
+        h = 1e-6 * max(abs(values[j]), sd[j], 1e-12)
+        step = np.zeros(size)
+        step[j] = h
+        grad[j] = (coefficient(values + step) - coefficient(values - step)) / (2 * h)
+    value = coefficient(values)
+    half = t * float(np.sqrt(max(grad @ cov @ grad, 0.0)))
+    return value, (value - half, value + half)
 
 
 def _round(x: float) -> float:
@@ -145,10 +250,6 @@ def steady_points(table: BenchTable, mode: Mode = 'auto',
                                table.notes + ('revolutions integrated from speed between '
                                               'the rows (trapezoid)',))
     return table
-
-
-def _errors(parts: LossParts, error: np.ndarray) -> Errors:
-    return Errors.of(error, parts.loss)
 
 
 def _without_effects(spec: MotorSpec, liquid: str,
@@ -202,29 +303,39 @@ def calibrate(table: BenchTable, liquid: str = 'oil', spec: MotorSpec | None = N
     spec, table = _without_effects(spec, liquid, table)
     model = MotorModel.from_spec(spec, liquid)
     points = steady_points(table, options.mode, options.steady)
+    rows = _source_rows(table, points)
     parts, usable = loss_parts(model, points)
     if not usable.all():
         points = points.select(usable, f'left out {int((~usable).sum())} points outside the '
                                        'model (no forward flow, negative speed or chamber '
                                        'drop out of range)')
+        rows = None if rows is None else rows[usable]
     check_identifiable(parts)
     law = standard_law(model.liquid, liquid)
     channels = {**points.channels, 'p_out': points.p_out}
     candidates, skipped = build_library(parts, channels, law)
-    c_floor = model.c_fc_beta / model.c if model.c > 0 else 0.0
     selector = CrossValidatedSelector(options.alpha, options.n_folds, options.min_gain,
-                                      options.tie, 'time' in points.channels, c_floor,
-                                      options.seed)
-    selection = selector.select(parts, candidates)
-    baseline = selection.baseline.fit.report()
-    chosen = selection.chosen
-    final = chosen.fit.report() if chosen is not None else baseline
-    packaged = parts.flow - predict_flow(parts, np.ones(3))
-    before = _errors(parts, selection.baseline.cv_error)
-    after = _errors(parts, chosen.cv_error) if chosen is not None else before
+                                      options.tie, 'time' in points.channels, options.seed,
+                                      options.max_effects)
+    forward = selector.select(parts, candidates)
+    first = forward.steps[0]
+    packaged_error = parts.flow - predict_flow(parts, np.ones(len(parts.components)))
+    at = ~forward.outliers
     return Calibration(liquid, spec, model, points, parts, law, tuple(candidates),
-                       tuple(skipped), selection, baseline, final,
-                       _errors(parts, packaged), before, after)
+                       tuple(skipped), forward, first.baseline.fit.report(),
+                       forward.final.fit.report(),
+                       Errors.of(packaged_error[at], parts.loss[at]),
+                       Errors.of(first.baseline.cv_error[at], parts.loss[at]),
+                       Errors.of(forward.final.cv_error[at], parts.loss[at]), rows)
+
+
+def _source_rows(table: BenchTable, points: BenchTable) -> np.ndarray | None:
+    """Return the table row of each point (sorted by time as :func:`steady_points` does)."""
+    if len(points) != len(table) or table.time_series:
+        return None
+    if 'time' in table.channels:
+        return np.argsort(table.channels['time'], kind='stable')
+    return np.arange(len(table))
 
 
 __all__ = ['Calibration', 'IdentificationError', 'Options', 'calibrate', 'steady_points']

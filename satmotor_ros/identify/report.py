@@ -11,13 +11,15 @@ from types import ModuleType
 import numpy as np
 
 from satmotor_ros.identify.output import effect_block, fitted_coefficients
-from satmotor_ros.identify.parts import LossParts, SCALES
+from satmotor_ros.identify.parts import LossParts
 from satmotor_ros.identify.pipeline import Calibration
 from satmotor_ros.identify.table import BenchTable
 from satmotor_ros.model import MotorModel
 from satmotor_ros.model._typing import FloatArray
-from satmotor_ros.model.effects import TERMS
 from satmotor_ros.model.units import LPM, MPA, RPM
+
+UNSEPARABLE = 0.95
+"""|correlation| of two fitted parameters beyond which the data cannot tell them apart."""
 
 _UNITS = {'time': ('s', 1.0), 'revolutions': ('rev', 1.0), 'temperature': ('degC', 1.0),
           'p_case': ('MPa', MPA), 'p_out': ('MPa', MPA), 'p_in': ('MPa', MPA)}
@@ -54,16 +56,6 @@ def channel_axes(parts: LossParts, table: BenchTable) -> dict[str, FloatArray]:
         unit, scale = _UNITS.get(name, (table.units.get(name, '') or '-', 1.0))
         if np.all(np.isfinite(x)):
             out[f'{name} [{unit}]'] = x / scale
-    return out
-
-
-def _regressors(cal: Calibration) -> dict[str, FloatArray]:
-    """Map ``'label [unit]'`` to the channels (:func:`channel_axes`) and a chosen term."""
-    parts = cal.parts
-    out = channel_axes(parts, cal.table)
-    chosen = cal.chosen
-    if chosen is not None and chosen.effect.startswith('term:'):
-        out[f'{chosen.regressor} [SI]'] = TERMS[chosen.regressor][0](parts.speed, parts.dp_i)
     return out
 
 
@@ -108,11 +100,12 @@ def plot_residual_grid(axes_data: dict[str, FloatArray], residuals: dict[str, Fl
 def _plot_residuals(cal: Calibration, path: Path) -> None:
     """Plot the out-of-sample residual of Q_vl against each regressor, before and after."""
     residuals = {'before (no effect)': cal.selection.baseline.cv_error}
-    chosen = cal.selection.chosen
-    if chosen is not None:
-        residuals[f'after ({chosen.label})'] = chosen.cv_error
-    plot_residual_grid(_regressors(cal), residuals, 'Out-of-sample residual of the volumetric '
-                       'losses against each regressor', path)
+    labels = []
+    for score in cal.found:
+        labels.append(score.label)
+        residuals[f'after {" + ".join(labels)}'] = score.cv_error
+    plot_residual_grid(channel_axes(cal.parts, cal.table), residuals, 'Out-of-sample residual '
+                       'of the volumetric losses against each regressor', path)
 
 
 def _fitted_model(cal: Calibration) -> MotorModel:
@@ -150,10 +143,10 @@ def _plot_characteristics(cal: Calibration, path: Path) -> None:
     measured = parts.loss / LPM
     before = measured - cal.selection.baseline.cv_error / LPM
     right.plot(measured, before, 'o', ms=3, alpha=0.6, label='before (no effect)')
-    if cal.selection.chosen is not None:
-        after = measured - cal.selection.chosen.cv_error / LPM
+    if cal.found:
+        after = measured - cal.forward.final.cv_error / LPM
         right.plot(measured, after, 'o', ms=3, alpha=0.6,
-                   label=f'after ({cal.selection.chosen.label})')
+                   label=f'after ({" + ".join(s.label for s in cal.found)})')
     lim = [min(measured.min(), before.min()), max(measured.max(), before.max())]
     right.plot(lim, lim, 'k-', lw=0.8)
     right.set_xlabel('measured Q_vl [l/min]')
@@ -172,7 +165,7 @@ def _plot_ranking(cal: Calibration, path: Path) -> None:
     fig, ax = plt.subplots(figsize=(8, 0.35 * len(ranking) + 1.5))
     labels = [s.label for s in ranking][::-1]
     values = [s.cv_rmse / LPM for s in ranking][::-1]
-    chosen = cal.chosen.label if cal.chosen else None
+    chosen = cal.found[0].label if cal.found else None
     runner = cal.selection.runner_up.label if cal.selection.runner_up else None
     colors = ['tab:orange' if lab == chosen else 'tab:olive' if lab == runner else 'tab:blue'
               for lab in labels]
@@ -198,6 +191,62 @@ def _table(rows: list[list[str]], header: list[str]) -> str:
     return '\n'.join(lines)
 
 
+def _errors_row(name: str, e: object) -> list[str]:
+    return [name, f'{e.rmse_lpm:.4g}', f'{e.mean_abs_pct:.3g}', f'{e.max_abs_lpm:.4g}']
+
+
+def _steps(cal: Calibration) -> list[str]:
+    """The forward selection step by step: the verdicts and the error after each effect."""
+    lines = []
+    for i, step in enumerate(cal.forward.steps, 1):
+        lines.append(f'{i}. {step.verdict}.')
+    rows = [_errors_row('packaged model (in sample)', cal.error_packaged),
+            _errors_row('fitted, no effect', cal.error_before)]
+    names = []
+    for score in cal.found:
+        names.append(f'`{score.label}`')
+        rows.append(_errors_row(f'+ {" + ".join(names)}', cal.errors(score)))
+    header = ['model', 'RMSE [l/min]', 'mean abs [% of mean Q_vl]', 'max abs [l/min]']
+    return lines + ['', _table(rows, header), '',
+                    'Errors are of the volumetric losses Q_vl = Q - q_t n, out of sample '
+                    f'({min(5, len(cal.parts))}-fold cross-validation), at the points that '
+                    'are not outliers.']
+
+
+def _outliers(cal: Calibration, summary: dict) -> list[str]:
+    rows = summary['outliers']
+    sigma = cal.forward.sigma / LPM
+    lines = ['## Outliers and noise', '',
+             f'Noise of the measured flow estimated from the residuals: {np.min(sigma):.3g} to '
+             f'{np.max(sigma):.3g} l/min (a floor plus a share of the reading). Each step weighs '
+             "the points by it and by Huber's loss, and leaves out the points that are "
+             'outliers even under its best-fitting model.', '']
+    if not rows:
+        return lines + ['No outlier.', '']
+    keys = list(rows[0])
+    return lines + [_table([[str(r[k]) for k in keys] for r in rows], keys), '',
+                    'These points decide nothing: they are left out of the fits and the '
+                    'error figures.', '']
+
+
+def _identifiability(cal: Calibration) -> list[str]:
+    """The fitted parameters' correlations and the pairs the data cannot separate."""
+    names = cal.final.names
+    corr = cal.final.correlation
+    lines = ['## Identifiability', '', 'Correlations of the fitted parameters (final fit):', '',
+             _table([[f'`{n}`'] + [f'{v:+.2f}' for v in row] for n, row in zip(names, corr)],
+                    ['', *[f'`{n}`' for n in names]]), '']
+    pairs = [(names[i], names[j], corr[i, j]) for i in range(len(names))
+             for j in range(i + 1, len(names)) if abs(corr[i, j]) > UNSEPARABLE]
+    if not pairs:
+        return lines + [f'No pair is correlated beyond |r| = {UNSEPARABLE}: the data separate '
+                        'every fitted parameter.', '']
+    lines += [f'The data cannot separate these pairs (|r| > {UNSEPARABLE}): each trades off '
+              'against the other, so only their combination is determined; measure where they '
+              'differ (e.g. speed and pressure varied independently) to tell them apart.', '']
+    return lines + [f'- `{a}` and `{b}`: r = {r:+.3f}' for a, b, r in pairs] + ['']
+
+
 def write_report(cal: Calibration, out: Path, summary: dict[str, object]) -> Path:
     """
     Write ``report.md`` and its three PNG plots into `out`.
@@ -220,48 +269,42 @@ def write_report(cal: Calibration, out: Path, summary: dict[str, object]) -> Pat
     for name, plot in PLOTS.items():
         plot(cal, out / f'{name}.png')
     sel = cal.selection
+    found = ', '.join(f'`{s.label}`' for s in cal.found) or '`none`'
     lines = [f'# Calibration of {cal.spec.name} on {cal.liquid}', '',
              f'Data: `{cal.table.source}`, {len(cal.parts)} steady operating points.']
     lines += [f'- {note}' for note in cal.table.notes]
-    lines += ['', '## Result', '', f'**Effect: `{summary["effect"]}`** — {sel.verdict}.', '']
-    if sel.runner_up is not None:
-        lines += [f'Runner-up: `{sel.runner_up.label}`. The two explain the data almost '
-                  'equally well; believe the choice only as far as the physics of your bench '
-                  'supports it.', '']
-    before, after = cal.error_before, cal.error_after
-    lines += [_table([
-        ['packaged model (in sample)', f'{cal.error_packaged.rmse_lpm:.4g}',
-         f'{cal.error_packaged.mean_abs_pct:.3g}', f'{cal.error_packaged.max_abs_lpm:.4g}'],
-        ['fitted, no effect (out of sample)', f'{before.rmse_lpm:.4g}',
-         f'{before.mean_abs_pct:.3g}', f'{before.max_abs_lpm:.4g}'],
-        ['fitted with the effect (out of sample)', f'{after.rmse_lpm:.4g}',
-         f'{after.mean_abs_pct:.3g}', f'{after.max_abs_lpm:.4g}']],
-        ['model', 'RMSE [l/min]', 'mean abs [% of mean Q_vl]', 'max abs [l/min]']), '',
-        'Errors are of the volumetric losses Q_vl = Q - q_t n, by '
-        f'{min(5, len(cal.parts))}-fold cross-validation.', '', '## Fitted coefficients', '',
-        'Factors on the packaged values (95 % confidence intervals from the Jacobian; the fit '
-        'has a weak prior that each factor is 1 ± 0.3):', '']
-    rows = []
-    for name, value, (lo, hi) in zip(cal.final.names, cal.final.values, cal.final.ci95):
-        rows.append([name, f'{value:.5g}', f'[{lo:.5g}, {hi:.5g}]'])
-    lines += [_table(rows, ['coefficient', 'value', 'ci95']), '']
-    lines += ['`leakage_scale` multiplies A_1 (eq. 1) and C_1 (eq. 5), `c_scale` C (eq. 33), '
-              '`c_id_scale` C_id (eq. 14). The other coefficients of Table 1 are not '
-              'identifiable from Q, n and dp and keep their packaged values.', '']
-    lines += ['## Candidates', '', _table(
+    lines += ['', '## Result', '', f'**Effects: {found}**, found one after the other:', '']
+    lines += _steps(cal) + ['']
+    for step in cal.forward.steps:
+        if step.runner_up is not None:
+            lines += [f'Runner-up of `{step.chosen.label}`: `{step.runner_up.label}`. The two '
+                      'explain the data almost equally well; believe the choice only as far as '
+                      'the physics of your bench supports it.', '']
+    lines += ['## Fitted coefficients', '',
+              'Factors on the packaged values, then the effects (95 % confidence intervals from '
+              'the Jacobian; the fit has a weak prior that each factor is 1 ± 0.3):', '']
+    rows = [[name, f'{value:.5g}', f'[{lo:.5g}, {hi:.5g}]']
+            for name, value, (lo, hi) in zip(cal.final.names, cal.final.values, cal.final.ci95)]
+    lines += [_table(rows, ['parameter', 'value', 'ci95']), '']
+    lines += [f'`{c.name}` multiplies {c.describes or c.name}.' for c in cal.parts.components]
+    lines += ['The other coefficients of Table 1 are not identifiable from Q, n and dp and keep '
+              'their packaged values.', '']
+    lines += _identifiability(cal) + _outliers(cal, summary)
+    lines += ['## Candidates of the first step', '', _table(
         [[f'`{s.label}`', f'{s.cv_rmse / LPM:.4g}', f'{s.p_value:.2g}',
           f'{s.fit.effect_coefficient:.4g} {s.candidate.unit if s.candidate else ""}']
          for s in sel.ranking],
-        ['candidate', 'CV RMSE [l/min]', 'p (F-test)', 'coefficient']), '',
-        f'No effect: CV RMSE {sel.baseline.cv_rmse / LPM:.4g} l/min. An effect is accepted '
-        f'when p < {sel.alpha:g}/{len(sel.ranking)} (Bonferroni) and it cuts the CV error by '
-        'more than 5 %.', '']
+        ['candidate', 'CV error [l/min]', 'p (F-test)', 'coefficient']), '',
+        f'No effect: CV error {sel.baseline.cv_rmse / LPM:.4g} l/min (noise-weighted, through '
+        f"Huber's loss). An effect is accepted when p < {sel.alpha:g}/{len(sel.ranking)} "
+        '(Bonferroni) and it cuts the CV error by more than 5 %; then the loop tests the '
+        'rest on top of it.', '']
     lines += ['Library:', ''] + [f'- {c.description}' for c in cal.candidates]
     if cal.skipped:
         lines += ['', 'Not tested:', ''] + [f'- {why}' for why in cal.skipped]
     block = effect_block(cal)
     if block:
-        lines += ['', '## The effect in `coefficients.yaml`', '', '```json',
+        lines += ['', '## The effects in `coefficients.yaml`', '', '```json',
                   json.dumps(block, indent=2), '```']
     lines += ['', '## Plots', '']
     for name in PLOTS:
@@ -272,4 +315,4 @@ def write_report(cal: Calibration, out: Path, summary: dict[str, object]) -> Pat
     return path
 
 
-__all__ = ['PLOTS', 'SCALES', 'channel_axes', 'plot_residual_grid', 'pyplot', 'write_report']
+__all__ = ['PLOTS', 'channel_axes', 'plot_residual_grid', 'pyplot', 'write_report']

@@ -1,19 +1,30 @@
 # SPDX-License-Identifier: Apache-2.0
 """
-Model selection: which candidate effect, if any, the data ask for.
+Model selection: which candidate effects, if any, the data ask for, one after the other.
 
-Each candidate is refitted with the model and scored by its K-fold
-cross-validated error (contiguous, time-ordered folds for data in time
-order, seeded shuffled folds otherwise). The best candidate is accepted
-only if it passes two tests against the baseline (the model refitted
-without any effect): a nested-model F-test at the significance ``alpha``,
-Bonferroni-corrected for the number of candidates tried, and a cut of the
-cross-validated error by at least ``min_gain``. Otherwise the answer is
-``none``. A runner-up that passes the same tests is reported as a near tie
-when its cross-validated error is within ``tie`` of the winner's, or when it
-removes all but ``tie`` of the error the winner removes (on data with little
-noise both errors left are tiny, and their ratio means nothing); among the
-first kind a named physical effect goes before ``channel:`` and ``term:``.
+Forward selection: each step refits every candidate not yet found on top of
+the effects found so far and scores it by its K-fold cross-validated error
+(contiguous, time-ordered folds for data in time order, seeded shuffled folds
+otherwise). The best candidate is accepted only if it passes two tests
+against the step's baseline (the model with the effects found so far): a
+nested-model F-test at the significance ``alpha``, Bonferroni-corrected for
+the number of candidates tried, and a cut of the cross-validated error by at
+least ``min_gain``. The loop stops at the first step whose best candidate
+fails; the answer is then the effects found, or ``none``. A runner-up that
+passes the same tests is reported as a near tie when its cross-validated
+error is within ``tie`` of the winner's, or when it removes all but ``tie``
+of the error the winner removes (on data with little noise both errors left
+are tiny, and their ratio means nothing); among the first kind a named
+physical effect goes before ``channel:``, ``term:`` and ``threshold:``, and
+before a fitted form that beats it by less than :data:`FORM_TIE` of the error
+removed (a form with free exponents bends towards anything).
+
+Every step weighs the points by a noise model estimated from the residuals
+of the step's best-fitting model (:mod:`.noise`): the F-test and the
+cross-validated error are those of standardised residuals, through Huber's
+loss, and the points that are outliers even under that model are left out of
+the step's fits, so that a bad row decides nothing, while a point that an
+effect explains is never mistaken for one.
 """
 
 from __future__ import annotations
@@ -24,7 +35,8 @@ from dataclasses import dataclass
 import numpy as np
 from satmotor_ros.identify.candidates import Candidate
 from satmotor_ros.identify.errors import IdentificationError
-from satmotor_ros.identify.fit import LossFit
+from satmotor_ros.identify.fit import HUBER, LossFit
+from satmotor_ros.identify.noise import noise_model, outliers, robust_scale
 from satmotor_ros.identify.parts import LossParts
 from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.units import LPM
@@ -67,42 +79,70 @@ class Errors:
         return {k: float(f'{v:.4g}') for k, v in vars(self).items()}
 
 
+FORM_TIE = 0.1
+"""A named effect goes before a fitted form (``term:``, ``threshold:``) that beats it when it
+removes all but this share of the error the form removes, [-]."""
+
+
 @dataclass(frozen=True)
 class Score:
-    """One candidate (or the baseline) fitted, cross-validated and tested."""
+    """One candidate (or a step's baseline) fitted, cross-validated and tested."""
 
-    candidate: Candidate | None  # None: the baseline
-    fit: LossFit  # fitted on all points
-    cv_error: FloatArray  # out-of-sample error of Q_vl at each point [m^3/s]
-    cv_rmse: float  # [m^3/s]
-    p_value: float  # F-test against the baseline (1 for the baseline) [-]
+    candidate: Candidate | None  # None: the step's baseline (the effects found before)
+    fit: LossFit  # fitted on the step's points
+    cv_error: FloatArray  # out-of-sample error of Q_vl at every point [m^3/s]
+    cv_rmse: float  # noise-weighted, robust cross-validated error [m^3/s]
+    p_value: float  # F-test against the step's baseline (1 for the baseline) [-]
 
     @property
     def label(self) -> str:
-        """Return the candidate's label, or ``'none'`` for the baseline."""
-        return self.candidate.label if self.candidate is not None else 'none'
+        """Return the effect as found (a fitted form by its expression), or ``'none'``."""
+        if self.candidate is None:
+            return 'none'
+        if self.candidate.shape:
+            return self.fit.found()[-1][1].name
+        return self.candidate.label
 
     @property
     def effect(self) -> str:
-        """Return the candidate's effect, or ``'none'`` for the baseline."""
-        return self.candidate.effect if self.candidate is not None else 'none'
+        """Return the effect id as found, or ``'none'`` for the baseline."""
+        if self.candidate is None:
+            return 'none'
+        return self.label if self.candidate.shape else self.candidate.effect
 
 
 @dataclass(frozen=True)
 class Selection:
-    """The outcome of model selection."""
+    """The outcome of one step of forward selection."""
 
-    baseline: Score  # the model refitted without any effect
+    baseline: Score  # the model with the effects found before this step
     ranking: tuple[Score, ...]  # candidates, best cross-validated error first
-    chosen: Score | None  # the accepted effect, or None
+    chosen: Score | None  # the accepted effect, or None (the loop stops)
     runner_up: Score | None  # a near tie of the chosen effect, or None
     verdict: str  # why the effect was accepted or not, one sentence
     alpha: float  # family-wise significance level [-]
+    sigma: FloatArray  # noise model of the step at every point [m^3/s]
+    left_out: np.ndarray  # bool: outliers even under the step's best model, not fitted
+
+
+@dataclass(frozen=True)
+class Forward:
+    """The outcome of forward selection: the steps, the final model and its outliers."""
+
+    steps: tuple[Selection, ...]  # every step; the last one chose nothing (or hit the limit)
+    final: Score  # the model with every effect found
+    sigma: FloatArray  # noise model of the last step [m^3/s]
+    outliers: np.ndarray  # bool: beyond the outlier limit under the final model
+
+    @property
+    def found(self) -> tuple[Score, ...]:
+        """Return the accepted effects' scores, in the order found."""
+        return tuple(s.chosen for s in self.steps if s.chosen is not None)
 
 
 def priority(effect: str) -> int:
     """
-    Rank a candidate's kind for near ties: named effects, then channels, then terms.
+    Rank a candidate's kind for near ties: named effects, then channels, then fitted forms.
 
     Parameters
     ----------
@@ -112,10 +152,17 @@ def priority(effect: str) -> int:
     Returns
     -------
     int
-        0 for a named physical effect, 1 for ``channel:``, 2 for ``term:``.
+        0 for a named effect, 1 for ``channel:``, 2 for ``term:`` and ``threshold:``.
 
     """
-    return 2 if effect.startswith('term:') else int(effect.startswith('channel:'))
+    return 2 if effect.startswith(('term:', 'threshold:')) else int(effect.startswith('channel:'))
+
+
+def same_effect(a: Candidate, b: Candidate) -> bool:
+    """Return whether two candidates are one effect: a kind once, a listed suffix once."""
+    def key(c: Candidate) -> str:
+        return c.effect.partition(':')[0] if c.shape or ':' not in c.effect else c.effect
+    return key(a) == key(b)
 
 
 def folds(n: int, k: int, time_ordered: bool, seed: int = 0) -> list[np.ndarray]:
@@ -145,12 +192,12 @@ def folds(n: int, k: int, time_ordered: bool, seed: int = 0) -> list[np.ndarray]
 
 class CrossValidatedSelector:
     """
-    Rank candidate effects by cross-validated error and accept one only if significant.
+    Add candidate effects one by one while one cuts the cross-validated error significantly.
 
     Parameters
     ----------
     alpha : float
-        Family-wise significance level of the F-tests, [-]
+        Family-wise significance level of each step's F-tests, [-]
     n_folds : int
         Number of cross-validation folds, [-]
     min_gain : float
@@ -160,16 +207,16 @@ class CrossValidatedSelector:
         counts as a near tie (of the winner's error, or of the error it removes), [-]
     time_ordered : bool
         Whether the points are in time order (contiguous folds), [-]
-    c_floor : float
-        Smallest factor on C (see :class:`LossFit`), [-]
     seed : int
         Seed of the fold shuffle, [-]
+    max_effects : int
+        Most effects the loop adds, [-]
 
     """
 
     def __init__(self, alpha: float = 0.05, n_folds: int = 5, min_gain: float = 0.05,
-                 tie: float = 0.05, time_ordered: bool = False, c_floor: float = 0.0,
-                 seed: int = 0) -> None:
+                 tie: float = 0.05, time_ordered: bool = False, seed: int = 0,
+                 max_effects: int = 4) -> None:
         """Validate and store the hyperparameters."""
         if not 0.0 < alpha < 1.0:
             msg = f'alpha = {alpha!r}: must be in (0, 1)'
@@ -177,26 +224,33 @@ class CrossValidatedSelector:
         if n_folds < 2:
             msg = f'n_folds = {n_folds!r}: must be >= 2'
             raise IdentificationError(msg)
-        if not 0.0 <= min_gain < 1.0 or tie < 0.0:
-            msg = f'min_gain = {min_gain!r}, tie = {tie!r}: need 0 <= min_gain < 1, tie >= 0'
+        if not 0.0 <= min_gain < 1.0 or tie < 0.0 or max_effects < 1:
+            msg = (f'min_gain = {min_gain!r}, tie = {tie!r}, max_effects = {max_effects!r}: '
+                   'need 0 <= min_gain < 1, tie >= 0, max_effects >= 1')
             raise IdentificationError(msg)
         self.alpha, self.n_folds, self.min_gain, self.tie = alpha, n_folds, min_gain, tie
-        self.time_ordered, self.c_floor, self.seed = time_ordered, c_floor, seed
-        self.noise_ = 0.0
+        self.time_ordered, self.seed, self.max_effects = time_ordered, seed, max_effects
 
-    def score(self, parts: LossParts, candidate: Candidate | None,
-              baseline_rss: float | None = None) -> Score:
+    def score(self, parts: LossParts, effects: Sequence[Candidate], sigma: FloatArray,
+              index: np.ndarray, start: FloatArray | None = None,
+              baseline: Score | None = None) -> Score:
         """
-        Fit one candidate on all points and on each training fold.
+        Fit a model on the points in `index` and on each training fold of them.
 
         Parameters
         ----------
         parts : LossParts
             Components at the points, [-]
-        candidate : Candidate or None
-            The effect; None scores the baseline, [-]
-        baseline_rss : float, optional
-            RSS of the baseline, for the F-test, [(m^3/s)^2]
+        effects : sequence of Candidate
+            The effects found so far, then the candidate (none for a baseline), [-]
+        sigma : ndarray
+            Noise at every point, [m^3/s]
+        index : ndarray of int
+            The points fitted (outliers left out), [-]
+        start : ndarray, optional
+            Initial values (a fit of the model without the candidate, or with it), [-]
+        baseline : Score, optional
+            The step's baseline, for the F-test; None scores a baseline, [-]
 
         Returns
         -------
@@ -204,38 +258,60 @@ class CrossValidatedSelector:
             The fit, its out-of-sample errors and its p-value.
 
         """
-        full = LossFit(candidate, self.c_floor, self.noise_).fit(parts)
-        n = len(parts)
-        error = np.empty(n)
-        everything = np.arange(n)
-        for test in folds(n, self.n_folds, self.time_ordered, self.seed):
-            train = np.setdiff1d(everything, test, assume_unique=True)
-            model = LossFit(candidate, self.c_floor, self.noise_).fit(parts, train)
-            error[test] = parts.flow[test] - model.predict(parts, test)
+        full = LossFit(effects, sigma, HUBER).fit(parts, index, start)
+        error = parts.flow - full.predict(parts)  # out of sample where not fitted
+        for test in folds(index.size, self.n_folds, self.time_ordered, self.seed):
+            u = full.without(test)
+            error[index[test]] = parts.flow[index[test]] - full.predict(parts, index[test], u)
+        z = error[index] / sigma[index]
+        rho = np.where(np.abs(z) <= HUBER, z * z, 2.0 * HUBER * np.abs(z) - HUBER ** 2)
+        cv = float(np.sqrt(np.mean(rho) * np.mean(sigma[index] ** 2)))
         p_value = 1.0
-        if candidate is not None and baseline_rss is not None:
-            dof = n - full.n_params
-            if dof > 0 and full.rss_ > 0.0:
-                f = max(baseline_rss - full.rss_, 0.0) / (full.rss_ / dof)
-                p_value = float(special.fdtrc(1, dof, f))
-            elif baseline_rss > full.rss_:
+        if baseline is not None:
+            q = full.n_params - baseline.fit.n_params
+            dof = index.size - full.n_params
+            drop = max(baseline.fit.objective_ - full.objective_, 0.0)
+            if dof > 0 and full.objective_ > 0.0:
+                p_value = float(special.fdtrc(q, dof, drop / q / (full.objective_ / dof)))
+            elif drop > 0.0:
                 p_value = 0.0
-        return Score(candidate, full, error, float(np.sqrt(np.mean(error ** 2))), p_value)
+        return Score(effects[-1] if baseline is not None else None, full, error, cv, p_value)
 
     def _passes(self, score: Score, baseline: Score, m: int) -> bool:
         return (score.p_value < self.alpha / m
                 and score.cv_rmse < (1.0 - self.min_gain) * baseline.cv_rmse)
 
-    def select(self, parts: LossParts, candidates: Sequence[Candidate]) -> Selection:
+    def _noise(self, parts: LossParts, found: tuple[Candidate, ...], pool: Sequence[Candidate],
+               start: FloatArray | None) -> tuple[FloatArray, np.ndarray, list[LossFit]]:
+        """Estimate the step's noise and outliers from its best-fitting model."""
+        floor = 1e-9 * float(np.max(np.abs(parts.flow)))
+        everything = np.arange(len(parts))
+        plain = LossFit(found).fit(parts, start=start)
+        scale = max(robust_scale(parts.flow - plain.predict(parts), plain.n_params), floor)
+        base = LossFit(found, scale, HUBER).fit(parts, start=plain.u_)
+        scale = max(robust_scale(parts.flow - base.predict(parts), base.n_params), floor)
+        fits = [LossFit((*found, c), scale, HUBER).fit(parts, everything, base.u_)
+                for c in pool]
+        best = min([base, *fits], key=lambda f: f.objective_)
+        residual = parts.flow - best.predict(parts)
+        sigma = noise_model(residual, parts.flow, best.n_params, floor)
+        return sigma, outliers(residual, sigma), fits
+
+    def step(self, parts: LossParts, found: tuple[Candidate, ...],
+             pool: Sequence[Candidate], start: FloatArray | None) -> Selection:
         """
-        Score the baseline and every candidate, and choose.
+        Test every candidate of `pool` on top of the effects `found`, and choose.
 
         Parameters
         ----------
         parts : LossParts
             Components at the points, [-]
-        candidates : sequence of Candidate
-            The library built for these data, [-]
+        found : tuple of Candidate
+            Effects found in the steps before, [-]
+        pool : sequence of Candidate
+            Candidates still to test, [-]
+        start : ndarray, optional
+            The fit of the model with `found`, to start from, [-]
 
         Returns
         -------
@@ -243,27 +319,35 @@ class CrossValidatedSelector:
             Ranking, choice, runner-up and the reason.
 
         """
-        free = LossFit(None, self.c_floor).fit(parts)
-        self.noise_ = float(np.sqrt(free.rss_ / max(len(parts) - free.n_params, 1)))
-        baseline = self.score(parts, None)
-        scores = [self.score(parts, c, baseline.fit.rss_) for c in candidates]
+        sigma, left_out, first = self._noise(parts, found, pool, start)
+        index = np.flatnonzero(~left_out)
+        baseline = self.score(parts, found, sigma, index, start)
+        scores = [self.score(parts, (*found, c), sigma, index, f.u_, baseline)
+                  for c, f in zip(pool, first)]
         ranking = tuple(sorted(scores, key=lambda s: s.cv_rmse))
-        m = max(len(candidates), 1)
+        m = max(len(pool), 1)
+        done = Selection(baseline, ranking, None, None, '', self.alpha, sigma, left_out)
         if not ranking:
-            return Selection(baseline, ranking, None, None, 'no candidate could be tested',
-                             self.alpha)
+            return _with_verdict(done, 'no candidate could be tested')
         top = ranking[0]
         gain = 1.0 - top.cv_rmse / baseline.cv_rmse if baseline.cv_rmse > 0 else 0.0
         if not self._passes(top, baseline, m):
-            verdict = (f'none: the best candidate, {top.label}, cuts the cross-validated '
-                       f'error by {100 * gain:.1f} % (need > {100 * self.min_gain:.0f} %) with '
-                       f'p = {top.p_value:.2g} (need < {self.alpha:g}/{m})')
-            return Selection(baseline, ranking, None, None, verdict, self.alpha)
+            return _with_verdict(done, (
+                f'{"none" if not found else "no further effect"}: the best candidate, '
+                f'{top.label}, cuts the cross-validated error by {100 * gain:.1f} % (need > '
+                f'{100 * self.min_gain:.0f} %) with p = {top.p_value:.2g} (need < '
+                f'{self.alpha:g}/{m})'))
         removed = baseline.cv_rmse - top.cv_rmse
         close = [s for s in ranking if self._passes(s, baseline, m) and (
             s.cv_rmse <= (1.0 + self.tie) * top.cv_rmse
             or s.cv_rmse - top.cv_rmse <= self.tie * removed)]
         contenders = [s for s in close if s.cv_rmse <= (1.0 + self.tie) * top.cv_rmse]
+        if priority(top.effect) == 2:  # a fitted form bends to anything: a named effect that
+            # removes nearly as much goes first (the form stays the runner-up)
+            named = [s for s in ranking if priority(s.effect) < 2 and self._passes(s, baseline, m)
+                     and s.cv_rmse - top.cv_rmse <= FORM_TIE * removed]
+            contenders += named
+            close += [s for s in named if s not in close]
         best = min(contenders, key=lambda s: (priority(s.effect), s.cv_rmse))
         # a runner-up also when it removes nearly all the error the winner removes: on data
         # with little noise the two errors left are both tiny and far apart in ratio
@@ -274,10 +358,65 @@ class CrossValidatedSelector:
         verdict = (f'{best.label}: cuts the cross-validated error by {100 * gain:.1f} %, '
                    f'p = {best.p_value:.2g} < {self.alpha:g}/{m}')
         if runner is not None:
-            runner_gain = 1.0 - runner.cv_rmse / baseline.cv_rmse
-            verdict += (f'; near tie with {runner.label} (cross-validated error '
-                        f'{100 * (runner.cv_rmse / best.cv_rmse - 1):+.1f} %, it cuts the '
-                        f'error by {100 * runner_gain:.1f} %): the data barely tell them apart')
-            if priority(runner.effect) > priority(best.effect):
-                verdict += ', and a named physical effect goes before a generic term'
-        return Selection(baseline, ranking, best, runner, verdict, self.alpha)
+            verdict += _tie(best, runner, baseline)
+        return Selection(baseline, ranking, best, runner, verdict, self.alpha, sigma, left_out)
+
+    def select(self, parts: LossParts, candidates: Sequence[Candidate]) -> Forward:
+        """
+        Add effects while the best remaining candidate passes the tests.
+
+        Parameters
+        ----------
+        parts : LossParts
+            Components at the points, [-]
+        candidates : sequence of Candidate
+            The library built for these data, [-]
+
+        Returns
+        -------
+        Forward
+            The steps, the final model and its outliers.
+
+        """
+        found: tuple[Candidate, ...] = ()
+        steps: list[Selection] = []
+        start = None
+        while True:
+            pool = [c for c in candidates if not any(same_effect(c, f) for f in found)]
+            step = self.step(parts, found, pool, start)
+            steps.append(step)
+            if step.chosen is None:
+                break
+            found = (*found, step.chosen.candidate)
+            start = step.chosen.fit.u_
+            if len(found) >= self.max_effects:
+                break
+        # the model as accepted (the last step only re-weighs it to test what is left)
+        final = steps[-1].chosen or (steps[-2].chosen if len(steps) > 1 else steps[-1].baseline)
+        residual = parts.flow - final.fit.predict(parts)
+        sigma = steps[-1].sigma
+        return Forward(tuple(steps), final, sigma, outliers(residual, sigma))
+
+
+def _with_verdict(step: Selection, verdict: str) -> Selection:
+    return Selection(step.baseline, step.ranking, step.chosen, step.runner_up, verdict,
+                     step.alpha, step.sigma, step.left_out)
+
+
+def _tie(best: Score, runner: Score, baseline: Score) -> str:
+    """Say that two effects explain the data almost equally well, and what that means."""
+    runner_gain = 1.0 - runner.cv_rmse / baseline.cv_rmse
+    text = (f'; near tie with {runner.label} (cross-validated error '
+            f'{100 * (runner.cv_rmse / best.cv_rmse - 1):+.1f} %, it cuts the error by '
+            f'{100 * runner_gain:.1f} %): the data barely tell them apart')
+    kinds = {priority(best.effect), priority(runner.effect)}
+    sensor = [s.label for s in (best, runner) if s.effect.endswith(('sensor_gain',
+                                                                   'sensor_offset'))]
+    if sensor and 2 in kinds:
+        form = best if priority(best.effect) == 2 else runner
+        text += (f', so an instrument error ({sensor[0]}) and a loss of the motor '
+                 f'({form.label}) explain the data equally well: check the instrument '
+                 f'against a reference before recalibrating it')
+    elif priority(runner.effect) > priority(best.effect):
+        text += ', and a named physical effect goes before a generic term'
+    return text

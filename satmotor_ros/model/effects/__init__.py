@@ -18,7 +18,8 @@ defines ``KIND = MyKind()`` (doc/effects.md). The kinds shipped:
 ``clearance_wear``         h_R and h_S grow by k (x - reference) >= 0, x = ``time`` [s]
                            or ``revolutions`` [rev], in eqs. (1), (2) and (5)
 ``channel:<name>``         extra loss k (x - reference) in Q_vl, x the channel <name>
-``term:<expression>``      extra loss k f(n, dp_i) in Q_vl, f one of :data:`TERMS`
+``term:<expression>``      extra loss k dp_i^a n^b in Q_vl, the exponents fitted
+``threshold:dp``           extra loss k max(0, dp_i - x_c)^e in Q_vl (a valve cracking open)
 ``flow_sensor_offset``     the flowmeter reads Q + k
 ``flow_sensor_gain``       the flowmeter reads (1 + k) Q
 ``speed_sensor_gain``      the speed sensor reads (1 + k) n
@@ -41,8 +42,7 @@ from satmotor_ros.model._typing import Real
 from satmotor_ros.model.effects._base import (Candidate, CandidateData, Conditions,
                                               CORE_CHANNELS, DOCUMENTARY, Effect, EffectKind,
                                               KINDS, Modifier, PlantInjection, PlantParameter,
-                                              SensorError, Synthetic)
-from satmotor_ros.model.effects.term import TERMS
+                                              SensorError, Shape, Synthetic)
 from satmotor_ros.model.errors import ConfigError
 
 if TYPE_CHECKING:
@@ -385,7 +385,7 @@ SENSOR_KINDS = tuple(k.name for k in ranked() if k.sensor)
 
 __all__ = ['Candidate', 'CandidateData', 'Conditions', 'Effect', 'EffectKind', 'KINDS',
            'Modifier', 'PlantInjection', 'PlantParameter', 'SENSOR_KINDS', 'SensorError',
-           'Synthetic', 'TERMS', 'build_candidates', 'check_effects', 'effect_from_mapping',
+           'Shape', 'Synthetic', 'build_candidates', 'check_effects', 'effect_from_mapping',
            'effect_to_mapping', 'flow_reading', 'kind_of', 'plant_injection', 'ranked',
            'register', 'sensor_error', 'true_flow', 'true_speed', 'unregister',
            'with_effects']

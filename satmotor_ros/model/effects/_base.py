@@ -116,6 +116,24 @@ class Modifier:
     additive: FloatArray | float = 0.0  # extra loss [m^3/s]
     offset: float = 0.0  # flowmeter offset [m^3/s]
 
+    def __add__(self, other: Modifier) -> Modifier:
+        """Compose two effects: gains and factors multiply, extra losses and offsets add."""
+        return Modifier(self.flow_gain * other.flow_gain, self.speed_gain * other.speed_gain,
+                        self.flat_clearance * other.flat_clearance,
+                        self.commutation * other.commutation, self.additive + other.additive,
+                        self.offset + other.offset)
+
+
+@dataclass(frozen=True)
+class Shape:
+    """A parameter of a candidate's form fitted with its coefficient (an exponent, a threshold)."""
+
+    name: str  # e.g. 'dp exponent'
+    starts: tuple[float, ...]  # initial values the fit tries
+    bounds: tuple[float, float]  # range, in the fitted units
+    unit: str = '-'  # of the physical value
+    to_unit: tuple[float, float] = (0.0, 1.0)  # physical value = [0] + [1] * fitted value
+
 
 @dataclass(frozen=True)
 class Candidate:
@@ -126,11 +144,12 @@ class Candidate:
     unit: str  # unit of the coefficient
     source: str  # the physics or standard the term comes from
     values: FloatArray  # the regressor at each point (SI), for plots
-    modify: Callable[[float], Modifier]  # coefficient -> modified prediction
+    modify: Callable[..., Modifier]  # (coefficient, *shape) -> modified prediction
     typical: float  # coefficient magnitude that changes the loss by ~1 l/min
     bounds: tuple[float, float] = (-np.inf, np.inf)  # physical range of the coefficient
     start: float = 0.0  # initial coefficient of the fit
-    make: Callable[[float], Effect] | None = None  # coefficient -> the effect, for the YAML
+    make: Callable[..., Effect] | None = None  # (coefficient, *shape) -> the effect (YAML)
+    shape: tuple[Shape, ...] = ()  # parameters of the form fitted with the coefficient
 
     @property
     def label(self) -> str:
@@ -144,10 +163,10 @@ class Candidate:
         """Return ``label [unit] (source)``, one line for reports."""
         return f'{self.label} [{self.unit}] ({self.source})'
 
-    def as_effect(self, coefficient: float) -> Effect:
-        """Return the effect this candidate stands for at a fitted coefficient."""
+    def as_effect(self, coefficient: float, *shape: float) -> Effect:
+        """Return the effect this candidate stands for at a fitted coefficient (and shape)."""
         if self.make is not None:
-            return self.make(coefficient)
+            return self.make(coefficient, *shape)
         return Effect(self.effect, coefficient, self.regressor)
 
 
@@ -211,6 +230,7 @@ class Synthetic(NamedTuple):
     dp_i: FloatArray  # chamber drop of the model without the effect [Pa]
     channels: Mapping[str, FloatArray]  # time [s], temperature [degC], p_case [Pa], ...
     law: ViscosityLaw  # the liquid's standard viscosity law
+    shape: tuple[tuple[str, float], ...] = ()  # kind-specific numbers (a threshold, ...)
 
 
 @dataclass(frozen=True)
@@ -456,5 +476,5 @@ def additive(effect: str, regressor: str, unit: str, source: str, x: FloatArray,
 
 
 __all__ = ['Candidate', 'CandidateData', 'Conditions', 'Effect', 'EffectKind', 'KINDS',
-           'Modifier', 'PlantInjection', 'PlantParameter', 'SensorError', 'Synthetic',
+           'Modifier', 'PlantInjection', 'PlantParameter', 'SensorError', 'Shape', 'Synthetic',
            'additive', 'finite', 'maker', 'per_unit', 'varies', 'why_not']

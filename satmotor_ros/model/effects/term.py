@@ -1,71 +1,169 @@
 # SPDX-License-Identifier: Apache-2.0
-"""``term:<expression>``: an extra loss k f(n, dp_i) in Q_vl, f one of :data:`TERMS`."""
+"""``term:<expression>``: an extra loss k dp_i^a n^b in Q_vl, the exponents fitted."""
 
 from __future__ import annotations
 
 from collections.abc import Mapping
+import re
 from typing import Any
 
 import numpy as np
 
-from satmotor_ros.model._typing import Real
-from satmotor_ros.model.effects._base import (additive, Candidate, CandidateData, Effect,
-                                              EffectKind, Loss, maker)
+from satmotor_ros.model._typing import FloatArray, Real
+from satmotor_ros.model.effects._base import (Candidate, CandidateData, Effect, EffectKind,
+                                              finite, Loss, Modifier, Shape)
 from satmotor_ros.model.errors import ConfigError
 
-TERMS: Mapping[str, tuple[Loss, str]] = {
-    'n^2': (lambda n, dp: n ** 2, 'm^3/s/(rad/s)^2'),
-    'n^1.5': (lambda n, dp: n ** 1.5, 'm^3/s/(rad/s)^1.5'),
-    'dp^2': (lambda n, dp: dp ** 2, 'm^3/s/Pa^2'),
-    'dp^0.5': (lambda n, dp: dp ** 0.5, 'm^3/s/Pa^0.5'),
-    'dp^2*n': (lambda n, dp: dp ** 2 * n, 'm^3/s/(Pa^2*rad/s)'),
-    'dp*n^2': (lambda n, dp: dp * n ** 2, 'm^3/s/(Pa*(rad/s)^2)'),
-    'dp*n^0.5': (lambda n, dp: dp * n ** 0.5, 'm^3/s/(Pa*(rad/s)^0.5)'),
-    'dp^0.5*n': (lambda n, dp: dp ** 0.5 * n, 'm^3/s/(Pa^0.5*rad/s)'),
-}
-"""
-Functions of speed n [rad/s] and chamber drop dp = dp_i [Pa] that eqs. (31)-(33) lack.
+FORMS = (('dp',), ('n',), ('dp', 'n'))
+"""The candidates offered: dp_i^a, n^b and dp_i^a n^b, each with its exponents fitted."""
 
-Left out on purpose, as the model or a named effect already has them: 1
-(flowmeter offset), n (sensor gains), n^0.5 (C_id, eq. 14), dp*n (C, eq. 33)
-and dp (the leakage of eqs. 1 and 5 is close to linear in dp).
-"""
+BOUNDS = {'dp': (0.05, 4.0), 'n': (0.05, 3.0)}
+"""Range of each fitted exponent, [-]."""
+
+_FACTOR = re.compile(r'(dp|n)(?:\^([0-9.]+))?')
+
+
+def expression(a: float, b: float) -> str:
+    """
+    Write dp^a n^b as an id suffix: 2 significant digits, a power of 1 bare, of 0 left out.
+
+    Parameters
+    ----------
+    a, b : float
+        Exponents of dp_i and n, [-]
+
+    Returns
+    -------
+    str
+        E.g. ``'dp^0.76'``, ``'dp^3*n'``, ``'n^0.7'``.
+
+    """
+    parts = []
+    for name, power in (('dp', a), ('n', b)):
+        text = f'{power:.2g}'
+        if text not in ('0', '-0'):
+            parts.append(name if text == '1' else f'{name}^{text}')
+    return '*'.join(parts) or '1'
+
+
+def exponents(suffix: str, where: str) -> tuple[float, float]:
+    """
+    Read the exponents of dp and n from an expression such as ``'dp^2*n'``.
+
+    Parameters
+    ----------
+    suffix : str
+        The expression, [-]
+    where : str
+        Key path quoted in errors, [-]
+
+    Returns
+    -------
+    tuple of float
+        a (of dp_i) and b (of n), [-]
+
+    Raises
+    ------
+    ConfigError
+        If the expression is not a product of powers of dp and n.
+
+    """
+    powers = {'dp': 0.0, 'n': 0.0}
+    for factor in suffix.split('*'):
+        match = _FACTOR.fullmatch(factor.strip())
+        if match is None or powers[match.group(1)] != 0.0:
+            msg = (f'{where}: term {suffix!r} is not a product of powers of dp and n '
+                   "(e.g. 'dp^0.76', 'dp^2*n', 'n^0.7')")
+            raise ConfigError(msg)
+        powers[match.group(1)] = float(match.group(2) or 1.0)
+    return powers['dp'], powers['n']
+
+
+def _variables(a: float, b: float) -> str:
+    return '*'.join(name for name, p in (('dp', a), ('n', b)) if p)
+
+
+def power_of(effect: Effect) -> tuple[float, float]:
+    """Return an effect's exponents (a of dp_i, b of n): its options, or read from its id."""
+    if effect.option('dp') is not None:
+        return float(effect.option('dp')), float(effect.option('n', 0.0))
+    return exponents(effect.suffix, effect.name)
 
 
 class Term(EffectKind):
-    """A loss term the paper's eqs. (31)-(33) lack."""
+    """A loss k dp_i^a n^b that the paper's eqs. (31)-(33) lack, the exponents fitted."""
 
     name = 'term'
     suffixed = True
     rank = 80
-    source = 'not in eqs. (31)-(33)'
-    evaluation = ('extra loss k f(n [rad/s], dp [Pa]) added to Q_vl (eq. 31), dp the chamber '
-                  'drop dp_i of eq. (34)')
+    keys = ('regressor', 'coefficient', 'exponents')
+    unit = 'm^3/s per Pa^a (rad/s)^b'
+    source = 'not in eqs. (31)-(33), exponents fitted'
+    evaluation = ('extra loss k |dp|^a |n|^b added to Q_vl (eq. 31): n [rad/s], dp [Pa] the '
+                  'chamber drop dp_i of eq. (34), a and b the exponents')
 
-    def regressor(self, suffix: str, value: Any, where: str) -> str:
-        """Read the expression of the name's suffix, one of :data:`TERMS`."""
-        if suffix not in TERMS:
-            msg = f'{where}: unknown term {suffix!r} (known: {", ".join(TERMS)})'
-            raise ConfigError(msg)
-        return suffix
+    def parse(self, name: str, doc: Mapping[str, Any], where: str) -> Effect:
+        """Read the coefficient and the exponents (``exponents:``, or the id's expression)."""
+        a, b = exponents(name.partition(':')[2], where)
+        given = doc.get('exponents')
+        if given is not None:
+            if not isinstance(given, Mapping) or set(map(str, given)) - {'dp', 'n'}:
+                msg = f'{where}.exponents = {given!r}: expected a mapping with dp and n'
+                raise ConfigError(msg)
+            a = finite(given.get('dp', 0.0), f'{where}.exponents.dp')
+            b = finite(given.get('n', 0.0), f'{where}.exponents.n')
+            if expression(a, b) != name.partition(':')[2]:
+                msg = (f'{where}.exponents = {dict(given)!r}: the id says '
+                       f'{name.partition(":")[2]!r}, these give {expression(a, b)!r}')
+                raise ConfigError(msg)
+        k = finite(doc['coefficient'], f'{where}.coefficient')
+        return Effect(name, k, _variables(a, b), options=(('dp', a), ('n', b)))
+
+    def to_mapping(self, effect: Effect) -> dict[str, Any]:
+        """Write the coefficient and the exponents."""
+        a, b = power_of(effect)
+        return {'regressor': _variables(a, b), 'coefficient': effect.coefficient,
+                'exponents': {'dp': a, 'n': b}}
 
     def loss(self, effect: Effect) -> Loss | None:
-        """Return k f(n, dp_i)."""
-        f, k = TERMS[effect.suffix][0], effect.coefficient
+        """Return k |dp_i|^a |n|^b."""
+        a, b = power_of(effect)
+        k = effect.coefficient
 
         def loss(n: Real, dp_i: Real) -> Real:
-            return k * f(n, dp_i)
+            return k * abs(dp_i) ** a * abs(n) ** b
         return loss
 
     def candidates(self, data: CandidateData) -> tuple[list[Candidate], list[str]]:
-        """Offer every expression of :data:`TERMS`."""
-        out = []
-        for expression, (f, unit) in TERMS.items():
-            x = np.asarray(f(data.parts.speed, data.parts.dp_i), dtype=float)
-            name = f'{self.name}:{expression}'
-            out.append(additive(name, expression, unit, self.source, x,
-                                make=maker(name, expression)))
-        return out, []
+        """Offer dp_i^a, n^b and dp_i^a n^b, k the extra loss at the largest dp_i and n."""
+        dp = np.abs(data.parts.dp_i) / max(float(np.max(np.abs(data.parts.dp_i))), 1e-300)
+        n = np.abs(data.parts.speed) / max(float(np.max(np.abs(data.parts.speed))), 1e-300)
+        ref = {'dp': float(np.max(np.abs(data.parts.dp_i))),
+               'n': float(np.max(np.abs(data.parts.speed)))}
+        columns = {'dp': dp, 'n': n}
+        return [self._candidate(form, columns, ref) for form in FORMS], []
+
+    def _candidate(self, form: tuple[str, ...], columns: Mapping[str, FloatArray],
+                   ref: Mapping[str, float]) -> Candidate:
+        def powers(theta: tuple[float, ...]) -> dict[str, float]:
+            return {'dp': 0.0, 'n': 0.0, **dict(zip(form, theta))}
+
+        def modify(k: float, *theta: float) -> Modifier:
+            x = 1.0
+            for name, p in zip(form, theta):
+                x = x * columns[name] ** p
+            return Modifier(additive=k * x)
+
+        def make(k: float, *theta: float) -> Effect:
+            p = powers(theta)
+            coefficient = k / ref['dp'] ** p['dp'] / ref['n'] ** p['n']
+            return Effect(f'{self.name}:{expression(p["dp"], p["n"])}', coefficient,
+                          _variables(p['dp'], p['n']), options=(('dp', p['dp']), ('n', p['n'])))
+
+        shape = tuple(Shape(f'{name} exponent', (0.5, 2.0), BOUNDS[name]) for name in form)
+        label = '*'.join(f'{name}^{"ab"[("dp", "n").index(name)]}' for name in form)
+        return Candidate(f'{self.name}:{label}', '*'.join(form), self.unit, self.source,
+                         columns[form[0]], modify, 1.0e-3 / 60.0, make=make, shape=shape)
 
 
 KIND = Term()

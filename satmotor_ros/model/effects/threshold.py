@@ -1,0 +1,97 @@
+# SPDX-License-Identifier: Apache-2.0
+"""``threshold:dp``: an extra loss k max(0, dp_i - x_c)^e in Q_vl, a valve that cracks open."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from satmotor_ros.model._typing import Real
+from satmotor_ros.model.effects._base import (Candidate, CandidateData, Effect, EffectKind,
+                                              finite, Loss, Modifier, Shape, Synthetic)
+from satmotor_ros.model.errors import ConfigError
+
+MIN_ABOVE = 0.15
+"""Least share of the points (and at least 4) above a fitted threshold, [-]."""
+
+EXPONENTS = (0.5, 3.0)
+"""Range of the fitted exponent e, [-]."""
+
+
+class Threshold(EffectKind):
+    """A flow that starts above a pressure drop: a relief or bypass valve cracking open."""
+
+    name = 'threshold'
+    suffixed = True
+    rank = 85
+    keys = ('regressor', 'coefficient', 'reference', 'exponent')
+    required = ('coefficient', 'reference')
+    unit = 'm^3/s per Pa^e'
+    source = 'a valve that cracks open (relief, bypass)'
+    evaluation = ('extra loss k max(0, dp - reference)^exponent added to Q_vl (eq. 31), dp '
+                  '[Pa] the chamber drop dp_i of eq. (34), reference the cracking drop [Pa]')
+
+    def regressor(self, suffix: str, value: Any, where: str) -> str:
+        """Read the regressor of the id's suffix: ``dp``."""
+        if suffix != 'dp' or value not in (None, 'dp'):
+            msg = f'{where}: a threshold reads the pressure drop: use threshold:dp'
+            raise ConfigError(msg)
+        return suffix
+
+    def parse(self, name: str, doc: Mapping[str, Any], where: str) -> Effect:
+        """Read k, the cracking drop and the exponent (default 1, > 0)."""
+        regressor = self.regressor(name.partition(':')[2], doc.get('regressor'), where)
+        exponent = finite(doc.get('exponent', 1.0), f'{where}.exponent')
+        if exponent <= 0.0:
+            msg = f'{where}.exponent = {exponent!r}: must be > 0'
+            raise ConfigError(msg)
+        return Effect(name, finite(doc['coefficient'], f'{where}.coefficient'), regressor,
+                      finite(doc['reference'], f'{where}.reference'),
+                      options=(('exponent', exponent),))
+
+    def to_mapping(self, effect: Effect) -> dict[str, Any]:
+        """Write k, the cracking drop and the exponent."""
+        return {'regressor': effect.regressor, 'coefficient': effect.coefficient,
+                'reference': effect.reference, 'exponent': effect.option('exponent', 1.0)}
+
+    def loss(self, effect: Effect) -> Loss | None:
+        """Return k max(0, |dp_i| - x_c)^e."""
+        k, x_c, e = effect.coefficient, effect.reference, effect.option('exponent', 1.0)
+
+        def loss(n: Real, dp_i: Real) -> Real:
+            return k * np.maximum(abs(dp_i) - x_c, 0.0) ** e
+        return loss
+
+    def candidates(self, data: CandidateData) -> tuple[list[Candidate], list[str]]:
+        """Offer a threshold within the data, with enough points above it, k >= 0."""
+        dp = np.abs(data.parts.dp_i)
+        above = max(4, int(np.ceil(MIN_ABOVE * dp.size)))
+        ordered = np.sort(dp)
+        if dp.size < 2 * above:
+            return [], [f'{self.name}:dp: too few points to place a threshold']
+        low, high = float(ordered[above // 2]), float(ordered[-above])
+        top = float(ordered[-1])
+
+        def modify(k: float, x_c: float, e: float) -> Modifier:
+            return Modifier(additive=k * (np.maximum(dp - x_c, 0.0) / (top - x_c)) ** e)
+
+        def make(k: float, x_c: float, e: float) -> Effect:
+            return Effect(f'{self.name}:dp', k / (top - x_c) ** e, 'dp', x_c,
+                          options=(('exponent', e),))
+
+        shape = (Shape('threshold', (0.3, 0.7), (0.0, 1.0), 'Pa', (low, high - low)),
+                 Shape('exponent', (1.0,), EXPONENTS))
+        return [Candidate(f'{self.name}:dp', 'dp', self.unit, self.source, dp, modify,
+                          1.0e-3 / 60.0, (0.0, np.inf), 0.1e-3 / 60.0, make, shape)], []
+
+    def scaled(self, name: str, magnitude: float, regressor: str, data: Synthetic) -> Effect:
+        """Inject `magnitude` [m^3/s] at the largest drop; ``reference``, ``exponent`` in shape."""
+        shape = dict(data.shape)
+        x_c, e = shape['reference'], shape.get('exponent', 1.0)
+        peak = float(np.max(np.maximum(np.abs(data.dp_i) - x_c, 0.0) ** e))
+        return Effect(name, magnitude / max(peak, 1e-300), 'dp', x_c, options=(('exponent', e),))
+
+
+KIND = Threshold()
