@@ -198,7 +198,8 @@ class LossFit:
         return predict_flow(parts, u[:self.m_], self._modifier(u),
                             u[self.m_:self.m_ + q] * self.typical_ if q else None)
 
-    def _starts(self, parts: LossParts, start: FloatArray | None) -> tuple[list, list, list]:
+    def _starts(self, parts: LossParts, start: FloatArray | None
+                ) -> tuple[list[float], list[float], list[FloatArray]]:
         lower = [c.floor for c in parts.components] + [-np.inf] * self.typical_.size
         upper = [SCALE_MAX] * self.m_ + [np.inf] * self.typical_.size
         base = [max(1.0, c.floor + 1e-6) for c in parts.components] + [0.0] * self.typical_.size

@@ -97,7 +97,7 @@ def effect_block(cal: Calibration) -> dict[str, Any]:
     block = {}
     for effect, row, score in zip(cal.effects(), cal.effect_rows(), cal.found):
         entry = effect_to_mapping(effect)
-        entry.update(unit=row['unit'], ci95=row['ci95'], source=score.candidate.source)
+        entry.update(unit=row['unit'], ci95=row['ci95'], source=score.added.source)
         entry['evaluation'] = entry.pop('evaluation')
         block[effect.name] = entry
     return block

@@ -23,6 +23,7 @@ from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.effects import Modifier
 from satmotor_ros.model.losses import channel_pressure_drop, clearance_height
 
+
 @dataclass(frozen=True)
 class Component:
     """
@@ -40,7 +41,7 @@ class Component:
 
     def flow(self, mod: Modifier) -> FloatArray:
         """Return the component at factor 1 under an effect's modifier, [m^3/s]."""
-        total = 0.0
+        total = np.zeros_like(self.pieces[0][1])
         for factor, column in self.pieces:
             total = total + (getattr(mod, factor) * column if factor else column)
         return total / mod.speed_gain ** self.speed_power if self.speed_power else total
@@ -182,7 +183,7 @@ def loss_parts(model: MotorModel, table: BenchTable) -> tuple[LossParts, np.ndar
     parts = LossParts(
         flow=flow[usable].copy(), speed=n.copy(), dp=dp[usable].copy(), dp_i=dpi.copy(),
         displacement=model.geometry.displacement * n,
-clearance=clearance_height(dpi, d.h0, d.compliance),
+        clearance=clearance_height(dpi, d.h0, d.compliance),
         clearance_satellites=model.geometry.clearance_satellites,
         h_exponent=3.0 / (2.0 - beta), hs_exponent=coef.c2,
         nu_exponent_lfg=-beta / (2.0 - beta), nu_exponent_c=-coef.gamma,

@@ -67,7 +67,7 @@ class Calibration:
 
     @property
     def selection(self) -> Selection:
-        """Return the first step of the forward selection (the first effect, or none)."""
+        """Return the forward selection's first step (the first effect, or none)."""
         return self.forward.steps[0]
 
     @property
@@ -108,7 +108,7 @@ class Calibration:
         rows = []
         position = len(self.parts.components) + len(self.parts.nuisance)
         for score, effect in zip(self.found, self.effects()):
-            candidate = score.candidate
+            candidate = score.added
             value, ci95 = _coefficient_interval(self.final, position, candidate)
             row: dict[str, Any] = {
                 'effect': effect.name if candidate.shape else candidate.effect,
@@ -185,7 +185,7 @@ def _coefficient_interval(report: FitReport, position: int,
     size = 1 + len(candidate.shape)
     values = report.values[position:position + size]
     if not candidate.shape:
-        return float(values[0]), tuple(float(v) for v in report.ci95[position])
+        return float(values[0]), (float(report.ci95[position, 0]), float(report.ci95[position, 1]))
     cov = report.covariance[position:position + size, position:position + size]
     sd = np.sqrt(np.maximum(np.diag(cov), 0.0))
     t = (report.ci95[position, 1] - values[0]) / max(sd[0], 1e-300)
@@ -200,7 +200,7 @@ def _coefficient_interval(report: FitReport, position: int,
         step[j] = h
         grad[j] = (coefficient(values + step) - coefficient(values - step)) / (2 * h)
     value = coefficient(values)
-    half = t * float(np.sqrt(max(grad @ cov @ grad, 0.0)))
+    half = float(t * np.sqrt(max(float(grad @ cov @ grad), 0.0)))
     return value, (value - half, value + half)
 
 

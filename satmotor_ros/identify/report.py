@@ -7,12 +7,14 @@ from dataclasses import replace
 import json
 from pathlib import Path
 from types import ModuleType
+from typing import Any
 
 import numpy as np
 
 from satmotor_ros.identify.output import effect_block, fitted_coefficients
 from satmotor_ros.identify.parts import LossParts
 from satmotor_ros.identify.pipeline import Calibration
+from satmotor_ros.identify.selection import Errors
 from satmotor_ros.identify.table import BenchTable
 from satmotor_ros.model import MotorModel
 from satmotor_ros.model._typing import FloatArray
@@ -191,12 +193,12 @@ def _table(rows: list[list[str]], header: list[str]) -> str:
     return '\n'.join(lines)
 
 
-def _errors_row(name: str, e: object) -> list[str]:
+def _errors_row(name: str, e: Errors) -> list[str]:
     return [name, f'{e.rmse_lpm:.4g}', f'{e.mean_abs_pct:.3g}', f'{e.max_abs_lpm:.4g}']
 
 
 def _steps(cal: Calibration) -> list[str]:
-    """The forward selection step by step: the verdicts and the error after each effect."""
+    """List the forward selection's steps: the verdicts and the error after each effect."""
     lines = []
     for i, step in enumerate(cal.forward.steps, 1):
         lines.append(f'{i}. {step.verdict}.')
@@ -213,7 +215,7 @@ def _steps(cal: Calibration) -> list[str]:
                     'are not outliers.']
 
 
-def _outliers(cal: Calibration, summary: dict) -> list[str]:
+def _outliers(cal: Calibration, summary: dict[str, Any]) -> list[str]:
     rows = summary['outliers']
     sigma = cal.forward.sigma / LPM
     lines = ['## Outliers and noise', '',
@@ -230,7 +232,7 @@ def _outliers(cal: Calibration, summary: dict) -> list[str]:
 
 
 def _identifiability(cal: Calibration) -> list[str]:
-    """The fitted parameters' correlations and the pairs the data cannot separate."""
+    """Give the fitted parameters' correlations and name the pairs the data cannot separate."""
     names = cal.final.names
     corr = cal.final.correlation
     lines = ['## Identifiability', '', 'Correlations of the fitted parameters (final fit):', '',
@@ -276,7 +278,7 @@ def write_report(cal: Calibration, out: Path, summary: dict[str, object]) -> Pat
     lines += ['', '## Result', '', f'**Effects: {found}**, found one after the other:', '']
     lines += _steps(cal) + ['']
     for step in cal.forward.steps:
-        if step.runner_up is not None:
+        if step.runner_up is not None and step.chosen is not None:
             lines += [f'Runner-up of `{step.chosen.label}`: `{step.runner_up.label}`. The two '
                       'explain the data almost equally well; believe the choice only as far as '
                       'the physics of your bench supports it.', '']

@@ -104,6 +104,13 @@ class Score:
         return self.candidate.label
 
     @property
+    def added(self) -> Candidate:
+        """Return the candidate this score tested (an error for a baseline)."""
+        if self.candidate is None:
+            raise IdentificationError('a baseline adds no effect')
+        return self.candidate
+
+    @property
     def effect(self) -> str:
         """Return the effect id as found, or ``'none'`` for the baseline."""
         if self.candidate is None:
@@ -387,12 +394,13 @@ class CrossValidatedSelector:
             steps.append(step)
             if step.chosen is None:
                 break
-            found = (*found, step.chosen.candidate)
+            found = (*found, step.chosen.added)
             start = step.chosen.fit.u_
             if len(found) >= self.max_effects:
                 break
         # the model as accepted (the last step only re-weighs it to test what is left)
-        final = steps[-1].chosen or (steps[-2].chosen if len(steps) > 1 else steps[-1].baseline)
+        accepted = [s.chosen for s in steps if s.chosen is not None]
+        final = accepted[-1] if accepted else steps[0].baseline
         residual = parts.flow - final.fit.predict(parts)
         sigma = steps[-1].sigma
         return Forward(tuple(steps), final, sigma, outliers(residual, sigma))

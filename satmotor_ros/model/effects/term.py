@@ -149,7 +149,7 @@ class Term(EffectKind):
             return {'dp': 0.0, 'n': 0.0, **dict(zip(form, theta))}
 
         def modify(k: float, *theta: float) -> Modifier:
-            x = 1.0
+            x: FloatArray | float = 1.0
             for name, p in zip(form, theta):
                 x = x * columns[name] ** p
             return Modifier(additive=k * x)
