@@ -60,6 +60,9 @@ SCALE_MAX = 20.0
 HUBER = 1.345
 """Huber's constant in noise standard deviations: 95 % efficiency on Gaussian noise, [-]."""
 
+TUKEY = 4.685
+"""Tukey's biweight constant in noise standard deviations (95 % efficiency), [-]."""
+
 
 def check_identifiable(parts: LossParts) -> None:
     """
@@ -117,6 +120,27 @@ def huber_root(z: FloatArray, c: float) -> FloatArray:
     return np.where(a <= c, z, np.sign(z) * np.sqrt(np.maximum(2.0 * c * a - c * c, 0.0)))
 
 
+def tukey_root(z: FloatArray, c: float) -> FloatArray:
+    """
+    Return sign(z) sqrt(2 rho(z)), Tukey's biweight rho: a point beyond c weighs nothing.
+
+    Parameters
+    ----------
+    z : ndarray
+        Standardised residuals, [-]
+    c : float
+        Tukey's constant, [-]
+
+    Returns
+    -------
+    ndarray
+        The transformed residuals, [-]
+
+    """
+    u = np.minimum((z / c) ** 2, 1.0)
+    return np.sign(z) * c * np.sqrt((1.0 - (1.0 - u) ** 3) / 3.0)
+
+
 @dataclass(frozen=True)
 class FitReport:
     """Fitted parameters with 95 % confidence intervals and their correlations."""
@@ -149,11 +173,14 @@ class LossFit:
     robust : float
         Huber's constant applied to the standardised residuals; 0 for plain least
         squares, [-]
+    redescending : bool
+        Tukey's biweight (constant :data:`TUKEY`) instead of Huber's loss: a gross
+        outlier then pulls the fit not at all, the fit no longer convex, [-]
 
     """
 
     def __init__(self, effects: Sequence[Candidate] = (), sigma: FloatArray | float | None = None,
-                 robust: float = 0.0) -> None:
+                 robust: float = 0.0, redescending: bool = False) -> None:
         """Store the hyperparameters; nothing is fitted yet."""
         if sigma is not None and not np.all(np.asarray(sigma) > 0.0):
             msg = 'sigma: the noise must be > 0 at every point'
@@ -164,6 +191,7 @@ class LossFit:
         self.effects = tuple(effects)
         self.sigma = sigma
         self.robust = robust
+        self.redescending = redescending
 
     @property
     def candidate(self) -> Candidate | None:
@@ -252,11 +280,13 @@ class LossFit:
         sigma = np.broadcast_to(np.asarray(LPM if self.sigma is None else self.sigma,
                                            dtype=float), parts.flow.shape)[index]
         lower, upper, starts = self._starts(parts, start)
-        m, c = self.m_, self.robust
+        m, c, tukey = self.m_, self.robust, self.redescending
 
         def residual(u: FloatArray) -> FloatArray:
             z = (flow - self._predict(parts, u)[index]) / sigma
-            if c:
+            if tukey:
+                z = tukey_root(z, TUKEY)
+            elif c:
                 z = huber_root(z, c)
             return np.concatenate((z, (u[:m] - 1.0) / PRIOR_SD)) if prior else z
 
@@ -264,8 +294,8 @@ class LossFit:
         with np.errstate(all='ignore'):
             for u0 in starts:
                 result = optimize.least_squares(residual, u0, bounds=(lower, upper),
-                                                method='trf', x_scale=1.0, xtol=1e-8,
-                                                ftol=1e-8)
+                                                method='trf', x_scale=1.0, xtol=1e-6,
+                                                ftol=1e-6)
                 if np.all(np.isfinite(result.fun)) and (best is None or result.cost < best.cost):
                     best = result
         if best is None:

@@ -41,8 +41,9 @@ class Component:
 
     def flow(self, mod: Modifier) -> FloatArray:
         """Return the component at factor 1 under an effect's modifier, [m^3/s]."""
-        total = np.zeros_like(self.pieces[0][1])
-        for factor, column in self.pieces:
+        factor, total = self.pieces[0]
+        total = getattr(mod, factor) * total if factor else total
+        for factor, column in self.pieces[1:]:
             total = total + (getattr(mod, factor) * column if factor else column)
         return total / mod.speed_gain ** self.speed_power if self.speed_power else total
 

@@ -172,6 +172,15 @@ def same_effect(a: Candidate, b: Candidate) -> bool:
     return key(a) == key(b)
 
 
+def determined(fit: LossFit) -> bool:
+    """Return whether the data determine every parameter of a fit (a fitted form's shape too)."""
+    try:
+        fit.report()
+    except IdentificationError:
+        return False
+    return True
+
+
 def folds(n: int, k: int, time_ordered: bool, seed: int = 0) -> list[np.ndarray]:
     """
     Split point indices into K folds.
@@ -237,6 +246,7 @@ class CrossValidatedSelector:
             raise IdentificationError(msg)
         self.alpha, self.n_folds, self.min_gain, self.tie = alpha, n_folds, min_gain, tie
         self.time_ordered, self.seed, self.max_effects = time_ordered, seed, max_effects
+        self._tried = {}
 
     def score(self, parts: LossParts, effects: Sequence[Candidate], sigma: FloatArray,
               index: np.ndarray, start: FloatArray | None = None,
@@ -286,7 +296,8 @@ class CrossValidatedSelector:
 
     def _passes(self, score: Score, baseline: Score, m: int) -> bool:
         return (score.p_value < self.alpha / m
-                and score.cv_rmse < (1.0 - self.min_gain) * baseline.cv_rmse)
+                and score.cv_rmse < (1.0 - self.min_gain) * baseline.cv_rmse
+                and determined(score.fit))
 
     def _noise(self, parts: LossParts, found: tuple[Candidate, ...], pool: Sequence[Candidate],
                start: FloatArray | None) -> tuple[FloatArray, np.ndarray, list[LossFit]]:
@@ -297,8 +308,12 @@ class CrossValidatedSelector:
         scale = max(robust_scale(parts.flow - plain.predict(parts), plain.n_params), floor)
         base = LossFit(found, scale, HUBER).fit(parts, start=plain.u_)
         scale = max(robust_scale(parts.flow - base.predict(parts), base.n_params), floor)
-        fits = [LossFit((*found, c), scale, HUBER).fit(parts, everything, base.u_)
-                for c in pool]
+        # the best-fitting model judged by Tukey's biweight: a candidate that bends to meet
+        # one bad row gains nothing by it
+        base = LossFit(found, scale, redescending=True).fit(parts, start=base.u_)
+        fits = [LossFit((*found, c), scale, redescending=True).fit(
+            parts, everything, np.concatenate((base.u_, self._tried.get(id(c), []))))
+            for c in pool]
         best = min([base, *fits], key=lambda f: f.objective_)
         residual = parts.flow - best.predict(parts)
         sigma = noise_model(residual, parts.flow, best.n_params, floor)
@@ -331,6 +346,8 @@ class CrossValidatedSelector:
         baseline = self.score(parts, found, sigma, index, start)
         scores = [self.score(parts, (*found, c), sigma, index, f.u_, baseline)
                   for c, f in zip(pool, first)]
+        for c, s_ in zip(pool, scores):  # the next step starts each candidate where it ended
+            self._tried[id(c)] = s_.fit.u_[-1 - len(c.shape):]
         ranking = tuple(sorted(scores, key=lambda s: s.cv_rmse))
         m = max(len(pool), 1)
         done = Selection(baseline, ranking, None, None, '', self.alpha, sigma, left_out)
@@ -387,6 +404,7 @@ class CrossValidatedSelector:
         """
         found: tuple[Candidate, ...] = ()
         steps: list[Selection] = []
+        self._tried: dict[int, FloatArray] = {}
         start = None
         while True:
             pool = [c for c in candidates if not any(same_effect(c, f) for f in found)]

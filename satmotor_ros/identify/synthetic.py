@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: Apache-2.0
 """
-Synthetic bench data from the model, with one effect injected and seeded noise.
+Synthetic bench data from the model, with effects injected and seeded noise.
 
 The truth is always :class:`~satmotor_ros.model.MotorModel` itself: the
 flow is its forward map Q(n, dp) (eqs. 34-36, channel drop coupled) with the
@@ -15,6 +15,7 @@ viscosity, so a test still checks that the fit generalises over the pinning.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 import re
@@ -70,6 +71,8 @@ class Injection:
     effect: str = 'none'  # an id of the DESIGN.md vocabulary
     magnitude: float = 0.0  # see the class docstring
     regressor: str = ''  # p_case|p_out (external_leakage), time|revolutions (wear)
+    shape: tuple[tuple[str, float], ...] = ()  # kind-specific numbers (threshold: reference [Pa],
+    # exponent [-])
 
     @classmethod
     def realistic(cls, effect: str, scale: float = 1.0, liquid: str = 'oil') -> Injection:
@@ -165,21 +168,22 @@ def injected_effect(base: MotorModel, injection: Injection, speed: FloatArray,
         return None
     kind = kind_of(Effect(injection.effect, 0.0))
     dp_i = base.absorbency(speed, dp=dp, errors='mask').dp_i
-    data = Synthetic(speed, dp_i, channels, standard_law(base.liquid, base.coefficient_set.name))
+    data = Synthetic(speed, dp_i, channels, standard_law(base.liquid, base.coefficient_set.name),
+                     injection.shape)
     return kind.scaled(injection.effect, injection.magnitude, injection.regressor, data)
 
 
-def true_flow(base: MotorModel, effect: Effect | None, speed: FloatArray, dp: FloatArray,
+def true_flow(base: MotorModel, effects: tuple[Effect, ...], speed: FloatArray, dp: FloatArray,
               channels: dict[str, FloatArray]) -> FloatArray:
     """
-    Compute the flow the motor really absorbs, with a physical effect injected.
+    Compute the flow the motor really absorbs, with the physical effects injected.
 
     Parameters
     ----------
     base : MotorModel
         The packaged model, [-]
-    effect : Effect or None
-        The injected effect (a sensor effect leaves the flow alone), [-]
+    effects : tuple of Effect
+        The injected effects (a sensor effect leaves the flow alone), [-]
     speed : ndarray
         True speed, [rad/s]
     dp : ndarray
@@ -193,9 +197,10 @@ def true_flow(base: MotorModel, effect: Effect | None, speed: FloatArray, dp: Fl
         Flow, [m^3/s]
 
     """
-    if effect is None or kind_of(effect).sensor:
+    motor = tuple(e for e in effects if not kind_of(e).sensor)
+    if not motor:
         return base.absorbency(speed, dp=dp).flow
-    model = with_effects(base, (effect,))
+    model = with_effects(base, motor)
     needed = {name: channels[name] for name in model.channels}
     return model.absorbency(speed, dp=dp, channels=needed).flow
 
@@ -207,11 +212,12 @@ def _operating_points(plan: Plan, rng: np.random.Generator,
     return speed, dp
 
 
-def _temperature(plan: Plan, injection: Injection, rng: np.random.Generator,
+def _temperature(plan: Plan, injections: tuple[Injection, ...], rng: np.random.Generator,
                  time: FloatArray) -> FloatArray:
-    if injection.effect == 'viscosity_temperature':
+    span = [i.magnitude for i in injections if i.effect == 'viscosity_temperature']
+    if span:
         mid = 0.5 * sum(plan.temperature_c)
-        lo, hi = mid - 0.5 * injection.magnitude, mid + 0.5 * injection.magnitude
+        lo, hi = mid - 0.5 * span[0], mid + 0.5 * span[0]
     else:
         lo, hi = plan.temperature_c
     # warm-up and cool-down cycles, so that temperature is no proxy for time
@@ -220,26 +226,26 @@ def _temperature(plan: Plan, injection: Injection, rng: np.random.Generator,
     return lo + (hi - lo) * (0.7 * cycles + 0.3 * rng.uniform(0, 1, time.size))
 
 
-def _channels(plan: Plan, injection: Injection, rng: np.random.Generator, time: FloatArray,
-              draw: int, index: np.ndarray) -> dict[str, FloatArray]:
+def _channels(plan: Plan, injections: tuple[Injection, ...], rng: np.random.Generator,
+              time: FloatArray, draw: int, index: np.ndarray) -> dict[str, FloatArray]:
     """Draw p_case, p_out and the extra channels `draw` times, spread by `index`."""
-    channels = {'time': time, 'temperature': _temperature(plan, injection, rng, time),
+    channels = {'time': time, 'temperature': _temperature(plan, injections, rng, time),
                 'p_case': rng.uniform(*plan.p_case_mpa, draw)[index] * MPA,
                 'p_out': rng.uniform(*plan.p_out_mpa, draw)[index] * MPA}
     names = list(plan.extra_channels)
-    match = re.fullmatch(r'channel:(\w+)', injection.effect)
-    if match and match.group(1) not in names:
-        names.append(match.group(1))
+    for injection in injections:
+        match = re.fullmatch(r'channel:(\w+)', injection.effect)
+        if match and match.group(1) not in names:
+            names.append(match.group(1))
     for name in names:
         channels[name] = rng.uniform(0.0, 1.0, draw)[index]
     return channels
 
 
-def _measure(plan: Plan, effect: Effect | None, rng: np.random.Generator, flow: FloatArray,
-             speed: FloatArray, dp: FloatArray,
+def _measure(plan: Plan, effects: tuple[Effect, ...], rng: np.random.Generator,
+             flow: FloatArray, speed: FloatArray, dp: FloatArray,
              channels: dict[str, FloatArray], noise: float) -> BenchTable:
     n = flow.size
-    effects = () if effect is None else (effect,)
     gain_q, offset_q = sensor_error(effects, 'flow')
     gain_n, offset_n = sensor_error(effects, 'speed')
     sd_q = np.hypot(plan.noise_flow_lpm * LPM, plan.noise_flow_rel * flow) * noise
@@ -257,7 +263,18 @@ def _measure(plan: Plan, effect: Effect | None, rng: np.random.Generator, flow: 
     return BenchTable(speed_m, flow_m, p_in, p_out, channels, units, '<synthetic>')
 
 
-def generate(plan: Plan, injection: Injection, seed: int = 0) -> BenchTable:
+def _effects(base: MotorModel, injections: tuple[Injection, ...], speed: FloatArray,
+             dp: FloatArray, channels: dict[str, FloatArray]) -> tuple[Effect, ...]:
+    effects = (injected_effect(base, i, speed, dp, channels) for i in injections)
+    return tuple(e for e in effects if e is not None)
+
+
+def _injections(injection: Injection | Sequence[Injection]) -> tuple[Injection, ...]:
+    return (injection,) if isinstance(injection, Injection) else tuple(injection)
+
+
+def generate(plan: Plan, injection: Injection | Sequence[Injection],
+             seed: int = 0) -> BenchTable:
     """
     Generate a bench table of steady operating points.
 
@@ -265,8 +282,8 @@ def generate(plan: Plan, injection: Injection, seed: int = 0) -> BenchTable:
     ----------
     plan : Plan
         Range, duration and noise, [-]
-    injection : Injection
-        The effect to inject, [-]
+    injection : Injection or sequence of Injection
+        The effect(s) to inject, [-]
     seed : int
         Seed of the operating points and the noise, [-]
 
@@ -281,15 +298,41 @@ def generate(plan: Plan, injection: Injection, seed: int = 0) -> BenchTable:
     n = plan.n_points
     speed, dp = _operating_points(plan, rng, n)
     time = np.sort(rng.uniform(0.0, plan.duration_s, n))
-    channels = _channels(plan, injection, rng, time, n, np.arange(n))
+    injections = _injections(injection)
+    channels = _channels(plan, injections, rng, time, n, np.arange(n))
     channels['revolutions'] = revolutions(speed, np.diff(time, prepend=0.0))
     base = MotorModel.from_spec(load_motor(), plan.liquid)
-    effect = injected_effect(base, injection, speed, dp, channels)
-    flow = true_flow(base, effect, speed, dp, channels)
-    return _measure(plan, effect, rng, flow, speed, dp, channels, 1.0)
+    effects = _effects(base, injections, speed, dp, channels)
+    flow = true_flow(base, effects, speed, dp, channels)
+    return _measure(plan, effects, rng, flow, speed, dp, channels, 1.0)
 
 
-def generate_series(plan: Plan, injection: Injection, seed: int = 0, samples: int = 20000,
+def with_outliers(table: BenchTable, rows: Sequence[int], size_lpm: Sequence[float]) -> BenchTable:
+    """
+    Return a table with gross errors added to the flow of some rows (a bad reading).
+
+    Parameters
+    ----------
+    table : BenchTable
+        A generated table, [-]
+    rows : sequence of int
+        Rows to spoil, [-]
+    size_lpm : sequence of float
+        Error added at each, [l/min]
+
+    Returns
+    -------
+    BenchTable
+        The table, the flow of those rows off by the errors.
+
+    """
+    flow = table.flow.copy()
+    flow[list(rows)] += np.asarray(size_lpm, dtype=float) * LPM
+    return replace(table, flow=flow)
+
+
+def generate_series(plan: Plan, injection: Injection | Sequence[Injection], seed: int = 0,
+                    samples: int = 20000,
                     rate: float = 100.0, hold_s: float = 8.0, tau_s: float = 0.3,
                     noise: float = 3.0) -> BenchTable:
     """
@@ -299,8 +342,8 @@ def generate_series(plan: Plan, injection: Injection, seed: int = 0, samples: in
     ----------
     plan : Plan
         Range and noise (multiplied by `noise` per sample), [-]
-    injection : Injection
-        The effect to inject, [-]
+    injection : Injection or sequence of Injection
+        The effect(s) to inject, [-]
     seed : int
         Seed, [-]
     samples : int
@@ -333,12 +376,13 @@ def generate_series(plan: Plan, injection: Injection, seed: int = 0, samples: in
         s += alpha * (target_s[i] - s)
         d += alpha * (target_d[i] - d)
         speed[i], dp[i] = s, d
-    channels = _channels(plan, injection, rng, time, steps, k)
+    injections = _injections(injection)
+    channels = _channels(plan, injections, rng, time, steps, k)
     channels['revolutions'] = revolutions(speed, 1.0 / rate)
     base = MotorModel.from_spec(load_motor(), plan.liquid)
-    effect = injected_effect(base, injection, speed, dp, channels)
-    flow = true_flow(base, effect, speed, dp, channels)
-    table = _measure(plan, effect, rng, flow, speed, dp, channels, noise)
+    effects = _effects(base, injections, speed, dp, channels)
+    flow = true_flow(base, effects, speed, dp, channels)
+    table = _measure(plan, effects, rng, flow, speed, dp, channels, noise)
     return replace(table, time_series=True)
 
 
