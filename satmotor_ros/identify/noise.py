@@ -75,11 +75,13 @@ def noise_model(residual: FloatArray, flow: FloatArray, n_params: int,
     scale = max(robust_scale(residual, n_params), floor)
     sigma = np.full(residual.size, scale)
     if residual.size >= MIN_HETERO_POINTS:
-        inside = np.abs(residual) <= 4.0 * scale
         x2 = (flow / max(float(np.max(np.abs(flow))), 1e-300)) ** 2
-        design = np.column_stack([np.ones(int(inside.sum())), x2[inside]])
-        (a, b), _ = optimize.nnls(design, residual[inside] ** 2)
-        if a + b > 0.0:
+        for _ in range(3):  # the band follows the noise model as it forms
+            inside = np.abs(residual) <= 4.0 * sigma
+            design = np.column_stack([np.ones(int(inside.sum())), x2[inside]])
+            (a, b), _ = optimize.nnls(design, residual[inside] ** 2)
+            if not a + b > 0.0:
+                break
             a = max(a, (a + b) / MAX_RATIO ** 2)
             sigma = np.sqrt(a + b * x2)
     ratio = np.abs(residual) / sigma

@@ -383,6 +383,9 @@ class CrossValidatedSelector:
                    f'p = {best.p_value:.2g} < {self.alpha:g}/{m}')
         if runner is not None:
             verdict += _tie(best, runner, baseline)
+        if top is not best and priority(top.effect) == 2 and (runner is None
+                                                              or runner.effect != top.effect):
+            verdict += _tie(best, top, baseline).replace('near tie', 'also near', 1)
         return Selection(baseline, ranking, best, runner, verdict, self.alpha, sigma, left_out)
 
     def select(self, parts: LossParts, candidates: Sequence[Candidate]) -> Forward:
