@@ -110,7 +110,8 @@ def test_two_effects_are_found_one_after_the_other(tmp_path, liquid, first, seco
     assert report.count('`+ ') == 0 and '+ `' in report  # the error after each step
 
 
-FORMS = [('oil', 'term:dp^0.76', 1.0), ('oil', 'term:dp^3*n', 1.0), ('water', 'term:dp^1.5*n^2', 1.0)]
+FORMS = [('oil', 'term:dp^0.76', 1.0), ('oil', 'term:dp^3*n', 1.0),
+         ('water', 'term:dp^1.5*n^2', 1.0)]
 
 
 @pytest.mark.parametrize(('liquid', 'effect', 'size'), FORMS, ids=[f for _, f, _ in FORMS])

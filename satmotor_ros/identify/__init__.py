@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: Apache-2.0
 """
-Calibration against measured data: load, fit, find the missing effect, add it.
+Calibration against measured data: load, fit, find the missing effects one by one, add them.
 
 No ROS here (scipy is allowed). The pieces are kept apart as PySINDy keeps
 library, optimizer and model apart: :mod:`.table` and :mod:`.steady` bring

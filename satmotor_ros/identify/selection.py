@@ -246,7 +246,7 @@ class CrossValidatedSelector:
             raise IdentificationError(msg)
         self.alpha, self.n_folds, self.min_gain, self.tie = alpha, n_folds, min_gain, tie
         self.time_ordered, self.seed, self.max_effects = time_ordered, seed, max_effects
-        self._tried = {}
+        self._tried: dict[int, FloatArray] = {}  # candidate id -> its parameters last fitted
 
     def score(self, parts: LossParts, effects: Sequence[Candidate], sigma: FloatArray,
               index: np.ndarray, start: FloatArray | None = None,
@@ -407,7 +407,7 @@ class CrossValidatedSelector:
         """
         found: tuple[Candidate, ...] = ()
         steps: list[Selection] = []
-        self._tried: dict[int, FloatArray] = {}
+        self._tried = {}
         start = None
         while True:
             pool = [c for c in candidates if not any(same_effect(c, f) for f in found)]
