@@ -229,7 +229,8 @@ class Family(ABC):
     One loss model: its name, coefficients, composition and linear parts.
 
     Subclasses set the class attributes and implement :meth:`compose`,
-    :meth:`linear_parts`, :meth:`linear_losses` and :meth:`default_coefficients`.
+    :meth:`linear_parts` and :meth:`default_coefficients`; :meth:`linear_losses`
+    reads the composition's ``linear`` callable unless a family overrides it.
     """
 
     name = ''
@@ -263,7 +264,29 @@ class Family(ABC):
     @abstractmethod
     def compose(self, geometry: MotorGeometry, coefficient_set: CoefficientSet,
                 valid_range: ValidRange, liquid: Liquid, law: str) -> Any:
-        """Return the Equations-like composition for one motor and liquid."""
+        """
+        Derive the constants and compose the family's equations for one motor and liquid.
+
+        Parameters
+        ----------
+        geometry : MotorGeometry
+            The motor, [-]
+        coefficient_set : CoefficientSet
+            The coefficients (of this family) and the liquid they were fitted on, [-]
+        valid_range : ValidRange
+            Range the coefficients were validated over, [-]
+        liquid : Liquid
+            The working liquid, [-]
+        law : str
+            Law of Delta q; one of :attr:`laws`, [-]
+
+        Returns
+        -------
+        object
+            The callables of :class:`~satmotor_ros.model.composition.Equations`, its
+            ``derived`` constants and ``law``.
+
+        """
 
     @abstractmethod
     def linear_parts(self, coefficients: Any) -> tuple[LinearPart, ...]:
@@ -282,7 +305,6 @@ class Family(ABC):
 
         """
 
-    @abstractmethod
     def linear_losses(self, model: MotorModel, speed: FloatArray, dp_i: FloatArray,
                       p_ex: FloatArray | float = 0.0) -> dict[str, FloatArray]:
         """
@@ -305,10 +327,28 @@ class Family(ABC):
             Each part by name, in :meth:`linear_parts` order, [m^3/s]
 
         """
+        parts = model.equations.linear(speed, dp_i, p_ex)
+        return dict(zip((p.name for p in self.linear_parts(model.coef)), parts))
 
     @abstractmethod
     def default_coefficients(self, packaged: CoefficientSet, displacement: float) -> Any:
-        """Return the documented defaults for a motor of `displacement` [m^3/rad] on a liquid."""
+        """
+        Return the family's documented default coefficients for a motor and liquid.
+
+        Parameters
+        ----------
+        packaged : CoefficientSet
+            The SM-0,75/25's set for the liquid (its Table 1 coefficients, for
+            ``sliwinski2017``), [-]
+        displacement : float
+            The motor's displacement q_t/(2 pi), [m^3/rad]
+
+        Returns
+        -------
+        dataclass
+            The coefficients, to be calibrated.
+
+        """
 
     def scaled(self, coefficients: Any, factors: Mapping[str, float]) -> Any:
         """

@@ -15,19 +15,16 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 import math
-from typing import Any, cast, TYPE_CHECKING
+from typing import Any, cast
 
 from satmotor_ros.model._numeric import maximum
-from satmotor_ros.model._typing import FloatArray, Real
+from satmotor_ros.model._typing import Real
 from satmotor_ros.model.coefficients import (CoefficientSet, FieldError, Liquid, MotorGeometry,
                                              ValidRange)
 from satmotor_ros.model.families import balawender_losses as eq
 from satmotor_ros.model.families._base import (Bounds, bounds, Family, inverse_dp, LinearPart,
                                                SplitEquations, Terms)
 from satmotor_ros.model.units import CST
-
-if TYPE_CHECKING:
-    from satmotor_ros.model.motor import MotorModel
 
 
 @dataclass(frozen=True)
@@ -203,28 +200,7 @@ class Balawender(Family):
 
     def compose(self, geometry: MotorGeometry, coefficient_set: CoefficientSet,
                 valid_range: ValidRange, liquid: Liquid, law: str) -> SplitEquations:
-        """
-        Compose eqs. (15)-(28) for one motor and liquid.
-
-        Parameters
-        ----------
-        geometry : MotorGeometry
-            The motor, [-]
-        coefficient_set : CoefficientSet
-            The coefficients, [-]
-        valid_range : ValidRange
-            Range the coefficients were validated over, [-]
-        liquid : Liquid
-            The working liquid, [-]
-        law : str
-            ``'eq33'``, the default, is the only law accepted, [-]
-
-        Returns
-        -------
-        SplitEquations
-            The composition; ``linear`` gives the linear parts.
-
-        """
+        """Compose eqs. (15)-(28) for one motor and liquid: see :meth:`Family.compose`."""
         self.check_law(law)
         d = constants(geometry, coefficient_set, valid_range, liquid)
         c = cast(BalawenderCoefficients, coefficient_set.coefficients)
@@ -232,49 +208,15 @@ class Balawender(Family):
                               _linear(d, c))
 
     def linear_parts(self, coefficients: Any) -> tuple[LinearPart, ...]:
-        """
-        Return the parts of Q_vl linear in the coefficients: see :meth:`Family.linear_parts`.
-
-        Parameters
-        ----------
-        coefficients : BalawenderCoefficients
-            The coefficients, [-]
-
-        Returns
-        -------
-        tuple of LinearPart
-            ``pressure_speed`` (C_vl), ``laminar`` (C_ol), ``turbulent`` (C_ot), ``external``.
-
-        """
+        """Return ``pressure_speed`` (C_vl), ``laminar`` (C_ol), ``turbulent`` (C_ot), external."""
         return (LinearPart('pressure_speed', 'eqs. (17)-(19)', ('c_vl',), 1.0),
                 LinearPart('laminar', 'eqs. (20), (22)-(23)', ('c_ol',), 0.0),
                 LinearPart('turbulent', 'eqs. (21)-(23)', ('c_ot',), 0.0),
                 LinearPart('external', 'eqs. (16), (24)', ('external_leakage',), 0.0))
 
-    def linear_losses(self, model: MotorModel, speed: FloatArray, dp_i: FloatArray,
-                      p_ex: FloatArray | float = 0.0) -> dict[str, FloatArray]:
-        """Return Q_vl as the named linear parts: see :meth:`Family.linear_losses`."""
-        parts = model.equations.linear(speed, dp_i, p_ex)
-        return dict(zip((p.name for p in self.linear_parts(model.coef)), parts))
-
     def default_coefficients(self, packaged: CoefficientSet,
                              displacement: float) -> BalawenderCoefficients:
-        """
-        Return the documented defaults (dimensionless: the same for every displacement).
-
-        Parameters
-        ----------
-        packaged : CoefficientSet
-            The SM-0,75/25's set for the liquid (not used: the defaults are the oil's), [-]
-        displacement : float
-            The motor's displacement, [m^3/rad]
-
-        Returns
-        -------
-        BalawenderCoefficients
-            The defaults.
-
-        """
+        """Return the defaults: dimensionless, the same for every displacement."""
         return BalawenderCoefficients()
 
 

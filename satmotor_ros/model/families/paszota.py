@@ -14,10 +14,10 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 import math
-from typing import Any, cast, TYPE_CHECKING
+from typing import Any, cast
 
 from satmotor_ros.model._numeric import maximum
-from satmotor_ros.model._typing import FloatArray, Real
+from satmotor_ros.model._typing import Real
 from satmotor_ros.model.coefficients import (CoefficientSet, FieldError, Liquid, MotorGeometry,
                                              ValidRange)
 from satmotor_ros.model.families import paszota_losses as eq
@@ -25,9 +25,6 @@ from satmotor_ros.model.families._base import (Bounds, bounds, Family, inverse_d
                                                SM_DISPLACEMENT, SplitEquations, Terms)
 from satmotor_ros.model.losses import channel_coefficients, channel_pressure_drop
 from satmotor_ros.model.units import MPA, RPM
-
-if TYPE_CHECKING:
-    from satmotor_ros.model.motor import MotorModel
 
 
 @dataclass(frozen=True)
@@ -160,28 +157,7 @@ class Paszota(Family):
 
     def compose(self, geometry: MotorGeometry, coefficient_set: CoefficientSet,
                 valid_range: ValidRange, liquid: Liquid, law: str) -> SplitEquations:
-        """
-        Compose eq. (29) with the channel drop of eqs. (34)-(35) for one motor and liquid.
-
-        Parameters
-        ----------
-        geometry : MotorGeometry
-            The motor, [-]
-        coefficient_set : CoefficientSet
-            The coefficients, [-]
-        valid_range : ValidRange
-            Range the coefficients were validated over, [-]
-        liquid : Liquid
-            The working liquid, [-]
-        law : str
-            ``'eq33'``, the default, is the only law accepted, [-]
-
-        Returns
-        -------
-        SplitEquations
-            The composition.
-
-        """
+        """Compose eq. (29) and the channel drop of eqs. (34)-(35): see :meth:`Family.compose`."""
         self.check_law(law)
         d = constants(geometry, coefficient_set, valid_range, liquid)
         terms = _terms(d)
@@ -191,48 +167,13 @@ class Paszota(Family):
         return SplitEquations(d, terms, 'eq29', linear)
 
     def linear_parts(self, coefficients: Any) -> tuple[LinearPart, ...]:
-        """
-        Return the parts of Q_vl linear in the coefficients: see :meth:`Family.linear_parts`.
-
-        Parameters
-        ----------
-        coefficients : PaszotaCoefficients
-            The coefficients (a_nv is the speed exponent of the loss), [-]
-
-        Returns
-        -------
-        tuple of LinearPart
-            ``losses`` (k_g) and ``external``.
-
-        """
+        """Return ``losses`` (k_g; its speed exponent is a_nv) and ``external``."""
         return (LinearPart('losses', 'eq. (29)', ('k_g',), coefficients.a_nv),
                 LinearPart('external', 'eq. (24), lumped', ('external_leakage',), 0.0))
 
-    def linear_losses(self, model: MotorModel, speed: FloatArray, dp_i: FloatArray,
-                      p_ex: FloatArray | float = 0.0) -> dict[str, FloatArray]:
-        """Return Q_vl as the named linear parts: see :meth:`Family.linear_losses`."""
-        parts = model.equations.linear(speed, dp_i, p_ex)
-        return dict(zip((p.name for p in self.linear_parts(model.coef)), parts))
-
     def default_coefficients(self, packaged: CoefficientSet,
                              displacement: float) -> PaszotaCoefficients:
-        """
-        Return the documented defaults, the channel coefficients scaled to the displacement.
-
-        Parameters
-        ----------
-        packaged : CoefficientSet
-            The SM-0,75/25's set for the liquid (not used), [-]
-        displacement : float
-            The motor's displacement, [m^3/rad]
-
-        Returns
-        -------
-        PaszotaCoefficients
-            The defaults; eq. (35)'s c_t ~ q^(-4/3) and c_l ~ q^(-1) for a
-            geometrically similar motor.
-
-        """
+        """Return the defaults; eq. (35) scaled for a similar motor: c_t ~ q^(-4/3), c_l ~ 1/q."""
         ratio = displacement / SM_DISPLACEMENT
         base = PaszotaCoefficients()
         return PaszotaCoefficients(c_t=base.c_t * ratio ** (-4.0 / 3.0),

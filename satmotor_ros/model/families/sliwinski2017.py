@@ -48,47 +48,12 @@ class Sliwinski2017(Family):
 
     def compose(self, geometry: MotorGeometry, coefficient_set: CoefficientSet,
                 valid_range: ValidRange, liquid: Liquid, law: str) -> Equations:
-        """
-        Derive the constants and compose eqs. (1)-(40) for one motor and liquid.
-
-        Parameters
-        ----------
-        geometry : MotorGeometry
-            The motor, [-]
-        coefficient_set : CoefficientSet
-            The coefficients, [-]
-        valid_range : ValidRange
-            Range the coefficients were validated over, [-]
-        liquid : Liquid
-            The working liquid, [-]
-        law : {'eq33', 'eq39'}
-            Law of Delta q, [-]
-
-        Returns
-        -------
-        Equations
-            The composition.
-
-        """
+        """Derive the constants and compose eqs. (1)-(40): see :meth:`Family.compose`."""
         derived = derive(geometry, coefficient_set, valid_range, liquid)
         return Equations(derived, displacement_law(law, derived))
 
     def linear_parts(self, coefficients: Any) -> tuple[LinearPart, ...]:
-        """
-        Return the parts of Q_vl linear in the coefficients: see :meth:`Family.linear_parts`.
-
-        Parameters
-        ----------
-        coefficients : LossCoefficients
-            The coefficients, [-]
-
-        Returns
-        -------
-        tuple of LinearPart
-            ``leakage`` (A_1 and C_1 of eqs. 1 and 5), ``pressure_speed`` (C of eq. 33),
-            ``inertia`` (C_id of eq. 14) and ``external``: the factors today's fit scales.
-
-        """
+        """Return ``leakage`` (a1, c1), ``pressure_speed`` (c), ``inertia`` (c_id), external."""
         return (LinearPart('leakage', 'eqs. (1), (5)', ('a1', 'c1'), 0.0),
                 LinearPart('pressure_speed', 'eqs. (11)-(13), (33)', ('c',), 1.0),
                 LinearPart('inertia', 'eqs. (14), (33)', ('c_id',), 0.5),
@@ -104,23 +69,7 @@ class Sliwinski2017(Family):
 
     def default_coefficients(self, packaged: CoefficientSet,
                              displacement: float) -> LossCoefficients:
-        """
-        Return Table 1's set for the liquid, eq. (35) scaled to the displacement.
-
-        Parameters
-        ----------
-        packaged : CoefficientSet
-            The SM-0,75/25's set for the liquid, [-]
-        displacement : float
-            The motor's displacement, [m^3/rad]
-
-        Returns
-        -------
-        LossCoefficients
-            The set; c_t ~ q^(-4/3) and c_l ~ q^(-1) for a geometrically similar
-            motor (flow areas ~ q^(2/3), lengths ~ q^(1/3)).
-
-        """
+        """Return Table 1's set for the liquid, eq. (35) scaled: c_t ~ q^(-4/3), c_l ~ q^(-1)."""
         coef = packaged.coefficients
         ratio = displacement / SM_DISPLACEMENT
         return replace(coef, c_t=coef.c_t * ratio ** (-4.0 / 3.0), c_l=coef.c_l / ratio)
