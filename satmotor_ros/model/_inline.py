@@ -19,8 +19,12 @@ are not names the builder binds (upper-case numbers, units, are put in as their
 values). A body of ``x = ...`` lines before the ``return`` folds in as
 ``(x := ...)`` where x is first read, if nothing in it is evaluated
 conditionally; each inlined call gets its own name for x, so calls nested in
-each other's arguments do not share it. A traceback points at the builder's
-line of the call.
+each other's arguments do not share it, and the calls an inlined expression
+makes are inlined in turn. A traceback points at the builder's line of the call.
+
+:func:`inline_per_class` compiles a builder once per class of one argument,
+and inlines that argument's static methods as well: how a composition reads a
+displacement law's equations in place (:mod:`.laws`).
 """
 
 from __future__ import annotations
@@ -56,8 +60,13 @@ def _parse(func: Callable[..., Any]) -> ast.FunctionDef | None:
 
 
 _STRAIGHT = (ast.BinOp, ast.UnaryOp, ast.Name, ast.Constant, ast.Attribute, ast.Call,
-             ast.expr_context, ast.operator, ast.unaryop)
+             ast.Tuple, ast.NamedExpr, ast.expr_context, ast.operator, ast.unaryop, ast.cmpop)
 """Nodes whose operands Python evaluates unconditionally, in field order."""
+
+
+def _straight(node: ast.AST) -> bool:
+    """Whether Python evaluates every operand of `node` unconditionally (one comparison, too)."""
+    return isinstance(node, _STRAIGHT) or isinstance(node, ast.Compare) and len(node.ops) == 1
 
 
 def _first_use(expr: ast.AST, name: str) -> ast.Name | None:
@@ -88,7 +97,7 @@ class _Bind(ast.NodeTransformer):
 def _bind(expr: ast.expr, name: str, value: ast.expr, local: str) -> ast.expr | None:
     """Return `expr` with ``name = value`` folded in, or None where the order is not plain."""
     first = _first_use(expr, name)
-    if first is None or not all(isinstance(n, _STRAIGHT) for n in ast.walk(expr)):
+    if first is None or not all(_straight(n) for n in ast.walk(expr)):
         return None
     folded: ast.expr = _Bind(name, value, local, first).visit(expr)
     return folded
@@ -160,12 +169,17 @@ def _bound(tree: ast.AST) -> set[str]:
 class _Inliner(ast.NodeTransformer):
     """Inline the calls of one-expression functions of the builder's module."""
 
-    def __init__(self, namespace: dict[str, Any], rebound: set[str]) -> None:
-        self.namespace, self.rebound = namespace, rebound
+    def __init__(self, namespace: dict[str, Any], rebound: set[str],
+                 classes: dict[str, type]) -> None:
+        self.namespace, self.rebound, self.classes = namespace, rebound, classes
         self.sites = 0  # inlined calls so far: numbers their ``x := ...`` locals
 
     def _callee(self, func: ast.expr) -> Callable[..., Any] | None:
-        """Return the function a call's ``name`` or ``module.name`` refers to, or None."""
+        """Return the function a call's ``name``, ``module.name`` or ``cls.static`` is, or None."""
+        if (isinstance(func, ast.Attribute) and isinstance(func.value, ast.Name)
+                and func.value.id in self.classes):
+            static = inspect.getattr_static(self.classes[func.value.id], func.attr, None)
+            return static.__func__ if isinstance(static, staticmethod) else None
         if isinstance(func, ast.Attribute) and isinstance(func.value, ast.Name):
             module = None if func.value.id in self.rebound else self.namespace.get(func.value.id)
             found = getattr(module, func.attr, None) if inspect.ismodule(module) else None
@@ -203,13 +217,31 @@ class _Inliner(ast.NodeTransformer):
         for part in ast.walk(inlined):  # the equation's lines are not the builder's: the call's
             if isinstance(part, ast.expr):
                 ast.copy_location(part, node)
-        return inlined
+        result: ast.expr = self.visit(inlined)  # the calls the expression itself makes
+        return result
 
     def _unbound(self, name: str) -> str:
         """Return `name`, or `name` with underscores appended, free in the builder and module."""
         while name in self.rebound or name in self.namespace:
             name += '_'
         return name
+
+
+def _compile(builder: Builder, classes: dict[str, type]) -> Builder:
+    """Return `builder` recompiled with its calls inlined; `classes`: arguments' types by name."""
+    node = _parse(builder)
+    if node is None:
+        return builder
+    node.decorator_list = []
+    module = sys.modules[builder.__module__]
+    inliner = _Inliner(vars(module), _bound(node), classes)
+    tree = ast.Module(body=[inliner.visit(node)], type_ignores=[])
+    ast.fix_missing_locations(tree)
+    namespace: dict[str, Any] = {}
+    code = compile(tree, inspect.getsourcefile(builder) or '<inlined>', 'exec',
+                   flags=annotations.compiler_flag, dont_inherit=True)  # as this module's
+    exec(code, vars(module), namespace)  # noqa: S102 (our own source, recompiled)
+    return cast(Builder, functools.wraps(builder)(namespace[builder.__name__]))
 
 
 def inline_equations(builder: Builder) -> Builder:
@@ -228,15 +260,40 @@ def inline_equations(builder: Builder) -> Builder:
         its source is not available.
 
     """
-    node = _parse(builder)
-    if node is None:
-        return builder
-    node.decorator_list = []
-    module = sys.modules[builder.__module__]
-    tree = ast.Module(body=[_Inliner(vars(module), _bound(node)).visit(node)], type_ignores=[])
-    ast.fix_missing_locations(tree)
-    namespace: dict[str, Any] = {}
-    code = compile(tree, inspect.getsourcefile(builder) or '<inlined>', 'exec',
-                   flags=annotations.compiler_flag, dont_inherit=True)  # as this module's
-    exec(code, vars(module), namespace)  # noqa: S102 (our own source, recompiled)
-    return cast(Builder, functools.wraps(builder)(namespace[builder.__name__]))
+    return _compile(builder, {})
+
+
+def inline_per_class(argument: str) -> Callable[[Builder], Builder]:
+    """
+    Return a decorator that inlines a builder once per class of one of its arguments.
+
+    Besides what :func:`inline_equations` inlines, a call ``argument.name(...)``
+    of a static method of that argument's class is inlined too (and the calls its
+    expression makes), so that a composition reads a displacement law's equations
+    in place. The builder is compiled the first time it meets a class; objects
+    of another class get their own compilation.
+
+    Parameters
+    ----------
+    argument : str
+        Name of the builder's argument whose class is specialised on, [-]
+
+    Returns
+    -------
+    callable
+        The decorator; its result calls the compilation for ``type(argument)``.
+
+    """
+    def decorate(builder: Builder) -> Builder:
+        position = inspect.getfullargspec(builder).args.index(argument)
+        compiled: dict[type, Builder] = {}
+
+        @functools.wraps(builder)
+        def specialised(*args: Any) -> Any:
+            kind = type(args[position])
+            func = compiled.get(kind)
+            if func is None:
+                func = compiled[kind] = _compile(builder, {argument: kind})
+            return func(*args)
+        return cast(Builder, specialised)
+    return decorate

@@ -14,14 +14,17 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from satmotor_ros.model._inline import inline_equations
-from satmotor_ros.model._numeric import maximum, minimum
+from satmotor_ros.model._inline import inline_equations, inline_per_class
+from satmotor_ros.model._numeric import log, maximum, minimum  # noqa: F401 (log: the laws')
 from satmotor_ros.model._typing import Real
 from satmotor_ros.model.derived import DerivedCoefficients
 from satmotor_ros.model.laws import DisplacementLaw
 from satmotor_ros.model.losses import (chamber_pressure_drop, channel_pressure_drop,
                                        clearance_height, commutation_leakage, external_leakage,
                                        flat_clearance_leakage, inertia_loss, pressure_speed_loss)
+# the laws' equations, read by their static methods' expressions inlined below
+from satmotor_ros.model.losses import (displacement_change_empirical,  # noqa: F401
+                                       displacement_loss, empirical_speed_floor)
 from satmotor_ros.model.speed import absorbency, effective_speed
 
 Residual = Callable[[Real], tuple[Real, Real]]
@@ -107,19 +110,19 @@ def _leakage(d: DerivedCoefficients) -> Callable[[Real, Real], tuple[Real, Real,
     return leakage
 
 
-@inline_equations
+@inline_per_class('law')
 def _breakdown(d: DerivedCoefficients, law: DisplacementLaw) -> Callable[
         [Real, Real, Real], tuple[Real, Real, Real, Real, Real]]:
     """Return (n, dp_i, leak) -> the components of eq. (31) and Q_vl, as the law shares them."""
     k_fc, k_dch, k_b, k_i = d.k_fc, d.k_dch, d.k_b, d.k_i
-    shared_loss = law.loss if law.shares else None
+    shares, (a, b) = law.shares, law.constants
 
     def breakdown(speed: Real, dp_i: Real, leak: Real) -> tuple[Real, Real, Real, Real, Real]:
         fc, dch, bl, ine = (pressure_speed_loss(dp_i, speed, k_fc),
                             pressure_speed_loss(dp_i, speed, k_dch),
                             pressure_speed_loss(dp_i, speed, k_b), inertia_loss(speed, k_i))
-        if shared_loss is not None:  # scaled to add up to the law's loss; parts of 0 stay 0
-            scale = shared_loss(speed, dp_i) / (fc + dch + bl + ine + _TINY_FLOW)
+        if shares:  # scaled to add up to the law's loss; parts of 0 stay 0
+            scale = law.loss_at(speed, dp_i, a, b) / (fc + dch + bl + ine + _TINY_FLOW)
             fc, dch, bl, ine = fc * scale, dch * scale, bl * scale, ine * scale
         return fc, dch, bl, ine, leak + ((fc + dch) + (bl + ine))
     return breakdown
@@ -135,11 +138,11 @@ def _closed_form_speed(d: DerivedCoefficients) -> Callable[[Real, Real, Real], R
     return closed_form_speed
 
 
-@inline_equations
+@inline_per_class('law')
 def _speed_problem(d: DerivedCoefficients, law: DisplacementLaw) -> Callable[
         [Real, Real, Real], tuple[Real, Real, Residual[Real]]]:
     """Return :meth:`Equations.speed_problem` for one model."""
-    qt, at_pressure = d.qt, law.at_pressure
+    qt, (a, b) = d.qt, law.constants
 
     def speed_problem(flow: Real, dp_i: Real, leak: Real) -> tuple[Real, Real, Residual[Real]]:
         """
@@ -169,23 +172,23 @@ def _speed_problem(d: DerivedCoefficients, law: DisplacementLaw) -> Callable[
             n -> (Q(n) - flow [m^3/s], its slope [m^3/rad]), n > 0.
 
         """
-        floor, terms = at_pressure(dp_i)
+        floor, p, p_slope = law.pressure_state(dp_i, a, b)
 
         def residual(speed: Real) -> tuple[Real, Real]:
-            loss, slope = terms(speed)
+            loss, slope = law.speed_terms(speed, p, p_slope, a, b)
             return absorbency(speed, loss + leak, qt) - flow, qt + slope
         return floor, maximum(flow - leak, 0.0) / qt, residual
     return speed_problem
 
 
-@inline_equations
+@inline_per_class('law')
 def _flow_problem(d: DerivedCoefficients, law: DisplacementLaw) -> Callable[
         [Real, Real, Real], tuple[Real, Callable[[], Real], Residual[Real]]]:
     """Return :meth:`Equations.flow_problem` for one model."""
     ch_a, ch_b, h0, compliance, k_lfg, e_lfg, k_c, gamma, qt, k_ex, limit = (
         d.ch_a, d.ch_b, d.h0, d.compliance, d.lfg_k, d.lfg_e, d.com_k, d.com_e, d.qt, d.k_ex,
         d.dp_limit)
-    at_speed = law.at_speed
+    a, b = law.constants
 
     def flow_problem(speed: Real, dp: Real,
                      p_ex: Real) -> tuple[Real, Callable[[], Real], Residual[Real]]:
@@ -218,7 +221,7 @@ def _flow_problem(d: DerivedCoefficients, law: DisplacementLaw) -> Callable[
 
         """
         dp_cap = minimum(dp, limit)
-        terms = at_speed(speed)
+        s, s_slope = law.speed_state(speed, a, b)
         base = absorbency(speed, external_leakage(p_ex, k_ex) if k_ex else 0.0 * p_ex, qt)
 
         def residual(flow: Real) -> tuple[Real, Real]:
@@ -229,7 +232,7 @@ def _flow_problem(d: DerivedCoefficients, law: DisplacementLaw) -> Callable[
             h = clearance_height(dp_i, h0, compliance)
             q_lfg = flat_clearance_leakage(dp_i, h, k_lfg, e_lfg)
             q_c = commutation_leakage(dp_i, k_c, gamma)
-            loss, d_loss = terms(dp_i)
+            loss, d_loss = law.pressure_terms(dp_i, speed, s, s_slope, a, b)
             # d(Q_Lfg + Q_C)/d(dp_i); the leakages are 0 at dp_i = 0, and so is their slope
             inv_dp = 1.0 / (dp_i + _TINY_DROP)
             d_leak = q_lfg * e_lfg * (inv_dp - 3.0 * compliance / h) + q_c * gamma * inv_dp
@@ -238,7 +241,8 @@ def _flow_problem(d: DerivedCoefficients, law: DisplacementLaw) -> Callable[
 
         def upper() -> Real:
             h = clearance_height(dp_cap, h0, compliance)
-            return base + (terms(dp_cap)[0] + flat_clearance_leakage(dp_cap, h, k_lfg, e_lfg)
+            return base + (law.pressure_terms(dp_cap, speed, s, s_slope, a, b)[0]
+                           + flat_clearance_leakage(dp_cap, h, k_lfg, e_lfg)
                            + commutation_leakage(dp_cap, k_c, gamma))
         return qt * speed, upper, residual
     return flow_problem
