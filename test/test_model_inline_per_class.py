@@ -88,3 +88,26 @@ def test_each_class_gets_its_own_compilation():
 
 def test_a_static_method_of_statements_stays_a_call():
     assert _branching(_Tripling(), -2.0) == 2.0
+
+
+def _square(x):
+    return x * x
+
+
+def _square_of_sum(a, b):
+    return _square(a + b)  # arithmetic read twice: bound once, (x := a + b) * x
+
+
+def _doubled_size(x):
+    return abs(x) * 2.0  # a builtin
+
+
+def _size_of(y):
+    return _doubled_size(y - 5.0)
+
+
+def test_arithmetic_read_twice_is_bound_once_and_builtins_are_inlined():
+    from satmotor_ros.model._inline import inline_equations
+    squared, sized = inline_equations(_square_of_sum), inline_equations(_size_of)
+    assert '_square' not in _loaded_names(squared) and squared(1.5, 2.0) == 12.25
+    assert '_doubled_size' not in _loaded_names(sized) and sized(1.0) == 8.0

@@ -12,15 +12,18 @@ in the same order (bitwise the same result, on floats and on arrays), with no
 second copy of any equation in the source. A call is left as it is unless the
 callee, named as ``function`` or ``module.function``, is a function whose body
 is one ``return`` expression, neither name is bound anywhere in the builder,
-each parameter used more than once or never gets a plain name or constant (so
-nothing is evaluated twice, and nothing that could fail is skipped), and the
-globals that expression reads are the same objects in the builder's module and
-are not names the builder binds (upper-case numbers, units, are put in as their
-values). A body of ``x = ...`` lines before the ``return`` folds in as
-``(x := ...)`` where x is first read, if nothing in it is evaluated
-conditionally; each inlined call gets its own name for x, so calls nested in
-each other's arguments do not share it, and the calls an inlined expression
-makes are inlined in turn. A traceback points at the builder's line of the call.
+each parameter never used gets a plain name or constant (nothing that could
+fail is skipped), each used more than once gets one, or arithmetic without
+calls that is then bound where the expression first reads it, ``(p := ...)``,
+if nothing in the expression is evaluated conditionally (nothing is evaluated
+twice or out of order), and the globals that expression reads are the same
+objects in the builder's module (or builtins) and are not names the builder
+binds (upper-case numbers, units, are put in as their values). A body of
+``x = ...`` lines before the ``return`` folds in as ``(x := ...)`` where x is
+first read, if nothing in it is evaluated conditionally; each inlined call
+gets its own name for x, so calls nested in each other's arguments do not
+share it, and the calls an inlined expression makes are inlined in turn. A
+traceback points at the builder's line of the call.
 
 :func:`inline_per_class` compiles a builder once per class of one argument,
 and inlines that argument's static methods as well: how a composition reads a
@@ -30,6 +33,7 @@ displacement law's equations in place (:mod:`.laws`).
 from __future__ import annotations
 
 import ast
+import builtins
 import copy
 import functools
 import inspect
@@ -203,17 +207,28 @@ class _Inliner(ast.NodeTransformer):
         local = {n.target.id for n in ast.walk(expr) if isinstance(n, ast.NamedExpr)
                  and isinstance(n.target, ast.Name)}
         for name in set(names) - set(params) - local:
-            value = callee.__globals__.get(name, self)
+            value = callee.__globals__.get(name, vars(builtins).get(name, self))
             if name.isupper() and type(value) in (float, int):
                 values[name] = ast.Constant(value)  # a unit or constant: its value
-            elif value is not self.namespace.get(name, None) or name in self.rebound:
+            elif value is not self.namespace.get(name, vars(builtins).get(name)) or (
+                    name in self.rebound):
                 return node  # the builder's module, or the builder itself, has another `name`
+        twice = {}  # parameters read more than once, bound where first read: (p := argument)
         for param, value in values.items():
             if names.count(param) != 1 and not isinstance(value, (ast.Name, ast.Constant)):
-                return node  # the argument would be evaluated twice, or never
+                if not names.count(param) or any(isinstance(n, ast.Call) for n in ast.walk(
+                        value)) or not all(_straight(n) for n in ast.walk(expr)):
+                    return node  # the argument would be evaluated never, or out of order
+                twice[param] = value
         self.sites += 1
-        renamed = {name: self._unbound(f'{name}_{self.sites}') for name in local}
-        inlined: ast.expr = _Substitute(values).visit(_Rename(renamed).visit(copy.deepcopy(expr)))
+        renamed = {name: self._unbound(f'{name}_{self.sites}') for name in local | set(twice)}
+        inlined: ast.expr | None = _Substitute(
+            {p: v for p, v in values.items() if p not in twice}).visit(
+                _Rename(renamed).visit(copy.deepcopy(expr)))
+        for param, value in twice.items():
+            inlined = _bind(inlined, renamed[param], value, renamed[param]) if inlined else None
+        if inlined is None:
+            return node
         for part in ast.walk(inlined):  # the equation's lines are not the builder's: the call's
             if isinstance(part, ast.expr):
                 ast.copy_location(part, node)

@@ -23,8 +23,9 @@ from satmotor_ros.model.losses import (chamber_pressure_drop, channel_pressure_d
                                        clearance_height, commutation_leakage, external_leakage,
                                        flat_clearance_leakage, inertia_loss, pressure_speed_loss)
 # the laws' equations, read by their static methods' expressions inlined below
-from satmotor_ros.model.losses import (displacement_change_empirical,  # noqa: F401
-                                       displacement_loss, empirical_speed_floor)
+from satmotor_ros.model.losses import (displacement_change_at_root,  # noqa: F401
+                                       displacement_change_empirical, displacement_loss,
+                                       empirical_speed_floor)
 from satmotor_ros.model.speed import absorbency, effective_speed
 
 Residual = Callable[[Real], tuple[Real, Real]]
@@ -189,6 +190,7 @@ def _flow_problem(d: DerivedCoefficients, law: DisplacementLaw) -> Callable[
         d.ch_a, d.ch_b, d.h0, d.compliance, d.lfg_k, d.lfg_e, d.com_k, d.com_e, d.qt, d.k_ex,
         d.dp_limit)
     a, b = law.constants
+    two_ch_a, three_compliance = 2.0 * ch_a, 3.0 * compliance  # the slopes' factors
 
     def flow_problem(speed: Real, dp: Real,
                      p_ex: Real) -> tuple[Real, Callable[[], Real], Residual[Real]]:
@@ -235,9 +237,9 @@ def _flow_problem(d: DerivedCoefficients, law: DisplacementLaw) -> Callable[
             loss, d_loss = law.pressure_terms(dp_i, speed, s, s_slope, a, b)
             # d(Q_Lfg + Q_C)/d(dp_i); the leakages are 0 at dp_i = 0, and so is their slope
             inv_dp = 1.0 / (dp_i + _TINY_DROP)
-            d_leak = q_lfg * e_lfg * (inv_dp - 3.0 * compliance / h) + q_c * gamma * inv_dp
+            d_leak = q_lfg * e_lfg * (inv_dp - three_compliance / h) + q_c * gamma * inv_dp
             return (flow - (base + (loss + q_lfg + q_c)),
-                    1.0 + (dp_i > 0.0) * ((d_leak + d_loss) * (2.0 * ch_a * flow + ch_b)))
+                    1.0 + (dp_i > 0.0) * ((d_leak + d_loss) * (two_ch_a * flow + ch_b)))
 
         def upper() -> Real:
             h = clearance_height(dp_cap, h0, compliance)

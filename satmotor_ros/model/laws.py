@@ -24,8 +24,10 @@ from satmotor_ros.model._numeric import log, maximum
 from satmotor_ros.model._typing import Real
 from satmotor_ros.model.derived import DerivedCoefficients
 from satmotor_ros.model.errors import ModelError
-from satmotor_ros.model.losses import (displacement_change_empirical, displacement_loss,
-                                       EMPIRICAL_DP_FLOOR, empirical_speed_floor)
+from satmotor_ros.model.losses import (displacement_change_at_root,
+                                       displacement_change_empirical, displacement_loss,
+                                       EMPIRICAL_DP_FLOOR, empirical_speed_floor, inertia_loss,
+                                       pressure_speed_loss)
 from satmotor_ros.model.units import MPA, RPM
 
 Terms = Callable[[Real], tuple[Real, Real]]
@@ -156,14 +158,15 @@ class PhysicalLaw(DisplacementLaw):
 
     @staticmethod
     def speed_state(speed: Real, k_p: float, k_i: float) -> tuple[Real, Real]:
-        """Return n and the slope in dp_i, k_p n, at fixed n."""
-        return speed, k_p * speed
+        """Return the inertia part of eq. (33), eq. (14), and the slope in dp_i, k_p n."""
+        return inertia_loss(speed, k_i), k_p * speed
 
     @staticmethod
-    def pressure_terms(dp_i: Real, speed: Real, same: Real, k_pn: Real, k_p: float,
+    def pressure_terms(dp_i: Real, speed: Real, inertia: Real, k_pn: Real, k_p: float,
                        k_i: float) -> tuple[Real, Real]:
         """Return Delta Q_vl of eq. (33) [m^3/s] and its slope in dp_i [m^3/(s*Pa)]."""
-        return displacement_loss(dp_i, speed, k_p, k_i), k_pn
+        # displacement_loss, its inertia part held from speed_state
+        return pressure_speed_loss(dp_i, speed, k_p) + inertia, k_pn
 
 
 class EmpiricalLaw(DisplacementLaw):
@@ -209,16 +212,16 @@ class EmpiricalLaw(DisplacementLaw):
 
     @staticmethod
     def speed_state(speed: Real, c1: float, c2: float) -> tuple[Real, Real]:
-        """Return n where it is > 0, else 1 (times n = 0 below), and C_2/sqrt(n), 0 at n = 0."""
+        """Return 1/sqrt(n [rpm]) (at n = 1 where n = 0: times 0) and C_2/sqrt(n), 0 at n = 0."""
         safe = speed + (speed <= 0.0)  # at n = 0 the loss is 0 and flat: at n = 1, times 0
-        return safe, (speed > 0.0) * (c2 / (safe / RPM) ** 0.5)
+        return 1.0 / (safe / RPM) ** 0.5, (speed > 0.0) * (c2 / (safe / RPM) ** 0.5)
 
     @staticmethod
-    def pressure_terms(dp_i: Real, speed: Real, safe: Real, c2_inv_s: Real, c1: float,
+    def pressure_terms(dp_i: Real, speed: Real, inv_sqrt_n: Real, c2_inv_s: Real, c1: float,
                        c2: float) -> tuple[Real, Real]:
         """Return Delta Q_vl of eq. (39) [m^3/s] and its slope in dp_i [m^3/(s*Pa)]."""
         dp = maximum(dp_i, EMPIRICAL_DP_FLOOR)  # below the floor, eq. (39) is flat in dp_i
-        loss = displacement_change_empirical(dp, safe, c1, c2) * speed
+        loss = displacement_change_at_root(dp, inv_sqrt_n, c1, c2) * speed
         return loss, (dp_i > EMPIRICAL_DP_FLOOR) * (loss * c2_inv_s / dp)
 
 

@@ -426,7 +426,7 @@ def displacement_loss(dp_i: Real, speed: Real, k_p: float, k_id: float) -> Real:
         Delta Q_vl, [m^3/s]
 
     """
-    return k_p * dp_i * speed + k_id * speed ** 0.5
+    return pressure_speed_loss(dp_i, speed, k_p) + inertia_loss(speed, k_id)
 
 
 def displacement_change_empirical(dp_i: Real, speed: Real, c1: float,
@@ -477,7 +477,30 @@ def displacement_change_empirical(dp_i: Real, speed: Real, c1: float,
     0.3727
 
     """
-    inv_sqrt_n = 1.0 / (speed / RPM) ** 0.5
+    return displacement_change_at_root(dp_i, 1.0 / (speed / RPM) ** 0.5, c1, c2)
+
+
+def displacement_change_at_root(dp_i: Real, inv_sqrt_n: Real, c1: float, c2: float) -> Real:
+    """
+    Compute Delta q of eq. (39) from 1/sqrt(n), n in rpm: :func:`displacement_change_empirical`.
+
+    Parameters
+    ----------
+    dp_i : float or ndarray
+        Pressure drop in the working chambers, at least :data:`EMPIRICAL_DP_FLOOR`, [Pa]
+    inv_sqrt_n : float or ndarray
+        1/sqrt(n), [(rev/min)^-0.5]
+    c1 : float
+        C_1 of eq. (39), [cm^3/rev (rev/min)^0.5]
+    c2 : float
+        C_2 of eq. (39), [(rev/min)^0.5]
+
+    Returns
+    -------
+    float or ndarray
+        Delta q, [m^3/rad].
+
+    """
     return c1 * inv_sqrt_n * (dp_i / MPA) ** (c2 * inv_sqrt_n) * CM3_PER_REV
 
 

@@ -368,7 +368,10 @@ class MotorModel:
             number, or an effect's channel is missing.
 
         """
-        port, value = _point_dp(dp, dp_i)
+        if dp_i is None and type(dp) is float:  # the usual call: skip the checks
+            port, value = True, dp
+        else:
+            port, value = _point_dp(dp, dp_i)
         if type(flow) is not float:
             flow = as_float('flow', flow)
         if type(p_ex) is not float:
@@ -415,7 +418,10 @@ class MotorModel:
             If not exactly one of `dp` and `dp_i` is given, or an argument is not a number.
 
         """
-        port, value = _point_dp(dp, dp_i)
+        if dp_i is None and type(dp) is float:  # the usual call: skip the checks
+            port, value = True, dp
+        else:
+            port, value = _point_dp(dp, dp_i)
         if type(speed) is not float:
             speed = as_float('speed', speed)
         if type(p_ex) is not float:

@@ -125,21 +125,15 @@ class PointEvaluator:
         return _new_point(Point, (flow, speed, dp, dp_i, q_lfg, q_c, fc, dch, bl, ine, q_ex,
                                   total, status))
 
-    def _chamber(self, dp: float, flow: float, port: bool) -> tuple[float, int]:
-        """Return dp_i of eqs. (34)-(35) clipped at 0, and CHANNEL_LIMITED or BEYOND_LIMIT."""
-        dp_i = self._chamber_drop(dp, flow) if port else dp
-        if dp_i < 0.0:
-            return 0.0, _CHANNEL_LIMITED
-        return dp_i, (_BEYOND_LIMIT if dp_i > self._dp_limit else 0)
-
     @inline_equations
     def speed(self, flow: float, dp: float, port: bool, p_ex: float) -> Point:
         """Compute n(Q, dp) at one point: :meth:`MotorModel.speed_point` without effects."""
         if not (0.0 <= flow < _INF and 0.0 <= dp < _INF and 0.0 <= p_ex < _INF):
             return _invalid(_screen(flow) | _screen(dp) | _screen(p_ex))
-        dp_i, status = self._chamber(dp, flow, port)
-        if status & _BEYOND_LIMIT:
-            return _invalid(status)
+        dp_i = self._chamber_drop(dp, flow) if port else dp
+        dp_i, status = (0.0, _CHANNEL_LIMITED) if dp_i < 0.0 else (dp_i, 0)
+        if dp_i > self._dp_limit:
+            return _invalid(_BEYOND_LIMIT)
         q_lfg, q_c, q_ex = self._leakage(dp_i, p_ex)
         if self._closed_form:
             speed = self._closed_form_speed(flow, dp_i, q_lfg + q_c + q_ex)
@@ -182,9 +176,10 @@ class PointEvaluator:
                                                    True)
             if failed:
                 return _invalid(failed)
-        dp_i, status = self._chamber(dp, root, port)
-        if status & _BEYOND_LIMIT:
-            return _invalid(status)
+        dp_i = self._chamber_drop(dp, root) if port else dp
+        dp_i, status = (0.0, _CHANNEL_LIMITED) if dp_i < 0.0 else (dp_i, 0)
+        if dp_i > self._dp_limit:
+            return _invalid(_BEYOND_LIMIT)
         if 0.0 < speed < self._max_floor and speed < self._floor(dp_i):
             return _invalid(_BEYOND_LIMIT)
         q_lfg, q_c, q_ex = self._leakage(dp_i, p_ex)

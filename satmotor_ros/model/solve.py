@@ -39,6 +39,7 @@ from satmotor_ros.model.results import PointStatus
 
 _NO_ROOT = int(PointStatus.NO_ROOT)
 _NOT_CONVERGED = int(PointStatus.NOT_CONVERGED)
+_NAN = math.nan
 CURVATURE_MARGIN = 1e-3
 """Predicted error, as a share of the tolerance, below which a Newton step ends the solve."""
 
@@ -92,9 +93,9 @@ def solve_increasing_scalar(func: Callable[[float], tuple[float, float]], lo: fl
 
     """
     xtol, rtol, check_rtol, maxiter = tol
-    if hi - lo <= xtol + rtol * abs(x):
+    if hi - lo <= xtol + rtol * (x if x >= 0.0 else -x):
         return x, 0
-    last_x = last_slope = nan = math.nan
+    last_x = last_slope = nan = _NAN
     margin = CURVATURE_MARGIN
     for _ in range(maxiter):
         f, slope = func(x)

@@ -35,6 +35,7 @@ from typing import NamedTuple
 import numpy as np
 
 from satmotor_ros.model import MotorModel
+from satmotor_ros.model._inline import inline_equations
 from satmotor_ros.model.effects import (Conditions, kind_of, plant_injection, PlantInjection,
                                         sensor_error, with_effects)
 from satmotor_ros.model.revolutions import revolutions
@@ -142,6 +143,8 @@ class Plant:
         self._motor = MotorCache(with_effects(base, self._injection.motor), p.rebuild_tolerance)
         self._point = self._motor.model.absorbency_point
         self._q_guess: float | None = None
+        # the revolutions are read only as a channel, by the model's effects or a drift
+        self._counts_revolutions = self._drifting or bool(self._motor.model.channels)
 
     def _set_constants(self) -> None:
         p = self.params
@@ -295,7 +298,8 @@ class Plant:
         lin = self._linearise()
         p, r, relief, w_new = self._solve_step(flow, lin, load, slope, dry)
         self._last = (flow, p, r, relief)  # as solved: the flows balance with these
-        self._settle(max(p, self._pv), max(r, self._pv), w_new, lin[2], flow)
+        pv = self._pv  # a line below the vapour pressure is held there by make-up flow
+        self._settle(pv if pv > p else p, pv if pv > r else r, w_new, lin[2], flow)  # max()
         if self._drifting:
             self._drift()
 
@@ -360,6 +364,7 @@ class Plant:
             w_new = 0.0
         return p, r, relief, w_new
 
+    @inline_equations
     def _settle(self, p: float, r: float, w_new: float, dich: float, flow: float) -> None:
         """Take the new state: torque, heat (P8), angle, revolutions and time."""
         dt = self._dt
@@ -375,7 +380,8 @@ class Plant:
                                             cooling)
         self._p_in, self._p_out, self._w = p, r, w_new
         self._theta += w_new * dt
-        self._revolutions = revolutions(w_new, dt, self._revolutions)
+        if self._counts_revolutions:
+            self._revolutions = revolutions(w_new, dt, self._revolutions)
         self._n += 1
         self._t = self._n * dt
 
