@@ -136,6 +136,7 @@ class MotorModelNode(Node):
         self._pub_losses_array: Publisher[Float64MultiArray] | None = None
         self._joint_msg = JointState(name=[self._joint])  # refilled per prediction
         self._losses_msg = Float64MultiArray()
+        self._loss_msgs = [Float64() for _ in LOSS_COMPONENTS]
         self._losses_msg.layout.dim = [MultiArrayDimension(
             label=','.join(LOSS_COMPONENTS), size=len(LOSS_COMPONENTS),
             stride=len(LOSS_COMPONENTS))]
@@ -304,8 +305,9 @@ class MotorModelNode(Node):
         if self._pub_losses_array is not None:
             self._losses_msg.data = array('d', losses)
             self._pub_losses_array.publish(self._losses_msg)
-        for publisher, value in zip(self._pub_losses, losses):
-            publisher.publish(Float64(data=value))
+        for publisher, msg, value in zip(self._pub_losses, self._loss_msgs, losses):
+            msg.data = value  # refilled: cheaper than a new message, published at once
+            publisher.publish(msg)
 
     # -- diagnostics ------------------------------------------------------------------------
 

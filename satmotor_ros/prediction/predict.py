@@ -13,12 +13,14 @@ and its numbers to 1e-12 (the two model paths agree to that).
 from __future__ import annotations
 
 import math
+from operator import itemgetter
 from typing import Any, NamedTuple, overload
 
 import numpy as np
 import numpy.typing as npt
 
-from satmotor_ros.model import COMPONENTS, describe_status, INVALID, MotorModel, PointStatus
+from satmotor_ros.model import (COMPONENTS, describe_status, INVALID, MotorModel, Point,
+                                PointStatus)
 from satmotor_ros.model.revolutions import revolutions
 from satmotor_ros.model.units import ATMOSPHERE
 from satmotor_ros.prediction.rule import (describe_input, FIELDS, input_level, INPUTS,
@@ -310,6 +312,8 @@ def _level_table() -> npt.NDArray[np.uint8]:
 
 
 _LEVELS = _level_table()
+_LEVEL_ROWS = _LEVELS.tolist()  # Python ints for one snapshot: numpy scalars are slower
+_POINT_LOSSES = itemgetter(*(Point._fields.index(c) for c in COMPONENTS))
 
 
 def _worst(levels: list[Any]) -> Any:
@@ -370,7 +374,7 @@ def _model_call(model: MotorModel, flow: Any, dp: Any, p_ex: Any,
         op = model.speed(flow, dp, p_ex=p_ex, errors='mask', channels=channels)
         return op.speed, op.dp_i, op.status, list(op.losses.as_dict().values())
     point = model.speed_point(flow, dp, p_ex=p_ex, channels=channels)
-    return point.speed, point.dp_i, point.status, [getattr(point, c) for c in COMPONENTS]
+    return point.speed, point.dp_i, point.status, list(_POINT_LOSSES(point))
 
 
 @overload
@@ -407,7 +411,8 @@ def predict(model: MotorModel, snap: Snapshot | SnapshotBatch, timeout: float,
 
     """
     values, states = snap.values, snap.states
-    level = _worst([row[state] for row, state in zip(_LEVELS, states)])
+    levels = _LEVELS if _is_array(states) else _LEVEL_ROWS
+    level = _worst([row[state] for row, state in zip(levels, states)])
     channels = None
     if model.channels:
         channels, missing = _channels(model.channels, snap, progress)
@@ -420,7 +425,7 @@ def predict(model: MotorModel, snap: Snapshot | SnapshotBatch, timeout: float,
     if channels is not None:
         channels = dict(zip(channels, _masked(usable, list(channels.values()), 0.0)))
     speed, dp_i, status, losses = _model_call(model, flow, dp, p_ex, channels)
-    leak = _leakage_channel(model)
+    leak = _leakage_channel(model) if channels is not None else None
     if leak is not None and channels is not None:
         p_ex = channels[leak]  # the pressure the effect drove eq. (24) with
     status = pick(usable, status, 0)
