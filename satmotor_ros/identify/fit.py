@@ -193,11 +193,6 @@ class LossFit:
         self.robust = robust
         self.redescending = redescending
 
-    @property
-    def candidate(self) -> Candidate | None:
-        """Return the last effect (the one tested on top of the others), or None."""
-        return self.effects[-1] if self.effects else None
-
     def _layout(self, parts: LossParts) -> None:
         self.m_ = len(parts.components)
         self.names_ = parts.names
