@@ -113,8 +113,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         rows = [r for c, r in zip(cases, results) if c[:3] == key]
         chosen = np.array([r[0] for r in rows])
         runner = np.array([r[1] for r in rows])
-        hit = np.mean([names(c, key[1]) for c in chosen])
-        hit_tie = np.mean([names(c, key[1]) or names(r, key[1]) for c, r in zip(chosen, runner)])
+        hit = float(np.mean([names(c, key[1]) for c in chosen]))
+        hit_tie = float(np.mean([names(c, key[1]) or names(r, key[1])
+                                 for c, r in zip(chosen, runner)]))
         none = np.mean(chosen == 'none')
         cut = np.median([r[3] / r[4] for r in rows])
         met = np.mean([r[3] >= 3 * r[4] or r[4] <= 1.5 * r[5] for r in rows])
