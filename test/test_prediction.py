@@ -188,7 +188,7 @@ def _random_events(rng, n):
 
 
 def _calibrated():
-    """Return the oil model with effects on case pressure, temperature and time."""
+    """Return the oil model with effects on case pressure, temperature, time and fitted forms."""
     k_ex = 1e-12
     effects = (
         effect_from_mapping('external_leakage', {'regressor': 'p_case', 'coefficient': k_ex}, 'e'),
@@ -198,7 +198,10 @@ def _calibrated():
         effect_from_mapping('clearance_wear', {'regressor': 'time', 'coefficient': 1e-8,
                                                'reference': 0.0}, 'e'),
         effect_from_mapping('channel:revolutions', {'coefficient': 1e-9, 'reference': 0.0},
-                            'e'))
+                            'e'),
+        effect_from_mapping('term:dp^0.76', {'coefficient': 3e-11}, 'e'),
+        effect_from_mapping('threshold:dp', {'coefficient': 1e-13, 'reference': 15e6,
+                                             'exponent': 1.2}, 'e'))
     coef = dataclasses.replace(OIL.coef, external_leakage=k_ex)
     fitted = dataclasses.replace(OIL.coefficient_set, coefficients=coef, effects=effects,
                                  viscosity_range=(1e-6, 1e-3))
