@@ -340,8 +340,19 @@ def test_clearance_wear_is_refused_for_a_family_without_clearances():
                'coefficients': {},
                'effects': {'clearance_wear': {'regressor': 'revolutions',
                                               'coefficient': 1e-12, 'reference': 0.0}}}}}
-    with pytest.raises(ConfigError, match='no axial clearances to wear'):
+    with pytest.raises(ConfigError, match='clearance_wear applies to the sliwinski2017 '
+                                          'family, not balawender'):
         motor_from_mapping(doc)
+
+
+@pytest.mark.parametrize('family', ['balawender', 'paszota'])
+def test_clearance_wear_injected_into_the_plant_of_such_a_family_is_refused(family):
+    from satmotor_ros.model.effects import Effect
+    from satmotor_ros.plant import Plant, PlantError, PlantParams
+    wear = Effect('clearance_wear', 1e-12, 'revolutions', reference=0.0)
+    with pytest.raises(PlantError, match=f'applies to the sliwinski2017 family, not {family}'):
+        Plant(MODELS[family, 'oil'], PlantParams(effects=(wear,)))
+    Plant(MODELS['sliwinski2017', 'oil'], PlantParams(effects=(wear,)))  # where it applies
 
 
 def test_a_motor_known_by_its_displacement_scales_the_defaults():

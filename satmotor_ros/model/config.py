@@ -219,12 +219,8 @@ def coefficient_set_from_mapping(doc: Any, name: str, geometry: MotorGeometry,
     coef = _record(family.coefficients_type, doc['coefficients'], f'{where}.coefficients',
                    {**_COEFFICIENT_KINDS, **family.quantities})
     if family.name != DEFAULT_FAMILY:
-        effects = _effects(doc.get('effects'), f'{where}.effects', coef)
-        for effect in effects:
-            if effect.kind == 'clearance_wear':
-                msg = (f'{where}.effects.{effect.name}: the {family.name} family has no '
-                       'axial clearances to wear (clearance_wear is for sliwinski2017)')
-                raise ConfigError(msg)
+        effects = check_effects(_effects(doc.get('effects'), f'{where}.effects', coef),
+                                f'{where}.effects', family.name)
         return _construct(CoefficientSet, where, name=name, liquid=liquid, coefficients=coef,
                           viscosity_range=span, effects=effects)
     c_fc = compressibility_coefficient(liquid.bulk_modulus, geometry, coef)

@@ -36,8 +36,9 @@ import numpy as np
 
 from satmotor_ros.model import MotorModel
 from satmotor_ros.model._inline import inline_equations
-from satmotor_ros.model.effects import (Conditions, kind_of, plant_injection, PlantInjection,
-                                        sensor_error, with_effects)
+from satmotor_ros.model.effects import (check_effects, Conditions, kind_of, plant_injection,
+                                        PlantInjection, sensor_error, with_effects)
+from satmotor_ros.model.errors import ConfigError
 from satmotor_ros.model.revolutions import revolutions
 from satmotor_ros.model.units import ATMOSPHERE
 from satmotor_ros.model.viscosity import standard_law
@@ -133,6 +134,10 @@ class Plant:
     def _build_motor(self) -> None:
         """Inject the effects: the motor ones into the model, the rest sorted by kind."""
         p, base = self.params, self._base
+        try:
+            check_effects(p.effects, 'PlantParams.effects', base.family.name)
+        except ConfigError as err:
+            raise PlantError(str(err)) from None
         bound = p.effects
         if bound:  # effects that leave the law to the liquid take its standard one
             law = standard_law(base.liquid, base.coefficient_set.name)

@@ -208,7 +208,8 @@ def effect_to_mapping(effect: Effect) -> dict[str, Any]:
     return {**kind.to_mapping(effect), 'evaluation': kind.evaluation}
 
 
-def check_effects(effects: Iterable[Effect], where: str) -> tuple[Effect, ...]:
+def check_effects(effects: Iterable[Effect], where: str,
+                  family: str | None = None) -> tuple[Effect, ...]:
     """
     Refuse two effects of one kind (only suffixed kinds may repeat, with other suffixes).
 
@@ -218,6 +219,8 @@ def check_effects(effects: Iterable[Effect], where: str) -> tuple[Effect, ...]:
         The effects, [-]
     where : str
         Key path quoted in errors, [-]
+    family : str, optional
+        Model family the effects act on: a kind that does not apply to it is refused, [-]
 
     Returns
     -------
@@ -227,13 +230,18 @@ def check_effects(effects: Iterable[Effect], where: str) -> tuple[Effect, ...]:
     Raises
     ------
     ConfigError
-        Naming the kind given twice or unknown.
+        Naming the kind given twice, unknown, or not applying to `family`.
 
     """
     effects = tuple(effects)
     seen: set[str] = set()
     for effect in effects:
-        key = effect.name if kind_of(effect).suffixed else effect.kind
+        kind = kind_of(effect)
+        if family is not None and kind.families is not None and family not in kind.families:
+            msg = (f'{where}.{effect.name}: {effect.kind} applies to the '
+                   f'{" and ".join(sorted(kind.families))} family, not {family}')
+            raise ConfigError(msg)
+        key = effect.name if kind.suffixed else effect.kind
         if key in seen:
             msg = f'{where} has more than one {key} effect'
             raise ConfigError(msg)
@@ -265,7 +273,7 @@ def with_effects(model: MotorModel, effects: Iterable[Effect]) -> MotorModel:
     coef = spec.coefficients
     for effect in effects:
         coef = kind_of(effect).coefficients(effect, coef)
-    combined = check_effects((*spec.effects, *effects), 'effects')
+    combined = check_effects((*spec.effects, *effects), 'effects', model.family.name)
     return type(model)(model.geometry, replace(spec, coefficients=coef, effects=combined),
                        model.valid_range, model.liquid, model.displacement_law, model.name)
 

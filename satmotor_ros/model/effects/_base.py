@@ -316,6 +316,7 @@ class EffectKind:
     source: str = ''  # the physics or standard the term comes from
     evaluation: str = ''  # what the model does with it (written into the YAML)
     plant_parameters: tuple[PlantParameter, ...] = ()  # node parameters
+    families: frozenset[str] | None = None  # model families it applies to; None: every one
 
     # -- YAML --------------------------------------------------------------------------
 

@@ -18,6 +18,7 @@ class ClearanceWear(EffectKind):
     """Both axial clearances grow with time [s] or shaft revolutions [rev]."""
 
     name = 'clearance_wear'
+    families = frozenset({'sliwinski2017'})  # the others have no axial clearances h_R, h_S
     rank = 60
     keys = ('regressor', 'coefficient', 'reference')
     required = ('coefficient', 'regressor', 'reference')
