@@ -84,6 +84,17 @@ def test_a_comma_log_with_absolute_pressures_and_a_signed_speed(tmp_path):
     assert table.channels['time'][0] == 0.0
 
 
+def test_an_optional_channel_the_log_lacks_is_skipped_with_a_note(tmp_path):
+    log = _log(tmp_path, HEAD + '1 2 3 4\n')
+    doc = {'columns': GOOD, 'channels': {'force': {'column': 'Force', 'optional': True},
+                                         'up': {'column': 'Up', 'optional': True}}}
+    table = read_log(log, mapping_from_dict(doc))
+    assert set(table.channels) == {'up'}
+    assert "force: no column 'Force', skipped (optional)" in table.notes[0]
+    with pytest.raises(DataError, match="channels.force: no column 'Force'"):
+        read_log(log, mapping_from_dict({'columns': GOOD, 'channels': {'force': 'Force'}}))
+
+
 def test_a_headerless_log_by_column_numbers(tmp_path):
     log = _log(tmp_path, '1 2 3 4\n5 6 7 8\n')
     mapping = mapping_from_dict({'file': {'header': 'none'}, 'columns': {

@@ -35,7 +35,7 @@ SI_UNITS = {'time': 's', 'speed': 'rad/s', 'flow': 'm^3/s', 'pressure': 'Pa',
 """The unit each kind of field is handed on in."""
 
 _SIGNED = ('speed', 'flow', 'torque')
-_KEYS = ('column', 'unit', 'area', 'sign', 'reference')
+_KEYS = ('column', 'unit', 'area', 'sign', 'reference', 'optional')
 _TOP = ('file', 'columns', 'channels', 'other_columns')
 _FILE = {'separator': 'auto', 'comment': '#', 'header': 'auto'}
 SUFFIX = '.columns.yaml'
@@ -51,6 +51,7 @@ class Source:
     area: float = 0.0  # piston area for a flow from a piston speed [m^2]; 0 when none
     sign: float = 1.0  # +1 or -1 [-]
     reference: str = ''  # 'gauge' or 'absolute' for a pressure; '' takes the unit's or gauge
+    optional: bool = False  # a channel the log may lack (skipped with a note)
 
 
 @dataclass(frozen=True)
@@ -105,7 +106,10 @@ def _source(doc: Any, where: str, name: str) -> Source:
     implied = pressure_reference(unit) if unit else None
     if reference and implied and implied != reference:
         raise _fail(f'{where}.reference', f'{reference} contradicts the unit {unit!r}')
-    return Source(column, unit, area, float(sign), reference)
+    optional = doc.get('optional', False)
+    if not isinstance(optional, bool):
+        raise _fail(f'{where}.optional', f'{optional!r}: use true or false')
+    return Source(column, unit, area, float(sign), reference, optional)
 
 
 def _kind(name: str) -> str | None:
@@ -164,6 +168,9 @@ def mapping_from_dict(doc: Any, where: str = '<mapping>') -> ColumnMapping:
                         f'{", ".join(FIELDS)}; other quantities go under channels:)')
     fields = {name: _source(value, f'{where}: columns.{name}', name)
               for name, value in columns.items()}
+    optional = [name for name, source in fields.items() if source.optional]
+    if optional:
+        raise _fail(f'{where}: columns.{optional[0]}.optional', 'only channels are optional')
     channels = {str(name): _source(value, f'{where}: channels.{name}', str(name))
                 for name, value in _section(doc, 'channels', where).items()}
     clash = [name for name in channels if name in FIELDS]
@@ -302,7 +309,13 @@ def read_log(path: str | Path, mapping: ColumnMapping) -> BenchTable:
     for section, sources in (('columns', mapping.fields), ('channels', mapping.channels)):
         for name, source in sources.items():
             where = f'{mapping.source}: {section}.{name}'
-            index, header_unit = _locate(source, text.header, where)
+            try:
+                index, header_unit = _locate(source, text.header, where)
+            except DataError:
+                if not source.optional:
+                    raise
+                described.append(f'{name}: no column {source.column!r}, skipped (optional)')
+                continue
             unit = source.unit or header_unit
             label = split_unit(text.header[index])[0] if text.header else f'column {index + 1}'
             values = text.data[:, index]
