@@ -12,8 +12,9 @@ from satmotor_ros.identify.synthetic import generate, Injection, Plan
 from satmotor_ros.model import load_motor, MotorModel
 from satmotor_ros.model.units import LPM, MPA, RPM
 
-FIELDS = ['liquid', 'n_points', 'effect', 'regressor', 'coefficient', 'ci95', 'unit',
-          'error_before', 'error_after', 'effects', 'outliers', 'candidates']
+FIELDS = ['liquid', 'family', 'n_points', 'effect', 'regressor', 'coefficient', 'ci95', 'unit',
+          'error_before', 'error_after', 'effects', 'outliers', 'candidates',
+          'family_comparison']
 
 
 def _csv(path, table, extra=()):

@@ -87,7 +87,9 @@ PAIRS = [
 def test_two_effects_are_found_one_after_the_other(tmp_path, liquid, first, second):
     plan = Plan(liquid=liquid)
     table = generate(plan, (first, second), seed=7)
-    cal = calibrate(table, liquid)
+    # the effect search within eqs. (31)-(33): pinned, since a family whose baseline bends
+    # with dp (paszota's) absorbs part of an unmodelled dp^0.76 term before any effect is tried
+    cal = calibrate(table, liquid, options=Options(compare_families=False))
     summary = write_json(cal, tmp_path / 'calibration.json')
     found = _effects(cal)
     assert len(found) == 2, [s.verdict for s in cal.forward.steps]

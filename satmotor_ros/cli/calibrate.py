@@ -71,7 +71,8 @@ def _calibrate(data: str, out: str, mode: Mode, alpha: float, folds: int,
     check_target('--out', Path(out), inputs, force, written_by('calibrate'), 'calibrate')
     spec = options.spec()
     table = load_data(data, columns)
-    cal = calibrate(table, options.liquid, spec, Options(alpha=alpha, n_folds=folds, mode=mode))
+    cal = calibrate(table, options.liquid, spec, Options(alpha=alpha, n_folds=folds, mode=mode,
+                                                         compare_families=not options.family))
     with output_dir('--out', out, 'calibrate', inputs, force) as tmp:
         summary = write_json(cal, tmp / 'calibration.json')
         write_yaml(cal, tmp / 'coefficients.yaml')
@@ -88,6 +89,7 @@ def _calibrate(data: str, out: str, mode: Mode, alpha: float, folds: int,
         line += f', near tie with {runner.label}'
     if len(summary['effects']) > 1:
         line += ', then ' + ', '.join(e['effect'] for e in summary['effects'][1:])
+    line += f'; family {summary["family"]}'
     if summary['outliers']:
         line += f'; {len(summary["outliers"])} outlier(s) left out'
     return (f'{line}; out-of-sample RMSE of Q_vl {before:.4g} -> {after:.4g} l/min over '

@@ -20,14 +20,13 @@ Plain numbers are SI (temperature in degC).
 
 from __future__ import annotations
 
-from dataclasses import fields, replace
+from dataclasses import fields
 import json
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 from satmotor_ros.identify.pipeline import Calibration
-from satmotor_ros.model import LossCoefficients
 from satmotor_ros.model.effects import effect_to_mapping, kind_of
 import yaml
 
@@ -54,26 +53,26 @@ def write_json(cal: Calibration, path: str | Path) -> dict[str, Any]:
     return summary
 
 
-def fitted_coefficients(cal: Calibration) -> LossCoefficients:
+def fitted_coefficients(cal: Calibration) -> Any:
     """
     Apply the fitted factors (and what the effects set, e.g. k_ex) to the packaged coefficients.
 
     Parameters
     ----------
     cal : Calibration
-        Its final fit holds s_L, s_C and s_id first, then the effects, [-]
+        Its final fit holds one factor per component first, then the effects, [-]
 
     Returns
     -------
-    LossCoefficients
-        a1 and c1 times s_L, c times s_C, c_id times s_id, and each effect's
-        numbers (:meth:`~satmotor_ros.model.effects.EffectKind.coefficients`).
+    dataclass
+        The family's coefficients, each linear part's times its factor (for eqs. (31)-(33):
+        a1 and c1 times s_L, c times s_C, c_id times s_id), and each effect's numbers
+        (:meth:`~satmotor_ros.model.effects.EffectKind.coefficients`).
 
     """
-    coef = cal.model.coef
-    s_l, s_c, s_id = (float(v) for v in cal.final.values[:3])
-    coef = replace(coef, a1=coef.a1 * s_l, c1=coef.c1 * s_l, c=coef.c * s_c,
-                   c_id=coef.c_id * s_id)
+    components = cal.parts.components
+    factors = {c.part: float(v) for c, v in zip(components, cal.final.values[:len(components)])}
+    coef = cal.model.family.scaled(cal.model.coef, factors)
     for effect in cal.effects():
         coef = kind_of(effect).coefficients(effect, coef)
     return coef
@@ -123,6 +122,7 @@ def _document(cal: Calibration) -> dict[str, Any]:
     g = spec.geometry
     return {
         'motor': f'{spec.name} (calibrated)',
+        'family': cal.model.family.name,
         'geometry': {f.name: float(getattr(g, f.name)) for f in fields(g)},
         'valid_range': {f.name: float(getattr(spec.valid_range, f.name))
                         for f in fields(spec.valid_range)},
@@ -155,11 +155,11 @@ def write_yaml(cal: Calibration, path: str | Path) -> None:
         File to write, [-]
 
     """
-    s_l, s_c, s_id = cal.final.values[:3]
+    factors = ', '.join(f'{c.part} ({c.describes}) x{v:.4g}' for c, v in
+                        zip(cal.parts.components, cal.final.values))
     head = (f'# {cal.spec.name} calibrated on {cal.table.source} ({len(cal.parts)} points), '
             f'liquid {cal.liquid}.\n'
-            f'# Fitted factors on the packaged values: leakage (a1, c1) x{s_l:.4g}, '
-            f'c x{s_c:.4g}, c_id x{s_id:.4g}.\n'
+            f'# Fitted factors on the packaged values: {factors}.\n'
             "# Plain numbers are SI (temperature degC); loss coefficients in the paper's "
             'fitting units.\n')
     body = yaml.safe_dump(_document(cal), sort_keys=False, allow_unicode=True,

@@ -21,7 +21,7 @@ from satmotor_ros.identify.table import BenchTable
 from satmotor_ros.model import MotorModel
 from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.effects import Modifier
-from satmotor_ros.model.losses import channel_pressure_drop, clearance_height
+from satmotor_ros.model.losses import clearance_height
 
 
 @dataclass(frozen=True)
@@ -38,6 +38,7 @@ class Component:
     speed_power: float = 0.0  # it grows as n^power at a fixed dp_i (how a speed gain acts) [-]
     floor: float = 0.0  # least factor: a share known otherwise (e.g. C_fc beta_l) [-]
     describes: str = ''  # what the factor multiplies, for the report
+    part: str = ''  # the family's linear part it scales (Family.linear_parts), for the YAML
 
     def flow(self, mod: Modifier) -> FloatArray:
         """Return the component at factor 1 under an effect's modifier, [m^3/s]."""
@@ -156,14 +157,8 @@ def loss_parts(model: MotorModel, table: BenchTable) -> tuple[LossParts, np.ndar
         If no point is usable.
 
     """
-    if model.family.name != 'sliwinski2017':  # the fit below scales that family's parts
-        msg = (f'calibrating the {model.family.name} family is not supported yet '
-               '(its linear parts: model.family.linear_parts); use --family sliwinski2017')
-        raise IdentificationError(msg)
-    coef = model.coef
     flow, speed, dp = table.flow, table.speed, table.dp
-    d = model.derived
-    dp_i = dp - channel_pressure_drop(np.maximum(flow, 0.0), d.ch_a, d.ch_b)
+    dp_i = model.equations.chamber_drop(dp, np.maximum(flow, 0.0))
     usable = (np.isfinite(flow) & np.isfinite(speed) & np.isfinite(dp) & (flow > 0.0)
               & (speed >= 0.0) & (dp_i >= 0.0) & (dp_i < model.dp_limit))
     if not usable.any():
@@ -171,16 +166,21 @@ def loss_parts(model: MotorModel, table: BenchTable) -> tuple[LossParts, np.ndar
                f'pressure drop between 0 and {model.dp_limit / 1e6:.1f} MPa)')
         raise IdentificationError(msg)
     n, dpi = speed[usable], dp_i[usable]
+    if model.family.name != 'sliwinski2017':
+        return _family_parts(model, flow[usable], n, dp[usable], dpi), usable
+    coef = model.coef
+    d = model.derived
     losses = model.breakdown(n, dpi)
     beta = coef.beta
     pressure_speed = losses.compressibility + losses.deformation + losses.backlash
     components = (
         Component('leakage_scale', (('flat_clearance', losses.flat_clearance),
                                     ('commutation', losses.commutation)), 0.0, 0.0,
-                  'A_1 (eq. 1) and C_1 (eq. 5)'),
+                  'A_1 (eq. 1) and C_1 (eq. 5)', 'leakage'),
         Component('c_scale', (('', pressure_speed),), 1.0,
-                  model.c_fc_beta / model.c if model.c > 0 else 0.0, 'C (eq. 33)'),
-        Component('c_id_scale', (('', losses.inertia),), 0.5, 0.0, 'C_id (eq. 14)'))
+                  model.c_fc_beta / model.c if model.c > 0 else 0.0, 'C (eq. 33)',
+                  'pressure_speed'),
+        Component('c_id_scale', (('', losses.inertia),), 0.5, 0.0, 'C_id (eq. 14)', 'inertia'))
     parts = LossParts(
         flow=flow[usable].copy(), speed=n.copy(), dp=dp[usable].copy(), dp_i=dpi.copy(),
         displacement=model.geometry.displacement * n,
@@ -190,3 +190,34 @@ def loss_parts(model: MotorModel, table: BenchTable) -> tuple[LossParts, np.ndar
         nu_exponent_lfg=-beta / (2.0 - beta), nu_exponent_c=-coef.gamma,
         components=components)
     return parts, usable
+
+
+GAP_LEAKAGE = ('leakage', 'laminar')
+"""Linear parts of a family that are laminar flow through a gap: the clearance and viscosity
+effects scale them as a plane gap would (Q ~ h^3 / nu)."""
+
+
+def _family_parts(model: MotorModel, flow: FloatArray, n: FloatArray, dp: FloatArray,
+                  dp_i: FloatArray) -> LossParts:
+    """
+    Components of a family other than eqs. (31)-(33): one factor per linear part of its Q_vl.
+
+    A part that is zero at every point (the external leakage of a set without one) is left
+    out: no factor could be fitted on it.
+    """
+    losses = model.family.linear_losses(model, n, dp_i)
+    components = []
+    for part in model.family.linear_parts(model.coef):
+        q = np.asarray(losses[part.name], dtype=float)
+        if not np.any(q):
+            continue
+        modifier = 'flat_clearance' if part.name in GAP_LEAKAGE else ''
+        components.append(Component(f'{part.name}_scale', ((modifier, q),), part.speed_exponent,
+                                    0.0, f'{", ".join(part.coefficients)} ({part.source})',
+                                    part.name))
+    h = model.geometry.clearance_satellites
+    return LossParts(flow=flow.copy(), speed=n.copy(), dp=dp.copy(), dp_i=dp_i.copy(),
+                     displacement=model.geometry.displacement * n,
+                     clearance=np.full(n.shape, h), clearance_satellites=h, h_exponent=3.0,
+                     hs_exponent=3.0, nu_exponent_lfg=-1.0, nu_exponent_c=-1.0,
+                     components=tuple(components))

@@ -16,6 +16,7 @@ import numpy as np
 
 from satmotor_ros.identify.candidates import build_library, Candidate
 from satmotor_ros.identify.errors import DataError, IdentificationError
+from satmotor_ros.identify.families import compare_families, FamilyChoice, family_specs
 from satmotor_ros.identify.fit import check_identifiable, FitReport
 from satmotor_ros.identify.parts import loss_parts, LossParts, predict_flow
 from satmotor_ros.identify.selection import (CrossValidatedSelector, Errors, Forward, Score,
@@ -42,6 +43,7 @@ class Options:
     max_effects: int = 4  # most effects the forward selection adds [-]
     mode: Mode = 'auto'  # rows are steady points, a time series, or decide from the data
     seed: int = 0  # fold shuffle [-]
+    compare_families: bool = True  # choose the model family first; False: the motor's, pinned
     steady: SteadyTolerance = field(default_factory=SteadyTolerance)
 
 
@@ -64,6 +66,7 @@ class Calibration:
     error_before: Errors  # baseline, out of sample (outliers left out)
     error_after: Errors  # with every effect, out of sample (outliers left out)
     rows: np.ndarray | None  # row of the table each point came from (None: a time series)
+    family: FamilyChoice | None = None  # the families compared (None: pinned by the user)
 
     @property
     def selection(self) -> Selection:
@@ -166,7 +169,8 @@ class Calibration:
         ranked = [self.selection.baseline, *self.selection.ranking]
         ranked.sort(key=lambda s: s.cv_rmse)
         return {
-            'liquid': self.liquid, 'n_points': len(self.parts),
+            'liquid': self.liquid, 'family': self.model.family.name,
+            'n_points': len(self.parts),
             'effect': first.get('effect', 'none'), 'regressor': first.get('regressor'),
             'coefficient': first.get('coefficient'), 'ci95': first.get('ci95'),
             'unit': first.get('unit'),
@@ -176,7 +180,16 @@ class Calibration:
             'candidates': [
                 {'effect': s.effect, 'regressor': s.candidate.regressor if s.candidate else None,
                  'cv_rmse_lpm': _round(s.cv_rmse / LPM)} for s in ranked],
+            'family_comparison': self.family_comparison(),
         }
+
+    def family_comparison(self) -> dict[str, Any]:
+        """Return how the family was chosen: the verdict and each family's out-of-sample error."""
+        if self.family is None:
+            return {'verdict': f'{self.model.family.name} pinned by the user (--family)',
+                    'n_points': None, 'families': []}
+        return {'verdict': self.family.verdict, 'n_points': self.family.n_points,
+                'families': self.family.as_list()}
 
 
 def _coefficient_interval(report: FitReport, position: int,
@@ -301,8 +314,19 @@ def calibrate(table: BenchTable, liquid: str = 'oil', spec: MotorSpec | None = N
         msg = f'liquid {liquid!r} is not a coefficient set of {spec.name} ({", ".join(spec.sets)})'
         raise IdentificationError(msg)
     spec, table = _without_effects(spec, liquid, table)
-    model = MotorModel.from_spec(spec, liquid)
     points = steady_points(table, options.mode, options.steady)
+
+    def selector() -> CrossValidatedSelector:
+        return CrossValidatedSelector(options.alpha, options.n_folds, options.min_gain,
+                                      options.tie, 'time' in points.channels, options.seed,
+                                      options.max_effects)
+
+    choice = None
+    if options.compare_families:
+        specs = family_specs(spec, spec.source == load_motor().source)
+        choice = compare_families(points, liquid, specs, selector, options.min_gain)
+        spec = specs[choice.chosen]
+    model = MotorModel.from_spec(spec, liquid)
     rows = _source_rows(table, points)
     parts, usable = loss_parts(model, points)
     if not usable.all():
@@ -314,10 +338,7 @@ def calibrate(table: BenchTable, liquid: str = 'oil', spec: MotorSpec | None = N
     law = standard_law(model.liquid, liquid)
     channels = {**points.channels, 'p_out': points.p_out}
     candidates, skipped = build_library(parts, channels, law)
-    selector = CrossValidatedSelector(options.alpha, options.n_folds, options.min_gain,
-                                      options.tie, 'time' in points.channels, options.seed,
-                                      options.max_effects)
-    forward = selector.select(parts, candidates)
+    forward = selector().select(parts, candidates)
     first = forward.steps[0]
     packaged_error = parts.flow - predict_flow(parts, np.ones(len(parts.components)))
     at = ~forward.outliers
@@ -326,7 +347,7 @@ def calibrate(table: BenchTable, liquid: str = 'oil', spec: MotorSpec | None = N
                        forward.final.fit.report(),
                        Errors.of(packaged_error[at], parts.loss[at]),
                        Errors.of(first.baseline.cv_error[at], parts.loss[at]),
-                       Errors.of(forward.final.cv_error[at], parts.loss[at]), rows)
+                       Errors.of(forward.final.cv_error[at], parts.loss[at]), rows, choice)
 
 
 def _source_rows(table: BenchTable, points: BenchTable) -> np.ndarray | None:

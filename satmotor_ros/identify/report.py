@@ -249,6 +249,25 @@ def _identifiability(cal: Calibration) -> list[str]:
     return lines + [f'- `{a}` and `{b}`: r = {r:+.3f}' for a, b, r in pairs] + ['']
 
 
+def _families(cal: Calibration) -> list[str]:
+    """The model family: how it was chosen (the structure before the effect)."""
+    comparison = cal.family_comparison()
+    lines = ['## Model family', '', f'**{cal.model.family.name}**: {comparison["verdict"]}.', '']
+    if not comparison['families']:
+        return lines
+    rows = [[f'`{f["family"]}`', ', '.join(f['factors']) or '-',
+             *(f'{f["cv_error"][k]:.4g}' if f['cv_error'] else '-'
+               for k in ('rmse_lpm', 'mean_abs_pct', 'max_abs_lpm')), f.get('note', '')]
+            for f in comparison['families']]
+    lines += [_table(rows, ['family', 'factors fitted', 'RMSE [l/min]', 'mean abs [%]',
+                            'max abs [l/min]', 'note']), '',
+              f'Each family refitted without any effect on the same {comparison["n_points"]} '
+              'points (those no family calls an outlier), errors of Q_vl out of sample '
+              '(cross-validated). The motor\'s own family is kept unless another cuts its '
+              'error by more than the least gain an effect must bring; `--family` pins it.', '']
+    return lines
+
+
 def write_report(cal: Calibration, out: Path, summary: dict[str, object]) -> Path:
     """
     Write ``report.md`` and its three PNG plots into `out`.
@@ -275,7 +294,8 @@ def write_report(cal: Calibration, out: Path, summary: dict[str, object]) -> Pat
     lines = [f'# Calibration of {cal.spec.name} on {cal.liquid}', '',
              f'Data: `{cal.table.source}`, {len(cal.parts)} steady operating points.']
     lines += [f'- {note}' for note in cal.table.notes]
-    lines += ['', '## Result', '', f'**Effects: {found}**, found one after the other:', '']
+    lines += [''] + _families(cal)
+    lines += ['## Result', '', f'**Effects: {found}**, found one after the other:', '']
     lines += _steps(cal) + ['']
     for step in cal.forward.steps:
         if step.runner_up is not None and step.chosen is not None:

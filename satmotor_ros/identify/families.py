@@ -1,0 +1,190 @@
+# SPDX-License-Identifier: Apache-2.0
+"""
+The structure before the effect: which model family the data support best, out of sample.
+
+Each family of :mod:`satmotor_ros.model.families` is fitted to the same points without any
+effect (one factor per linear part of its Q_vl, :func:`~.parts.loss_parts`) and scored by
+its cross-validated error of Q_vl, with the folds and the selector the effect search uses.
+The motor's own family (its file's, or the SM-0,75/25's) is kept unless another one cuts
+that error by more than the selector's ``min_gain``: like an effect, a change of structure
+has to earn its place. A family pinned by the user (``--family``) is not compared.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+import math
+from typing import Any
+
+import numpy as np
+from satmotor_ros.identify.errors import IdentificationError
+from satmotor_ros.identify.parts import loss_parts
+from satmotor_ros.identify.selection import CrossValidatedSelector, Errors
+from satmotor_ros.identify.table import BenchTable
+from satmotor_ros.model import MotorModel, MotorSpec
+from satmotor_ros.model.errors import ModelError
+from satmotor_ros.model.families import FAMILY_NAMES
+from satmotor_ros.model.families.defaults import default_motor
+from satmotor_ros.model.units import LPM
+
+
+@dataclass(frozen=True)
+class FamilyScore:
+    """One family's baseline, fitted and cross-validated on the common points."""
+
+    family: str  # the family's name
+    factors: tuple[str, ...]  # the factors fitted (one per linear part of Q_vl)
+    error: Errors | None  # out of sample, at the points no family calls an outlier
+    note: str = ''  # why the family could not be scored, when error is None
+
+    @property
+    def rmse(self) -> float:
+        """Return the out-of-sample RMSE of Q_vl, inf when not scored, [m^3/s]."""
+        return self.error.rmse_lpm * LPM if self.error is not None else math.inf
+
+
+@dataclass(frozen=True)
+class FamilyChoice:
+    """The comparison of the families and the one the calibration continues with."""
+
+    chosen: str  # the family calibrated further
+    scores: tuple[FamilyScore, ...]  # best first; empty when pinned
+    n_points: int  # points the families were compared on [-]
+    verdict: str  # why this family, one sentence
+
+    def as_list(self) -> list[dict[str, Any]]:
+        """Return the comparison for ``calibration.json``: one entry per family, best first."""
+        return [{'family': s.family, 'factors': list(s.factors),
+                 'cv_error': s.error.as_dict() if s.error is not None else None,
+                 **({'note': s.note} if s.note else {})} for s in self.scores]
+
+
+def family_specs(spec: MotorSpec, default: bool) -> dict[str, MotorSpec]:
+    """
+    Return a motor of every family: `spec` for its own, the others' defaults at its size.
+
+    Parameters
+    ----------
+    spec : MotorSpec
+        The motor given (a file, the packaged SM-0,75/25 or a motor of a displacement), [-]
+    default : bool
+        Whether `spec` is the packaged SM-0,75/25 (the others then use its geometry), [-]
+
+    Returns
+    -------
+    dict of str to MotorSpec
+        Family name -> motor, `spec`'s family first.
+
+    """
+    displacement = None if default else spec.geometry.displacement
+    specs = {spec.family: spec}
+    for name in FAMILY_NAMES:
+        if name not in specs:
+            specs[name] = default_motor(name, displacement)
+    return specs
+
+
+def _parts_on(models: dict[str, MotorModel], points: BenchTable) -> tuple[BenchTable, dict]:
+    """Keep the points every family can use; return them and each family's parts there."""
+    common = np.ones(len(points), dtype=bool)
+    for model in models.values():
+        try:
+            common &= loss_parts(model, points)[1]
+        except IdentificationError:
+            continue
+    if not common.any():
+        msg = f'{points.source}: no point is usable by every model family'
+        raise IdentificationError(msg)
+    if not common.all():
+        points = points.select(common)
+    parts = {}
+    for name, model in models.items():
+        try:
+            parts[name] = loss_parts(model, points)[0]
+        except IdentificationError as err:
+            parts[name] = str(err)
+    return points, parts
+
+
+def compare_families(points: BenchTable, liquid: str, specs: dict[str, MotorSpec],
+                     selector: Callable[[], CrossValidatedSelector],
+                     min_gain: float) -> FamilyChoice:
+    """
+    Fit each family's baseline on the same points and choose the structure.
+
+    Parameters
+    ----------
+    points : BenchTable
+        Steady points (or samples), [-]
+    liquid : str
+        Coefficient set, [-]
+    specs : dict of str to MotorSpec
+        One motor per family, the motor's own family first (:func:`family_specs`), [-]
+    selector : callable
+        Makes the selector the effect search uses (same folds and noise model), [-]
+    min_gain : float
+        Least cut of the out-of-sample error for a family to replace the motor's own, [-]
+
+    Returns
+    -------
+    FamilyChoice
+        The families scored, best first, and the one chosen.
+
+    Raises
+    ------
+    IdentificationError
+        If no family can be fitted to the points.
+
+    """
+    models = {}
+    for name, spec in specs.items():
+        try:
+            models[name] = MotorModel.from_spec(spec, liquid)
+        except ModelError:
+            continue
+    common, parts = _parts_on(models, points)
+    scored = {}
+    outlier = np.zeros(len(common), dtype=bool)
+    for name, p in parts.items():
+        if isinstance(p, str):
+            continue
+        try:
+            forward = selector().select(p, ())
+        except IdentificationError as err:
+            parts[name] = str(err)
+            continue
+        scored[name] = (p, forward.steps[0].baseline.cv_error)
+        outlier |= forward.outliers
+    keep = ~outlier if (~outlier).any() else np.ones(len(common), dtype=bool)
+    scores = []
+    for name in specs:
+        if name in scored:
+            p, error = scored[name]
+            scores.append(FamilyScore(name, p.names, Errors.of(error[keep], p.loss[keep])))
+        elif name in models:
+            scores.append(FamilyScore(name, (), None, str(parts.get(name, 'not fitted'))))
+        else:
+            scores.append(FamilyScore(name, (), None, 'no model for this liquid'))
+    own = scores[0]
+    scores.sort(key=lambda s: s.rmse)
+    best = scores[0]
+    if best.error is None:
+        msg = f'{points.source}: no model family could be fitted ({own.note})'
+        raise IdentificationError(msg)
+    n = int(keep.sum())
+    if best.family == own.family:
+        verdict = f'{own.family} has the least out-of-sample error of the families'
+        return FamilyChoice(own.family, tuple(scores), n, verdict)
+    if own.error is not None and best.rmse >= (1.0 - min_gain) * own.rmse:
+        verdict = (f'{own.family} kept: {best.family} cuts the out-of-sample error by only '
+                   f'{100.0 * (1.0 - best.rmse / own.rmse):.1f} % (need > '
+                   f'{100.0 * min_gain:.0f} %)')
+        return FamilyChoice(own.family, tuple(scores), n, verdict)
+    cut = (f'cuts the out-of-sample error of {own.family} by '
+           f'{100.0 * (1.0 - best.rmse / own.rmse):.1f} %' if own.error is not None
+           else f'fits where {own.family} cannot')
+    return FamilyChoice(best.family, tuple(scores), n, f'{best.family} {cut}')
+
+
+__all__ = ['FamilyChoice', 'FamilyScore', 'compare_families', 'family_specs']
