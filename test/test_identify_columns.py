@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """Users' own logs through a column mapping: the MBARI logs, other layouts, one-line errors."""
 
+import json
 import math
 
 import numpy as np
@@ -8,6 +9,8 @@ import pytest
 from satmotor_ros.cli.main import main
 from satmotor_ros.identify import DataError
 from satmotor_ros.identify.columns import load_mapping, mapping_from_dict, read_log
+from satmotor_ros.model import load_motor
+from satmotor_ros.model.families import FAMILY_NAMES
 from satmotor_ros.model.units import INCH, LPM, MPA, PSI, RPM
 from shared_data import shared_path
 import yaml
@@ -165,3 +168,25 @@ def test_packaged_mapping_is_found_by_name_and_by_path():
     assert by_name.fields['flow'].sign == -1.0
     assert by_name.fields['flow'].area == pytest.approx(1.375 * INCH ** 2)
     assert load_mapping(by_name.source).fields == by_name.fields
+
+
+def test_calibrate_the_stepped_mbari_log_with_the_f11_displacement(tmp_path, capsys):
+    log = shared_path('data', 'real', 'mbari_pto', MBARI[0])
+    out = tmp_path / 'cal'
+    code = main(['calibrate', str(log), '--columns', 'mbari_pto', '--liquid', 'oil',
+                 '--displacement', '0.30 in^3/rev', '--out', str(out)])
+    captured = capsys.readouterr()
+    assert code == 0, captured.err
+    assert 'warning: ' in captured.err and "'p_b (LowerHydPress)'" in captured.err
+    result = json.loads((out / 'calibration.json').read_text())
+    assert result['family'] in FAMILY_NAMES and result['n_points'] >= 8
+    assert len(result['family_comparison']['families']) == 3
+    assert result['error_after']['rmse_lpm'] <= result['error_before']['rmse_lpm'] < 1.0
+    report = (out / 'report.md').read_text()
+    assert '## Model family' in report and 'columns mapped by' in report
+    assert load_motor(out / 'coefficients.yaml').family == result['family']
+    code = main(['validate', str(log), '--columns', 'mbari_pto', '--liquid', 'oil',
+                 '--motor', str(out / 'coefficients.yaml'), '--out', str(tmp_path / 'val')])
+    assert code == 0, capsys.readouterr().err
+    validation = json.loads((tmp_path / 'val' / 'validation.json').read_text())
+    assert validation['n_points'] >= result['n_points'] - len(result['outliers'])

@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 from satmotor_ros.identify.errors import IdentificationError
-from satmotor_ros.identify.parts import loss_parts
+from satmotor_ros.identify.parts import loss_parts, LossParts
 from satmotor_ros.identify.selection import CrossValidatedSelector, Errors
 from satmotor_ros.identify.table import BenchTable
 from satmotor_ros.model import MotorModel, MotorSpec
@@ -85,7 +85,8 @@ def family_specs(spec: MotorSpec, default: bool) -> dict[str, MotorSpec]:
     return specs
 
 
-def _parts_on(models: dict[str, MotorModel], points: BenchTable) -> tuple[BenchTable, dict]:
+def _parts_on(models: dict[str, MotorModel],
+              points: BenchTable) -> tuple[BenchTable, dict[str, LossParts | str]]:
     """Keep the points every family can use; return them and each family's parts there."""
     common = np.ones(len(points), dtype=bool)
     for model in models.values():
@@ -98,7 +99,7 @@ def _parts_on(models: dict[str, MotorModel], points: BenchTable) -> tuple[BenchT
         raise IdentificationError(msg)
     if not common.all():
         points = points.select(common)
-    parts = {}
+    parts: dict[str, LossParts | str] = {}
     for name, model in models.items():
         try:
             parts[name] = loss_parts(model, points)[0]

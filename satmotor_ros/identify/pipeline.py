@@ -16,7 +16,7 @@ import numpy as np
 
 from satmotor_ros.identify.candidates import build_library, Candidate
 from satmotor_ros.identify.errors import DataError, IdentificationError
-from satmotor_ros.identify.families import compare_families, FamilyChoice, family_specs
+from satmotor_ros.identify.families import compare_families, family_specs, FamilyChoice
 from satmotor_ros.identify.fit import check_identifiable, FitReport
 from satmotor_ros.identify.parts import loss_parts, LossParts, predict_flow
 from satmotor_ros.identify.selection import (CrossValidatedSelector, Errors, Forward, Score,

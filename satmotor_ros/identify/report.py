@@ -250,7 +250,7 @@ def _identifiability(cal: Calibration) -> list[str]:
 
 
 def _families(cal: Calibration) -> list[str]:
-    """The model family: how it was chosen (the structure before the effect)."""
+    """Describe the model family and how it was chosen (the structure before the effect)."""
     comparison = cal.family_comparison()
     lines = ['## Model family', '', f'**{cal.model.family.name}**: {comparison["verdict"]}.', '']
     if not comparison['families']:
@@ -263,7 +263,7 @@ def _families(cal: Calibration) -> list[str]:
                             'max abs [l/min]', 'note']), '',
               f'Each family refitted without any effect on the same {comparison["n_points"]} '
               'points (those no family calls an outlier), errors of Q_vl out of sample '
-              '(cross-validated). The motor\'s own family is kept unless another cuts its '
+              "(cross-validated). The motor's own family is kept unless another cuts its "
               'error by more than the least gain an effect must bring; `--family` pins it.', '']
     return lines
 
