@@ -124,13 +124,6 @@ def test_every_family_builds_from_the_packaged_liquids():
             assert model.speed_point(10 * LPM, 10 * MPA).status & 0xF8 == 0
 
 
-def test_calibration_refuses_a_family_the_fitter_does_not_take_yet():
-    from satmotor_ros.identify.errors import IdentificationError
-    from satmotor_ros.identify.parts import loss_parts
-    with pytest.raises(IdentificationError, match='paszota family is not supported yet'):
-        loss_parts(MotorOptions(family='paszota').build_model(), None)
-
-
 @pytest.mark.parametrize('family', ['balawender', 'paszota'])
 def test_effects_of_a_coefficient_set_work_in_every_family(family, tmp_path):
     from satmotor_ros.model.config import motor_from_mapping
