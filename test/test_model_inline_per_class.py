@@ -1,29 +1,17 @@
 # SPDX-License-Identifier: Apache-2.0
 """A composition specialised per displacement law reads the law's equations in place."""
 
-import dis
-
 import numpy as np
 import pytest
 
 from satmotor_ros.model import MotorModel
 from satmotor_ros.model._inline import inline_per_class
 from satmotor_ros.model.units import LPM, MPA, RPM
+from test_model_inline import _loaded_names
 
 LAW_TERMS = {'loss_at', 'floor_at', 'pressure_state', 'speed_terms', 'speed_state',
              'pressure_terms', 'displacement_change_empirical', 'displacement_loss',
              'empirical_speed_floor'}
-
-
-def _loaded_names(func):
-    """Return the globals and attributes a function's code loads, its nested functions' too."""
-    code = getattr(func, '__code__', func)
-    names = {i.argval for i in dis.get_instructions(code)
-             if i.opname in ('LOAD_GLOBAL', 'LOAD_ATTR', 'LOAD_METHOD', 'LOAD_NAME')}
-    for const in code.co_consts:
-        if hasattr(const, 'co_code'):
-            names |= _loaded_names(const)
-    return names
 
 
 @pytest.mark.parametrize('law', ['eq33', 'eq39'])

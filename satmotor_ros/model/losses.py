@@ -484,22 +484,8 @@ def displacement_change_at_root(dp_i: Real, inv_sqrt_n: Real, c1: float, c2: flo
     """
     Compute Delta q of eq. (39) from 1/sqrt(n), n in rpm: :func:`displacement_change_empirical`.
 
-    Parameters
-    ----------
-    dp_i : float or ndarray
-        Pressure drop in the working chambers, at least :data:`EMPIRICAL_DP_FLOOR`, [Pa]
-    inv_sqrt_n : float or ndarray
-        1/sqrt(n), [(rev/min)^-0.5]
-    c1 : float
-        C_1 of eq. (39), [cm^3/rev (rev/min)^0.5]
-    c2 : float
-        C_2 of eq. (39), [(rev/min)^0.5]
-
-    Returns
-    -------
-    float or ndarray
-        Delta q, [m^3/rad].
-
+    Its arguments but `inv_sqrt_n` [(rev/min)^-0.5] in place of the speed, so that
+    a solve at fixed n computes the root once; Delta q in m^3/rad.
     """
     return c1 * inv_sqrt_n * (dp_i / MPA) ** (c2 * inv_sqrt_n) * CM3_PER_REV
 
