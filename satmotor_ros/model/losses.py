@@ -484,8 +484,24 @@ def displacement_change_at_root(dp_i: Real, inv_sqrt_n: Real, c1: float, c2: flo
     """
     Compute Delta q of eq. (39) from 1/sqrt(n), n in rpm: :func:`displacement_change_empirical`.
 
-    Its arguments but `inv_sqrt_n` [(rev/min)^-0.5] in place of the speed, so that
-    a solve at fixed n computes the root once; Delta q in m^3/rad.
+    A solve at fixed n computes the root once and calls this (see that function's notes).
+
+    Parameters
+    ----------
+    dp_i : float or ndarray
+        Chamber pressure drop, not below the 1 MPa floor, [Pa]
+    inv_sqrt_n : float or ndarray
+        1/sqrt(n) with n in rev/min, [(rev/min)^-0.5]
+    c1 : float
+        Eq. (39)'s factor C_1, [cm^3/rev (rev/min)^0.5]
+    c2 : float
+        Eq. (39)'s exponent factor C_2, [(rev/min)^0.5]
+
+    Returns
+    -------
+    float or ndarray
+        Delta q, [m^3/rad]
+
     """
     return c1 * inv_sqrt_n * (dp_i / MPA) ** (c2 * inv_sqrt_n) * CM3_PER_REV
 
