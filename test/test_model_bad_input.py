@@ -17,8 +17,8 @@ def oil():
 @pytest.mark.parametrize(('kwargs', 'match'), [
     ({'flow': np.nan, 'dp': 10 * MPA}, r'^flow = nan m\^3/s: not finite$'),
     ({'flow': np.inf, 'dp': 10 * MPA}, r'^flow = inf m\^3/s: not finite$'),
-    ({'flow': -1e-4, 'dp': 10 * MPA}, r'^flow = -0.0001 m\^3/s: negative$'),
-    ({'flow': 1e-4, 'dp': -1.0}, r'^dp = -1.0 Pa: negative$'),
+    ({'flow': -np.inf, 'dp': 10 * MPA}, r'^flow = -inf m\^3/s: not finite$'),
+    ({'flow': 1e-4, 'dp': -np.inf}, r'^dp = -inf Pa: not finite$'),
     ({'flow': 1e-4, 'dp_i': np.nan}, r'^dp_i = nan Pa: not finite$'),
     ({'flow': 1e-4, 'dp': 1e6, 'p_ex': -5.0}, r'^p_ex = -5.0 Pa: negative$'),
     ({'flow': 1e-4, 'dp': 80 * MPA}, r'^dp = 80000000.0 Pa: chamber pressure drop beyond'),
@@ -47,13 +47,14 @@ def test_batch_error_index_is_global_across_chunks(oil):
 def test_mask_mode_keeps_the_batch_and_reports_which_elements_are_invalid(oil):
     flow = np.array([5, np.nan, -1, 5, 5, 0.0]) * LPM
     dp = np.array([10, 10, 10, np.inf, 80, 10]) * MPA
-    op = oil.speed(flow, dp, errors='mask')
+    p_ex = np.array([0, 0, -1, 0, 0, 0]) * MPA
+    op = oil.speed(flow, dp, p_ex=p_ex, errors='mask')
     assert op.invalid.tolist() == [False, True, True, True, True, False]
     assert np.isnan(op.speed[op.invalid]).all()
     assert np.isnan(op.losses.total[op.invalid]).all()
     assert op.speed[0] == pytest.approx(oil.speed(5 * LPM, 10 * MPA).speed)
     assert describe_status(op.status[1]) == 'NOT_FINITE'
-    assert describe_status(op.status[2]) == 'NEGATIVE'
+    assert describe_status(op.status[2]) == 'NEGATIVE'  # p_ex; a negative flow is pump mode
     assert describe_status(op.status[3]) == 'NOT_FINITE'
     assert describe_status(op.status[4]) == 'BEYOND_LIMIT'
     assert op.status[5] & PointStatus.STALLED
@@ -85,9 +86,11 @@ def test_beyond_validated_range_is_computed_and_flagged_extrapolated(oil):
     assert fast.status & PointStatus.EXTRAPOLATED
 
 
-def test_forward_map_rejects_negative_speed_and_eq39_below_its_floor():
-    with pytest.raises(InvalidInputError, match=r'^speed = -1.0 rad/s: negative$'):
-        MotorModel.default('oil').absorbency(-1.0, dp_i=1e6)
+def test_forward_map_takes_negative_speed_and_rejects_eq39_below_its_floor():
+    # a negative speed was refused until the model went four-quadrant (issue 13)
+    oil = MotorModel.default('oil')
+    backwards = oil.absorbency(-1.0, dp_i=-1e6).flow
+    assert backwards.shape == () and float(backwards) == -float(oil.absorbency(1.0, dp_i=1e6).flow)
     with pytest.raises(InvalidInputError, match='below the floor of eq. \\(39\\)'):
         MotorModel.default('oil', 'eq39').absorbency(1e-4, dp_i=25 * MPA)
     assert float(MotorModel.default('oil', 'eq39').absorbency(0.0, dp_i=25 * MPA).flow) > 0.0

@@ -155,10 +155,10 @@ def test_point_is_python_floats_and_an_int_status():
 
 @pytest.mark.parametrize(('call', 'flag'), [
     (lambda m: m.speed_point(math.nan, 1e6), PointStatus.NOT_FINITE),
-    (lambda m: m.speed_point(1e-4, dp_i=-1.0), PointStatus.NEGATIVE),
+    (lambda m: m.speed_point(1e-4, dp_i=-1.0, p_ex=-1.0), PointStatus.NEGATIVE),
     (lambda m: m.speed_point(1e-4, 1e6, p_ex=math.inf), PointStatus.NOT_FINITE),
     (lambda m: m.speed_point(1e-4, 80 * MPA), PointStatus.BEYOND_LIMIT),
-    (lambda m: m.absorbency_point(-1.0, 1e6), PointStatus.NEGATIVE),
+    (lambda m: m.absorbency_point(-1.0, 1e6, p_ex=-5.0), PointStatus.NEGATIVE),
     (lambda m: m.absorbency_point(10.0, dp_i=math.inf), PointStatus.NOT_FINITE),
     (lambda m: m.breakdown_point(10.0, 60 * MPA), PointStatus.BEYOND_LIMIT),
 ])

@@ -70,7 +70,10 @@ class ConditionedModel:
         motor = [(kind, e) for kind, e in motor if not kind.sensor]
         self.channels = tuple(sorted({e.channel for _, e in motor if e.channel}))
         self._conditioning = tuple((kind, e) for kind, e in motor if e.channel)
-        self._terms = tuple(f for f in (kind.loss(e) for kind, e in motor) if f is not None)
+        self._terms = tuple(f for f in (kind.loss(e) for kind, e in motor if not kind.reverse)
+                            if f is not None)
+        self._reverse_terms = tuple(f for f in (kind.loss(e) for kind, e in motor
+                                                if kind.reverse) if f is not None)
         self._bare = core
         self._variants: dict[tuple[float, float], ModelCore] = {}
 
@@ -143,9 +146,30 @@ class ConditionedModel:
             return None, now.p_ex, 0.0, int(PointStatus.BEYOND_LIMIT)
         return model, now.p_ex, now.extra, 0
 
-    def _extra(self, speed: float, dp_i: float, constant: float) -> float:
+    def channel_drop(self, p_ex: float, channels: Channels | None) -> Callable[[float], float]:
+        """
+        Return Q -> the channel drop of eq. (35) of the motor at the channels' values, [Pa].
+
+        Parameters
+        ----------
+        p_ex : float
+            Pressure driving the external leakage when no effect names one, [Pa]
+        channels : mapping of str to float or None
+            Measured channels by name, [-]
+
+        Returns
+        -------
+        callable
+            The drop; NaN where the channels make the motor invalid.
+
+        """
+        model = self.conditions(channels, p_ex)[0]
+        return model.eqs.channel_drop if model is not None else lambda flow: math.nan
+
+    def _extra(self, speed: float, dp_i: float, constant: float, reverse: bool) -> float:
         try:
-            return constant + sum(f(speed, dp_i) for f in self._terms)
+            extra = constant + sum(f(speed, dp_i) for f in self._terms)
+            return extra + sum(f(speed, dp_i) for f in self._reverse_terms) if reverse else extra
         except OverflowError:
             return math.inf  # flagged BEYOND_LIMIT by _with_extra
 
@@ -172,7 +196,7 @@ class ConditionedModel:
     # -- maps ------------------------------------------------------------------------------
 
     def speed_point(self, flow: float, dp: float, port: bool, p_ex: float,
-                    channels: Channels | None) -> Point:
+                    channels: Channels | None, reverse: bool = False) -> Point:
         """
         Compute the inverse map n(Q, dp) at one point with the effects.
 
@@ -188,6 +212,9 @@ class ConditionedModel:
             Pressure driving the external leakage when no effect names one, [Pa]
         channels : mapping of str to float or None
             Measured channels by name, [-]
+        reverse : bool
+            Whether the shaft turns backwards (n < 0 before the magnitudes were
+            taken): the effects keyed on that direction apply, [-]
 
         Returns
         -------
@@ -200,7 +227,8 @@ class ConditionedModel:
             return _invalid(status)
         evaluator = model.point
         first = evaluator.speed(flow, dp, port, p_ex)
-        if (not self._terms and constant == 0.0) or first.status & _SCREENED:
+        if (not self._terms and constant == 0.0 and not (reverse and self._reverse_terms)
+                or first.status & _SCREENED):
             return first  # no extra loss; or bad input or beyond the limit, whatever the effect
         dp_i = model.eqs.chamber_drop(dp, flow) if port else dp
         limited = _CHANNEL_LIMITED if dp_i < 0.0 else 0
@@ -208,7 +236,7 @@ class ConditionedModel:
 
         def excess(n: float) -> float:
             at = evaluator.absorbency(n, dp_i, False, p_ex, None)
-            return at.flow + self._extra(n, dp_i, constant) - flow
+            return at.flow + self._extra(n, dp_i, constant, reverse) - flow
 
         lo = model.eqs.law.floor(dp_i)
         f_lo = excess(lo)
@@ -236,10 +264,11 @@ class ConditionedModel:
             status = 0
         point = evaluator.absorbency(speed, dp_i, False, p_ex, None)
         return self._with_extra(model, point, flow, dp if port else None,
-                                self._extra(speed, dp_i, constant), status | limited)
+                                self._extra(speed, dp_i, constant, reverse), status | limited)
 
     def absorbency_point(self, speed: float, dp: float, port: bool, p_ex: float,
-                         flow_guess: float | None, channels: Channels | None) -> Point:
+                         flow_guess: float | None, channels: Channels | None,
+                         reverse: bool = False) -> Point:
         """
         Compute the forward map Q(n, dp) at one point with the effects.
 
@@ -257,6 +286,8 @@ class ConditionedModel:
             Starting estimate of Q for the coupled solve, [m^3/s]
         channels : mapping of str to float or None
             Measured channels by name, [-]
+        reverse : bool
+            Whether the shaft turns backwards: the effects keyed on it apply, [-]
 
         Returns
         -------
@@ -269,10 +300,12 @@ class ConditionedModel:
             return _invalid(status)
         evaluator = model.point
         first = evaluator.absorbency(speed, dp, port, p_ex, flow_guess)
-        if (not self._terms and constant == 0.0) or first.status & _INVALID_FLAGS:
+        if (not self._terms and constant == 0.0 and not (reverse and self._reverse_terms)
+                or first.status & _INVALID_FLAGS):
             return first
         if not port:
-            return self._with_extra(model, first, None, None, self._extra(speed, dp, constant),
+            return self._with_extra(model, first, None, None,
+                                    self._extra(speed, dp, constant, reverse),
                                     first.status & _STALLED)
 
         def chamber(q: float) -> float:
@@ -281,10 +314,10 @@ class ConditionedModel:
         def excess(q: float) -> float:
             dp_i = chamber(q)
             at = evaluator.absorbency(speed, dp_i, False, p_ex, None)
-            return q - at.flow - self._extra(speed, dp_i, constant)
+            return q - at.flow - self._extra(speed, dp_i, constant, reverse)
 
         q0 = first.flow
-        step = abs(self._extra(speed, first.dp_i, constant)) + abs(q0) * 1e-6 + 1e-12
+        step = abs(self._extra(speed, first.dp_i, constant, reverse)) + abs(q0) * 1e-6 + 1e-12
         lo, hi = q0 - step, q0 + step
         f_lo, f_hi = excess(lo), excess(hi)
         for _ in range(_EXPANSIONS):
@@ -305,7 +338,8 @@ class ConditionedModel:
         dp_i = chamber(flow)
         limited = _CHANNEL_LIMITED if model.eqs.chamber_drop(dp, flow) < 0.0 else 0
         point = evaluator.absorbency(speed, dp_i, False, p_ex, None)
-        point = self._with_extra(model, point, None, dp, self._extra(speed, dp_i, constant),
+        point = self._with_extra(model, point, None, dp,
+                                 self._extra(speed, dp_i, constant, reverse),
                                  (point.status & _STALLED) | limited)
         return point if point.status & _INVALID_FLAGS else point._replace(flow=flow)
 

@@ -19,10 +19,12 @@ with ``errors='raise'`` (the default) the first bad element raises
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from typing import Any, Literal
 
-from satmotor_ros.model._typing import ArrayLike, Real
+import numpy as np
+
+from satmotor_ros.model._typing import ArrayLike, FloatArray, Real
 from satmotor_ros.model.coefficients import (CoefficientSet, Liquid, MotorGeometry,
                                              ValidRange)
 from satmotor_ros.model.conditioned import ConditionedModel, map_points
@@ -35,6 +37,7 @@ from satmotor_ros.model.families.defaults import default_motor
 from satmotor_ros.model.forward import absorbency_map
 from satmotor_ros.model.inverse import speed_map
 from satmotor_ros.model.point import as_float
+from satmotor_ros.model.quadrants import chamber_drop, Channels, Quadrants, signed_map
 from satmotor_ros.model.results import LossBreakdown, OperatingPoints, Point
 from satmotor_ros.model.screening import Errors
 
@@ -55,12 +58,43 @@ def _point_dp(dp: object, dp_i: object) -> tuple[bool, float]:
     raise ModelError('give exactly one of dp (between the ports) and dp_i (chambers)')
 
 
+class _Magnitudes:
+    """The model's single-point path at magnitudes, for :class:`Quadrants`."""
+
+    def __init__(self, core: ModelCore, conditioned: ConditionedModel | None) -> None:
+        self.qt = core.geometry.displacement
+        self._point, self._conditioned = core.point, conditioned
+        self._drop = core.eqs.channel_drop
+
+    def speed(self, flow: float, dp: float, port: bool, p_ex: float, channels: Channels,
+              reverse: bool) -> Point:
+        if self._conditioned is not None:
+            return self._conditioned.speed_point(flow, dp, port, p_ex, channels, reverse)
+        return self._point.speed(flow, dp, port, p_ex)
+
+    def absorbency(self, speed: float, dp: float, port: bool, p_ex: float,
+                   flow_guess: float | None, channels: Channels, reverse: bool) -> Point:
+        if self._conditioned is not None:
+            return self._conditioned.absorbency_point(speed, dp, port, p_ex, flow_guess,
+                                                      channels, reverse)
+        return self._point.absorbency(speed, dp, port, p_ex, flow_guess)
+
+    def channel_drop(self, p_ex: float, channels: Channels) -> Callable[[float], float]:
+        if self._conditioned is not None:
+            return self._conditioned.channel_drop(p_ex, channels)
+        return self._drop
+
+
 class MotorModel:
     """
     The volumetric-loss and speed model of one motor on one liquid, in one model family.
 
     The family is the one the coefficients belong to (:attr:`family`); every
     family gives the same results, statuses and guarantees.
+
+    Every map takes signed flow, speed and pressure drops (four quadrants, see
+    :mod:`.quadrants`): positive flow enters port A, dp = p_a - p_b, and the
+    losses run from the higher- to the lower-pressure port.
 
     Parameters
     ----------
@@ -108,6 +142,7 @@ class MotorModel:
         self.effects = coefficient_set.effects
         self._conditioned = ConditionedModel(core) if self.effects else None
         self.channels = self._conditioned.channels if self._conditioned else ()
+        self._quadrants = Quadrants(_Magnitudes(core, self._conditioned))
 
     # constants of the equations for this liquid, read from :attr:`derived`
     c_fc_beta = _derived('c_fc_beta', 'C_fc*beta_l of eq. (11) for this liquid, [1/(MPa*rev)].')
@@ -252,8 +287,12 @@ class MotorModel:
                 lambda q, d, p, c: self.speed_point(q, **{dp_name: d}, p_ex=p, channels=c),
                 ('flow', flow), (dp_name, dp_value), p_ex, channels, self.geometry, errors)
         closed_form = self.law.closed_form and method == 'auto'
-        return speed_map(self._equations, self.geometry, flow, dp_name, dp_value, p_ex, errors,
-                         closed_form)
+        port = dp_name == 'dp'
+        return signed_map(
+            lambda q, d, p: self._quadrants.speed(q, d, port, p, None),
+            lambda q, d, p, err: speed_map(self._equations, self.geometry, q, dp_name, d, p,
+                                           err, closed_form),
+            ('flow', flow), (dp_name, dp_value), p_ex, self.geometry, errors)
 
     def absorbency(self, speed: ArrayLike, dp: ArrayLike | None = None, *,
                    dp_i: ArrayLike | None = None, p_ex: ArrayLike = 0.0,
@@ -292,8 +331,12 @@ class MotorModel:
             return map_points(
                 lambda n, d, p, c: self.absorbency_point(n, **{dp_name: d}, p_ex=p, channels=c),
                 ('speed', speed), (dp_name, dp_value), p_ex, channels, self.geometry, errors)
-        return absorbency_map(self._equations, self.geometry, speed, dp_name, dp_value, p_ex,
-                              errors)
+        port = dp_name == 'dp'
+        return signed_map(
+            lambda n, d, p: self._quadrants.absorbency(n, d, port, p, None, None),
+            lambda n, d, p, err: absorbency_map(self._equations, self.geometry, n, dp_name, d,
+                                                p, err),
+            ('speed', speed), (dp_name, dp_value), p_ex, self.geometry, errors)
 
     @staticmethod
     def _which_dp(dp: ArrayLike | None, dp_i: ArrayLike | None) -> tuple[str, ArrayLike]:
@@ -376,6 +419,8 @@ class MotorModel:
             flow = as_float('flow', flow)
         if type(p_ex) is not float:
             p_ex = as_float('p_ex', p_ex)
+        if not (flow >= 0.0 and value >= 0.0):  # any other quadrant, or NaN
+            return self._quadrants.speed(flow, value, port, p_ex, channels)
         if self._conditioned is not None:
             return self._conditioned.speed_point(flow, value, port, p_ex, channels)
         return self._point.speed(flow, value, port, p_ex)
@@ -428,6 +473,8 @@ class MotorModel:
             p_ex = as_float('p_ex', p_ex)
         if flow_guess is not None and type(flow_guess) is not float:
             flow_guess = as_float('flow_guess', flow_guess)
+        if not (speed >= 0.0 and value >= 0.0):  # any other quadrant, or NaN
+            return self._quadrants.absorbency(speed, value, port, p_ex, flow_guess, channels)
         if self._conditioned is not None:
             return self._conditioned.absorbency_point(speed, value, port, p_ex, flow_guess,
                                                       channels)
@@ -461,9 +508,34 @@ class MotorModel:
             dp_i = as_float('dp_i', dp_i)
         if type(p_ex) is not float:
             p_ex = as_float('p_ex', p_ex)
+        if not (speed >= 0.0 and dp_i >= 0.0):
+            return self._quadrants.absorbency(speed, dp_i, False, p_ex, None, channels)
         if self._conditioned is not None:
             return self._conditioned.absorbency_point(speed, dp_i, False, p_ex, None, channels)
         return self._point.absorbency(speed, dp_i, False, p_ex, None)
+
+    def chamber_drop(self, dp: ArrayLike, flow: ArrayLike) -> FloatArray:
+        """
+        Compute the chamber drop of eqs. (34)-(35) for flows of either sign.
+
+        The channel drop of eq. (35) runs with the flow: dp_i = dp - sign(Q)
+        dp_ich(|Q|), so in pump mode the chambers deliver more than the ports.
+
+        Parameters
+        ----------
+        dp : float or ndarray
+            p_a - p_b at the ports, [Pa]
+        flow : float or ndarray
+            Flow entering port A, [m^3/s]
+
+        Returns
+        -------
+        ndarray
+            dp_i, unclipped (of the other sign where the channels take more than dp), [Pa]
+
+        """
+        return chamber_drop(self._equations.channel_drop, np.asarray(dp, dtype=float),
+                            np.asarray(flow, dtype=float))
 
     # -- instruments -----------------------------------------------------------------------
 

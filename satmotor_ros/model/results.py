@@ -23,7 +23,7 @@ class PointStatus(enum.IntFlag):
     CHANNEL_LIMITED = 2  # dp_ich >= dp: the chamber drop dp_i is clipped to 0
     EXTRAPOLATED = 4  # beyond the coefficient set's validated range (computed)
     NOT_FINITE = 8  # NaN or inf input (invalid: output NaN)
-    NEGATIVE = 16  # negative flow, speed or pressure drop (invalid: output NaN)
+    NEGATIVE = 16  # a negative p_ex (flow, speed and drops are signed) (invalid: output NaN)
     BEYOND_LIMIT = 32  # where the equations stop being physical (invalid: output NaN)
     NOT_CONVERGED = 64  # an iterative solve ran out of iterations (invalid: output NaN)
     NO_ROOT = 128  # the equations have no solution at this point (invalid: output NaN)

@@ -261,5 +261,6 @@ def with_secant_slope(func: Callable[[float], float], x: float,
         run = x - last[0]
         slope = (f - last[1]) / run if run else math.nan
         last[0], last[1] = x, f
-        return f, slope
+        # an end at +-inf gives an infinite slope, whose Newton step of 0 would look converged
+        return f, (slope if -math.inf < slope < math.inf else math.nan)
     return residual

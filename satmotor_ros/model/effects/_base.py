@@ -312,6 +312,7 @@ class EffectKind:
     reads_channel: bool = False  # the model needs its regressor's value
     drifts: bool = False  # it changes the motor itself (a rebuilt model)
     sensor: str = ''  # the channel of an instrument error ('flow', 'speed')
+    reverse: bool = False  # its loss() applies only while the shaft turns backwards (n < 0)
     unit: str = '-'  # unit of the coefficient
     source: str = ''  # the physics or standard the term comes from
     evaluation: str = ''  # what the model does with it (written into the YAML)
