@@ -15,15 +15,15 @@ from shared_data import foreign_bag, FOREIGN_BAGS
 OIL = MotorModel.default('oil')
 
 
-def _bag(path, n=300, prefix='/motor1/', reversed_from=None, joint=True, names=None):
+def _bag(path, n=300, prefix='/motor1/', bad_from=None, joint=True, names=None):
     """Write an input bag at 100 Hz: pressures 1 ms, joint 2 ms before each flow_command."""
     rng = np.random.default_rng(7)
     t = 2_000_000_000 + np.arange(n, dtype=np.int64) * 10_000_000
     flow = rng.uniform(5, 40, n) * LPM
     p_in = rng.uniform(5, 25, n) * MPA
     p_out = rng.uniform(0.1, 1.0, n) * MPA
-    if reversed_from is not None:
-        p_out[reversed_from:] = p_in[reversed_from:] + MPA
+    if bad_from is not None:  # an absolute pressure below 0 (p_out > p_in is a pump's drop)
+        p_out[bad_from:] = -MPA
     speed = rng.uniform(50, 150, n)
     names = names or {}
     topics = [
@@ -90,7 +90,7 @@ def test_replay_without_measured_speed_reports_no_residual_and_no_plot(tmp_path,
 
 
 def test_replay_marks_rejected_rows_and_counts_them(tmp_path, capsys):
-    _bag(tmp_path / 'bag', reversed_from=200)
+    _bag(tmp_path / 'bag', bad_from=200)
     assert main(['replay', str(tmp_path / 'bag'), '--out', str(tmp_path / 'p.csv'),
                  '--no-plot']) == 0
     printed = capsys.readouterr().out
@@ -98,12 +98,12 @@ def test_replay_marks_rejected_rows_and_counts_them(tmp_path, capsys):
     assert 'first ERROR at 2.000 s: outlet_pressure.fluid_pressure = ' in printed
     rows = _rows(tmp_path / 'p.csv')
     assert rows[250]['level'] == 'ERROR' and rows[250]['speed [rpm]'] == ''
-    assert rows[250]['inputs'] == 'outlet_pressure:REVERSED'
+    assert rows[250]['inputs'] == 'outlet_pressure:NEGATIVE'
     assert rows[10]['level'] == 'OK' and rows[10]['inputs'] == ''
 
 
 def test_replay_with_no_usable_prediction_fails_with_one_line(tmp_path, capsys):
-    _bag(tmp_path / 'bag', reversed_from=0)
+    _bag(tmp_path / 'bag', bad_from=0)
     assert main(['replay', str(tmp_path / 'bag')]) == 1
     err = capsys.readouterr().err
     assert err.count('\n') == 1 and 'none of 300 predictions could be made' in err

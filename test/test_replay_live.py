@@ -69,7 +69,7 @@ def test_live_run_recorded_and_replayed_gives_identical_predictions(harness, tmp
         steps = 25
         for k in range(steps):
             p_in = rng.uniform(5, 25) * MPA
-            p_out = p_in + MPA if k in (7, 8) else rng.uniform(0.1, 1.0) * MPA
+            p_out = -MPA if k in (7, 8) else rng.uniform(0.1, 1.0) * MPA
             motor.inputs(p_in=p_in, p_out=p_out, speed=float(rng.uniform(20, 150)))
             harness.spin_for(0.05)
             motor.flow.publish(Float64(data=float(rng.uniform(2, 40)) * LPM))
@@ -81,7 +81,7 @@ def test_live_run_recorded_and_replayed_gives_identical_predictions(harness, tmp
         harness.executor.remove_node(node)
         node.destroy_node()
     live = [m.velocity[0] for m in motor.predicted]
-    assert len(live) == steps - 2  # steps 7 and 8 (p_out > p_in) are rejected
+    assert len(live) == steps - 2  # steps 7 and 8 (p_out < 0 absolute) are rejected
     recorder.write(tmp_path / 'live')
     out = tmp_path / 'replay.csv'
     assert main(['replay', str(tmp_path / 'live'), '--out', str(out), '--no-plot']) == 0
@@ -89,7 +89,7 @@ def test_live_run_recorded_and_replayed_gives_identical_predictions(harness, tmp
         rows = list(csv.DictReader(stream))
     published = [r for r in rows if r['level'] != 'ERROR']
     assert len(rows) == steps and len(published) == len(live)
-    assert [r['inputs'] for r in rows[7:9]] == ['outlet_pressure:REVERSED'] * 2
+    assert [r['inputs'] for r in rows[7:9]] == ['outlet_pressure:NEGATIVE'] * 2
     np.testing.assert_allclose([float(r['speed [rad/s]']) for r in published], live,
                                rtol=1e-12)
     for c in COMPONENTS:

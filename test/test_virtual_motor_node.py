@@ -90,7 +90,7 @@ def test_commanded_flow_turns_the_shaft_at_the_models_speed(ros):
 
 
 def test_bad_commands_are_refused_held_and_reported(ros):
-    """NaN, negative and absurd flows: the node keeps the last good command and says so."""
+    """A NaN or absurd flow (either sign): the node keeps the last good command, says so."""
     context, executor, probe = ros
     node = _motor(context, executor, diagnostics_period=0.05)
     command = probe.create_publisher(Float64, 'flow_command', 10)

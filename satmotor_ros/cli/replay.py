@@ -292,7 +292,7 @@ def residual_stats(batch: PredictionBatch) -> dict[str, float] | None:
 
 
 def _state_notes(batch: PredictionBatch) -> list[str]:
-    """Name, per prediction, the inputs that are not usable (e.g. 'p_out:REVERSED')."""
+    """Name, per prediction, the inputs that are not usable (e.g. 'p_out:NEGATIVE')."""
     states = batch.snapshots.states.astype(np.int64)
     key = np.zeros(states.shape[1], dtype=np.int64)
     for row in states:  # one small integer per combination of input states

@@ -7,6 +7,11 @@ The model gives it as the sum of the leakage (eqs. 1, 5, 24) and the
 speed-dependent part (eqs. 11-14, 33), evaluated at the measured speed and
 at the chamber drop dp_i = dp - dp_ich(Q) of eqs. (34)-(35), where Q is the
 measured flow, so no equation has to be solved per point.
+
+Rows may be signed (four quadrants, doc/quadrants.md): each row is taken in
+the frame where its loss runs forward, i.e. flow, displacement and drops are
+multiplied by s = sign(dp), and the components are the model's at |n| and
+|dp_i|, so the fit and every candidate see the loss as in forward motor mode.
 """
 
 from __future__ import annotations
@@ -53,11 +58,11 @@ class Component:
 class LossParts:
     """Model components at the measured points, each for unit scale factors, [m^3/s]."""
 
-    flow: FloatArray  # measured Q [m^3/s]
-    speed: FloatArray  # measured n [rad/s]
-    dp: FloatArray  # port drop [Pa]
-    dp_i: FloatArray  # chamber drop, eq. (34) [Pa]
-    displacement: FloatArray  # q_t n [m^3/s]
+    flow: FloatArray  # measured Q, times s [m^3/s]
+    speed: FloatArray  # measured |n| [rad/s]
+    dp: FloatArray  # port drop |dp| [Pa]
+    dp_i: FloatArray  # chamber drop |dp_i|, eqs. (34)-(35) with the signed flow [Pa]
+    displacement: FloatArray  # q_t n, times s [m^3/s]
     clearance: FloatArray  # h, eq. (2) [m]
     clearance_satellites: float  # h_S [m]
     h_exponent: float  # Q_Lfg ~ h^(3/(2-beta)), eq. (1) [-]
@@ -67,6 +72,13 @@ class LossParts:
     components: tuple[Component, ...] = ()  # the fitted parts of Q_vl, one factor each
     nuisance: Mapping[str, FloatArray] = field(default_factory=dict)  # name -> x (SI), fitted
     # linearly without a prior in every fit (e.g. dp/dt of a time series)
+    sign: FloatArray | float = 1.0  # s = sign(dp): the row's frame, +1 or -1 [-]
+    rotation: FloatArray | float = 1.0  # sign of the measured speed, -1, 0 or +1 [-]
+
+    @property
+    def reverse(self) -> np.ndarray:
+        """Return which rows turn backwards (n < 0): where a direction-keyed effect acts."""
+        return np.asarray(self.rotation) < 0.0
 
     @property
     def loss(self) -> FloatArray:
@@ -129,7 +141,7 @@ def predict_flow(parts: LossParts, scales: FloatArray, mod: Modifier = NO_EFFECT
     if nuisance is not None:
         for beta, x in zip(nuisance, parts.nuisance.values()):
             inner = inner + beta * x
-    return mod.flow_gain * inner + mod.offset
+    return mod.flow_gain * inner + mod.offset * parts.sign
 
 
 def loss_parts(model: MotorModel, table: BenchTable) -> tuple[LossParts, np.ndarray]:
@@ -148,8 +160,9 @@ def loss_parts(model: MotorModel, table: BenchTable) -> tuple[LossParts, np.ndar
     LossParts
         Components at the usable points.
     ndarray of bool
-        Which rows of `table` were usable (finite, forward flow and speed,
-        dp_i within the model's limit).
+        Which rows of `table` were usable (finite, a flow the model can give:
+        not a shaft turning with the pressure and no flow that way, the
+        channels not taking the whole port drop, dp_i within the model's limit).
 
     Raises
     ------
@@ -157,20 +170,26 @@ def loss_parts(model: MotorModel, table: BenchTable) -> tuple[LossParts, np.ndar
         If no point is usable.
 
     """
-    flow, speed, dp = table.flow, table.speed, table.dp
-    dp_i = model.equations.chamber_drop(dp, np.maximum(flow, 0.0))
-    usable = (np.isfinite(flow) & np.isfinite(speed) & np.isfinite(dp) & (flow > 0.0)
-              & (speed >= 0.0) & (dp_i >= 0.0) & (dp_i < model.dp_limit))
+    with np.errstate(invalid='ignore'):
+        s = np.where(table.dp < 0.0, -1.0, np.where((table.dp == 0.0) & (table.flow < 0.0),
+                                                    -1.0, 1.0))
+        flow, speed, dp = s * table.flow, s * table.speed, s * table.dp  # the loss runs forward
+        dp_i = s * model.chamber_drop(table.dp, table.flow)
+        usable = (np.isfinite(flow) & np.isfinite(speed) & np.isfinite(dp)
+                  & ((flow > 0.0) | (speed < 0.0)) & (dp_i >= 0.0) & (dp_i < model.dp_limit))
     if not usable.any():
-        msg = (f'{table.source}: no usable point (need flow > 0, speed >= 0 and a chamber '
-               f'pressure drop between 0 and {model.dp_limit / 1e6:.1f} MPa)')
+        msg = (f'{table.source}: no usable point (need a flow, with the pressure drop unless '
+               'the shaft turns against it, and a chamber pressure drop between 0 and '
+               f'{model.dp_limit / 1e6:.1f} MPa)')
         raise IdentificationError(msg)
     n, dpi = speed[usable], dp_i[usable]
+    signs = {'sign': s[usable], 'rotation': np.sign(table.speed[usable])}
     if model.family.name != 'sliwinski2017':
-        return _family_parts(model, flow[usable], n, dp[usable], dpi), usable
+        return _family_parts(model, flow[usable], n, dp[usable], dpi, signs), usable
     coef = model.coef
     d = model.derived
-    losses = model.breakdown(n, dpi)
+    magnitude = np.abs(n)
+    losses = model.breakdown(magnitude, dpi)
     beta = coef.beta
     pressure_speed = losses.compressibility + losses.deformation + losses.backlash
     components = (
@@ -182,13 +201,13 @@ def loss_parts(model: MotorModel, table: BenchTable) -> tuple[LossParts, np.ndar
                   'pressure_speed'),
         Component('c_id_scale', (('', losses.inertia),), 0.5, 0.0, 'C_id (eq. 14)', 'inertia'))
     parts = LossParts(
-        flow=flow[usable].copy(), speed=n.copy(), dp=dp[usable].copy(), dp_i=dpi.copy(),
+        flow=flow[usable].copy(), speed=magnitude, dp=dp[usable].copy(), dp_i=dpi.copy(),
         displacement=model.geometry.displacement * n,
         clearance=clearance_height(dpi, d.h0, d.compliance),
         clearance_satellites=model.geometry.clearance_satellites,
         h_exponent=3.0 / (2.0 - beta), hs_exponent=coef.c2,
         nu_exponent_lfg=-beta / (2.0 - beta), nu_exponent_c=-coef.gamma,
-        components=components)
+        components=components, **signs)
     return parts, usable
 
 
@@ -198,14 +217,16 @@ effects scale them as a plane gap would (Q ~ h^3 / nu)."""
 
 
 def _family_parts(model: MotorModel, flow: FloatArray, n: FloatArray, dp: FloatArray,
-                  dp_i: FloatArray) -> LossParts:
+                  dp_i: FloatArray, signs: Mapping[str, FloatArray]) -> LossParts:
     """
     Components of a family other than eqs. (31)-(33): one factor per linear part of its Q_vl.
 
     A part that is zero at every point (the external leakage of a set without one) is left
-    out: no factor could be fitted on it.
+    out: no factor could be fitted on it. `n` is the speed in the row's frame (negative
+    for a pump), `signs` the rows' ``sign`` and ``rotation``.
     """
-    losses = model.family.linear_losses(model, n, dp_i)
+    magnitude = np.abs(n)
+    losses = model.family.linear_losses(model, magnitude, dp_i)
     components = []
     for part in model.family.linear_parts(model.coef):
         q = np.asarray(losses[part.name], dtype=float)
@@ -216,8 +237,8 @@ def _family_parts(model: MotorModel, flow: FloatArray, n: FloatArray, dp: FloatA
                                     0.0, f'{", ".join(part.coefficients)} ({part.source})',
                                     part.name))
     h = model.geometry.clearance_satellites
-    return LossParts(flow=flow.copy(), speed=n.copy(), dp=dp.copy(), dp_i=dp_i.copy(),
+    return LossParts(flow=flow.copy(), speed=magnitude, dp=dp.copy(), dp_i=dp_i.copy(),
                      displacement=model.geometry.displacement * n,
                      clearance=np.full(n.shape, h), clearance_satellites=h, h_exponent=3.0,
                      hs_exponent=3.0, nu_exponent_lfg=-1.0, nu_exponent_c=-1.0,
-                     components=tuple(components))
+                     components=tuple(components), **signs)

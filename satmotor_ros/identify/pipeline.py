@@ -331,7 +331,7 @@ def calibrate(table: BenchTable, liquid: str = 'oil', spec: MotorSpec | None = N
     parts, usable = loss_parts(model, points)
     if not usable.all():
         points = points.select(usable, f'left out {int((~usable).sum())} points outside the '
-                                       'model (no forward flow, negative speed or chamber '
+                                       'model (no flow the model can give, or a chamber '
                                        'drop out of range)')
         rows = None if rows is None else rows[usable]
     check_identifiable(parts)

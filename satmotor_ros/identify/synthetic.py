@@ -116,6 +116,8 @@ class Plan:
     noise_pressure_mpa: float = 0.01  # [MPa]
     noise_temperature_c: float = 0.1  # [degC]
     extra_channels: tuple[str, ...] = ('aux',)  # channels with no effect unless injected
+    reverse_share: float = 0.0  # share of the points turned backwards (n < 0) [-]
+    pump_share: float = 0.0  # share driven as a pump: dp against the flow [-]
 
     def noise_lpm(self, flow: FloatArray, model: MotorModel) -> FloatArray:
         """
@@ -168,8 +170,9 @@ def injected_effect(base: MotorModel, injection: Injection, speed: FloatArray,
         return None
     kind = kind_of(Effect(injection.effect, 0.0))
     dp_i = base.absorbency(speed, dp=dp, errors='mask').dp_i
-    data = Synthetic(speed, dp_i, channels, standard_law(base.liquid, base.coefficient_set.name),
-                     injection.shape)
+    data = Synthetic(np.abs(speed), np.abs(dp_i), channels,
+                     standard_law(base.liquid, base.coefficient_set.name), injection.shape,
+                     np.sign(speed))
     return kind.scaled(injection.effect, injection.magnitude, injection.regressor, data)
 
 
@@ -209,6 +212,10 @@ def _operating_points(plan: Plan, rng: np.random.Generator,
                       n: int) -> tuple[FloatArray, FloatArray]:
     speed = rng.uniform(*plan.speed_rpm, n) * RPM
     dp = rng.uniform(*plan.dp_mpa, n) * MPA
+    if plan.reverse_share or plan.pump_share:  # four quadrants (doc/quadrants.md)
+        backwards = np.where(rng.uniform(0.0, 1.0, n) < plan.reverse_share, -1.0, 1.0)
+        against = np.where(rng.uniform(0.0, 1.0, n) < plan.pump_share, -1.0, 1.0)
+        speed, dp = backwards * speed, backwards * against * dp
     return speed, dp
 
 
@@ -253,8 +260,9 @@ def _measure(plan: Plan, effects: tuple[Effect, ...], rng: np.random.Generator,
     speed_m = (gain_n * speed + offset_n
                + rng.normal(0.0, plan.noise_speed_rpm * RPM * noise, n))
     sd_p = plan.noise_pressure_mpa * MPA * noise
-    p_out = channels.pop('p_out') + rng.normal(0.0, sd_p, n)
-    p_in = p_out + dp + rng.normal(0.0, sd_p, n)
+    low = channels.pop('p_out') + rng.normal(0.0, sd_p, n)  # the low port: B unless dp < 0
+    p_in = low + np.maximum(dp, 0.0) + rng.normal(0.0, sd_p, n)
+    p_out = low + np.maximum(-dp, 0.0)
     channels['temperature'] = channels['temperature'] + rng.normal(
         0.0, plan.noise_temperature_c * noise, n)
     channels['p_case'] = channels['p_case'] + rng.normal(0.0, sd_p, n)

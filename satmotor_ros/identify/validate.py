@@ -104,7 +104,7 @@ def validate(table: BenchTable, model: MotorModel, liquid: str, mode: Mode = 'au
     parts, usable = loss_parts(_bare(model), points)
     if not usable.all():
         points = points.select(usable, f'left out {int((~usable).sum())} points outside the '
-                                       'model (no forward flow, negative speed or chamber '
+                                       'model (no flow the model can give, or a chamber '
                                        'drop out of range)')
     channels = {**points.channels, 'p_out': points.p_out}
     missing = [name for name in model.channels if name not in channels]
@@ -113,7 +113,9 @@ def validate(table: BenchTable, model: MotorModel, liquid: str, mode: Mode = 'au
                f'{model.name} need')
         raise DataError(msg)
     calibrated = CalibratedModel(model)
-    predicted = calibrated.measured_flow(parts.speed, channels, dp_i=parts.dp_i)
+    # the model takes the signed row; the parts hold it where its loss runs forward
+    predicted = parts.sign * calibrated.measured_flow(parts.rotation * parts.speed, channels,
+                                                      dp_i=parts.sign * parts.dp_i)
     flagged = ~np.isfinite(predicted)
     if flagged.all():
         msg = f'{points.source}: the model flags every point invalid'

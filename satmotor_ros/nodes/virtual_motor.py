@@ -10,7 +10,8 @@ with sensor-data QoS, and ``/diagnostics``. All physics is in :mod:`satmotor_ros
 
 ``clock_mode`` ``wall`` steps the plant with the wall clock; ``sim`` steps it as fast as
 possible (or ``max_speedup`` times real time) and publishes ``/clock``, so every other
-node runs on ``use_sim_time``. A bad command (NaN, negative, above ``max_flow_command``)
+node runs on ``use_sim_time``. A negative command feeds port B and turns the shaft
+backwards (doc/quadrants.md); a bad command (NaN, beyond ``max_flow_command`` either way)
 is refused: the last good one is held, the reason logged and put on ``/diagnostics``.
 """
 
@@ -53,8 +54,8 @@ NODE_PARAMETERS: tuple[ParamSpec, ...] = (
               'as possible', '-', 0.0, 1.0e6),
     ParamSpec('publish_rate', 100.0, 'rate of the sensor topics', 'Hz', 1.0, 1000.0),
     ParamSpec('diagnostics_period', 1.0, 'period of /diagnostics', 's', 0.01, 60.0),
-    ParamSpec('max_flow_command', 100.0 * LPM, 'commands above are refused', 'm^3/s',
-              1.0e-6, 1.0e-2),
+    ParamSpec('max_flow_command', 100.0 * LPM, 'commands beyond it either way are refused',
+              'm^3/s', 1.0e-6, 1.0e-2),
     ParamSpec('joint_name', JOINT_NAME, 'joint name in joint_states'),
     ParamSpec('frame_id', 'motor', 'frame_id of the sensor headers'),
     ParamSpec('load.kind', 'constant', 'load profile', choices=tuple(LOAD_KINDS)),
@@ -226,8 +227,8 @@ class VirtualMotorNode(Node):
         value = msg.data
         problem = self.plant.check_command(value)
         limit = self._setup.values['max_flow_command']
-        if problem is None and value > limit:
-            problem = f'flow command {value!r} m^3/s is above max_flow_command = {limit!r}'
+        if problem is None and abs(value) > limit:
+            problem = f'flow command {value!r} m^3/s is beyond max_flow_command = +-{limit!r}'
         if problem is not None:
             self._refuse(problem)
             return

@@ -41,7 +41,8 @@ class ControllerParams(Bounded):
         1.5e-6, 'proportional gain, flow per speed error', 'm^3/rad', 0.0, 1.0e-3)
     ki: float = parameter(
         3.0e-5, 'integral gain, flow per integrated speed error', 'm^3/(s*rad)', 0.0, 1.0e-2)
-    flow_min: float = parameter(0.0, 'smallest flow the pump gives', 'm^3/s', 0.0, 1.0e-2)
+    flow_min: float = parameter(
+        0.0, 'smallest flow the pump gives (negative: it reverses)', 'm^3/s', -1.0e-2, 1.0e-2)
     flow_max: float = parameter(
         60.0 * LPM, 'largest flow the pump gives', 'm^3/s', 1.0e-7, 1.0e-2)
     setpoint_weight: float = parameter(
@@ -108,10 +109,10 @@ class SpeedController:
         kind = self.params.feedforward
         if kind == 'none':
             return 0.0
-        naive = self.model.geometry.displacement * max(setpoint, 0.0)
+        naive = self.model.geometry.displacement * setpoint
         if kind == 'naive':
             return naive
-        flow = self.model.absorbency_point(max(setpoint, 0.0), max(dp, 0.0)).flow
+        flow = self.model.absorbency_point(setpoint, dp).flow  # any quadrant
         if flow != flow:  # beyond the model's limit: fall back, and count it
             self.feedforward_fallbacks += 1
             return naive

@@ -12,7 +12,6 @@ last build, so a slow drift costs one rebuild per tolerance step.
 from __future__ import annotations
 
 import dataclasses
-import math
 
 from satmotor_ros.model import MotorModel
 
@@ -74,44 +73,3 @@ class MotorCache:
         self.clearance_growth = clearance_growth
         self.rebuilds += 1
         return True
-
-
-def mirrored_point(model: MotorModel, speed: float, dp: float, flow_guess: float | None,
-                   channels: dict[str, float] | None = None
-                   ) -> tuple[float, float, float, float, int]:
-    """
-    Evaluate the motor at any sign of speed and pressure drop.
-
-    The paper's model covers n >= 0 and dp >= 0. A shaft driven backwards, or a
-    pressure drop reversed by an overrunning load, is mapped onto that domain
-    by symmetry: the losses at (|n|, |dp|) flow from the higher to the lower
-    pressure, and the displacement flow follows the shaft.
-
-    Parameters
-    ----------
-    model : MotorModel
-        The motor, [-]
-    speed : float
-        Shaft speed, any sign, [rad/s]
-    dp : float
-        Port pressure drop p_in - p_out, any sign, [Pa]
-    flow_guess : float or None
-        Warm start of the port-drop solve, [m^3/s]
-    channels : dict, optional
-        Channels a calibrated coefficient set's effects read, [-]
-
-    Returns
-    -------
-    tuple
-        Flow into the inlet port [m^3/s], dp_i [Pa], external leakage [m^3/s],
-        the speed-driven inertia loss [m^3/s] and the PointStatus flags.
-
-    """
-    qt = model.geometry.displacement
-    a_speed, a_dp = abs(speed), abs(dp)
-    guess = None if flow_guess is None else qt * a_speed + abs(flow_guess - qt * speed)
-    pt = model.absorbency_point(a_speed, a_dp, flow_guess=guess, channels=channels)
-    loss = pt.flow - qt * a_speed - pt.inertia
-    sign = 1.0 if dp >= 0.0 else -1.0
-    return (qt * speed + math.copysign(pt.inertia, speed) + sign * loss,
-            math.copysign(pt.dp_i, dp), pt.external, pt.inertia, pt.status)

@@ -1,15 +1,18 @@
 # SPDX-License-Identifier: Apache-2.0
 """
-The virtual motor: lines, relief valve, shaft and heat around the model's motor.
+The virtual motor: lines, relief valves, shaft and heat around the model's motor.
 
-State: inlet-line pressure p_in, outlet-line pressure p_out (both absolute),
-shaft speed omega and angle theta, liquid temperature T. Per step of dt:
+State: pressure p_in of the line at port A, p_out of the line at port B (both
+absolute), shaft speed omega and angle theta, liquid temperature T. Per step of dt:
 
-0. the pump delivers the flow command through a first-order lag;
+0. the pump delivers the flow command through a first-order lag; a negative
+   command feeds port B (a directional valve: the pump line and the return line
+   swap, and the shaft turns backwards);
 1. the motor model gives the absorbency Q_m(omega, dp) at the start of the step
-   (eqs. (34)-(36) of Śliwiński 2017, through the model's single-point path);
+   (eqs. (34)-(36) of Śliwiński 2017, through the model's single-point path, in
+   any quadrant: doc/quadrants.md);
 2. a linearly implicit (backward Euler) step solves the line pressures (P1),
-   the relief valve (P2), the return valve (P3) and the shaft (P4), (P5)
+   a relief valve on each line (P2), the return valve (P3) and the shaft (P4), (P5)
    together, with Q_m linearised as
    ``Q_m' = Q_m + q_t (omega' - omega) + G (dp' - dp)``, G >= 0 the secant
    leakage conductance. Stiff terms (line compliance against valves and
@@ -46,7 +49,7 @@ from satmotor_ros.plant.equations import (case_pressure, driving_torque, frictio
                                           return_flow, temperature_rate)
 from satmotor_ros.plant.errors import PlantError
 from satmotor_ros.plant.load import ConstantLoad, LoadProfile
-from satmotor_ros.plant.motor import mirrored_point, MotorCache
+from satmotor_ros.plant.motor import MotorCache
 from satmotor_ros.plant.params import PlantParams
 from satmotor_ros.plant.sensors import Sensor
 
@@ -54,7 +57,7 @@ _DP_REF = 0.1e6
 """Pressure drop below which the leakage conductance is taken as secant to this value, [Pa]."""
 
 MAX_FLOW_COMMAND = 1.0e-2
-"""Largest flow command the plant accepts (600 l/min), [m^3/s]."""
+"""Largest flow command the plant accepts, either sign (600 l/min), [m^3/s]."""
 
 
 class PlantState(NamedTuple):
@@ -71,12 +74,12 @@ class PlantState(NamedTuple):
 class StepFlows(NamedTuple):
     """The flows of the last step, as the integrator balanced them, [m^3/s]."""
 
-    command: float  # from the pump into the inlet line (the command after the pump's lag)
-    motor: float  # into the motor's inlet port (model absorbency, linearised)
-    relief: float  # relief valve, inlet line to tank
-    leakage: float  # external-leakage effects, inlet line to tank
-    model_external: float  # the model's own external leakage Q_ex (eq. 24)
-    returned: float  # return valve, outlet line to tank
+    command: float  # from the pump into line A; < 0: into line B (after the pump's lag)
+    motor: float  # into the motor's port A (model absorbency, linearised)
+    relief: float  # relief valves, both lines to tank
+    leakage: float  # external-leakage effects, pump line to tank
+    model_external: float  # the model's own external leakage Q_ex (eq. 24), return line
+    returned: float  # return valve, return line (B; A for a negative command) to tank
     cavitation_in: float  # make-up that held p_in at the vapour pressure
     cavitation_out: float  # make-up that held p_out at the vapour pressure
 
@@ -223,7 +226,7 @@ class Plant:
         self._revolutions = 0.0
         self._q_guess = None
         self._lin = (0.0, 0.0, 0.0, 0.0)  # last good (G, h, channel drop, model Q_ex)
-        self._last = (0.0, self._p_in, self._p_out, False)  # q_cmd, P, R, relief open
+        self._last = (0.0, self._p_in, self._p_out, (False, False))  # q, p_a, p_b, reliefs
         self._torque = 0.0
         self._dp_i = 0.0
         self.model_status = 0  # PointStatus flags of the last model evaluation
@@ -285,18 +288,20 @@ class Plant:
         Parameters
         ----------
         flow_command : float
-            Flow from the pump into the inlet line, 0..MAX_FLOW_COMMAND, [m^3/s]
+            Flow from the pump into line A (negative: into line B), at most
+            MAX_FLOW_COMMAND either way, [m^3/s]
         load_torque : float, optional
             Load torque for this step instead of the load profile, [N*m]
 
         Raises
         ------
         PlantError
-            If the command is not finite or outside 0..MAX_FLOW_COMMAND (the state is unchanged).
+            If the command is not finite or beyond +-MAX_FLOW_COMMAND (the state is unchanged).
 
         """
-        if not 0.0 <= flow_command <= MAX_FLOW_COMMAND:
-            msg = f'flow_command = {flow_command!r} m^3/s: outside [0, {MAX_FLOW_COMMAND}]'
+        if not -MAX_FLOW_COMMAND <= flow_command <= MAX_FLOW_COMMAND:
+            msg = (f'flow_command = {flow_command!r} m^3/s: outside [-{MAX_FLOW_COMMAND}, '
+                   f'{MAX_FLOW_COMMAND}]')
             raise PlantError(msg)
         load, slope, dry = self._load_torques(load_torque)
         flow = self._pump(flow_command)
@@ -330,26 +335,23 @@ class Plant:
         """Linearise the motor at the start of the step as Q_m' = q_t w' + G dp' + h."""
         w, dp, qt = self._w, self._p_in - self._p_out, self._qt
         channels = self._channels() if self._motor.model.channels else None
-        if w >= 0.0 and dp >= 0.0:
-            pt = self._point(w, dp, flow_guess=self._q_guess, channels=channels)
-            q, dp_i, q_id, qx, self.model_status = pt[0], pt[3], pt[9], pt[10], pt[12]
-        else:
-            q, dp_i, qx, q_id, self.model_status = mirrored_point(self._motor.model, w, dp,
-                                                                  self._q_guess, channels)
+        pt = self._point(w, dp, flow_guess=self._q_guess, channels=channels)  # any quadrant
+        q, dp_i, q_id, qx, self.model_status = pt[0], pt[3], pt[9], abs(pt[10]), pt[12]
         if q != q:  # NaN: the model refused the point; keep the last good linearisation
             self.invalid_points += 1
             return self._lin
         self._q_guess = q
         qtw = qt * w
-        g = abs(q - qtw - (q_id if w >= 0.0 else -q_id)) / max(abs(dp), _DP_REF)
+        # the conductance leaves out eq. (14)'s loss, which does not grow with the pressure
+        g = abs(q - qtw - q_id) / max(abs(dp), _DP_REF)
         self._lin = (g, q - qtw - g * dp, dp - dp_i, qx)
         return self._lin
 
     def _solve_step(self, flow: float, lin: tuple[float, float, float, float], load: float,
-                    slope: float, dry: float) -> tuple[float, float, bool, float]:
+                    slope: float, dry: float) -> tuple[float, float, tuple[bool, bool], float]:
         """Solve the lines and the shaft: sliding, sticking or breaking away (Karnopp)."""
         w, dich = self._w, lin[2]
-        relief = self._p_in > self._pcr
+        relief = (self._p_in > self._pcr, self._p_out > self._pcr)
         if w == 0.0:
             p, r, relief = self._solve(flow, lin, 0.0, 0.0, relief)
             sign = 0.0 if self._locked else self._breakaway(p - r - dich, load, dry)
@@ -380,7 +382,7 @@ class Plant:
                       - friction_torque(w_new, dp_i, self._qt, self._b, self._tc, self._cp))
         self._torque = torque
         heat_capacity, cooling, ambient = self._heat
-        loss_power = flow * (p - self._pt) - w_new * torque
+        loss_power = abs(flow) * ((p if flow >= 0.0 else r) - self._pt) - w_new * torque
         self._temp += dt * temperature_rate(loss_power, self._temp, ambient, heat_capacity,
                                             cooling)
         self._p_in, self._p_out, self._w = p, r, w_new
@@ -398,38 +400,52 @@ class Plant:
         return 1.0 if drive > 0.0 else -1.0
 
     def _solve(self, q_cmd: float, lin: tuple[float, float, float, float], w0: float,
-               wk: float, relief: bool) -> tuple[float, float, bool]:
+               wk: float, relief: tuple[bool, bool]) -> tuple[float, float, tuple[bool, bool]]:
         """
-        Solve the implicit line pressures with omega' = w0 + wk (P - R).
+        Solve the implicit line pressures p_a, p_b with omega' = w0 + wk (p_a - p_b).
 
-        Inlet:  a (P - p_in)  = Q_cmd - Q_m' - Q_rv(P) - Q_x(R)        (P1), (P2)
-        Outlet: c (R - p_out) = Q_m' - Q_ex - Q_r(R)                    (P1), (P3)
-        with Q_m' = q_t omega' + G (P - R) + h. The relief valve is tried in
-        its last state and switched once if the solution contradicts it.
+        In the frame of the pump line P (A, or B for a negative command) and the
+        return line R, with d = +-1 the direction and Q_m' = d (q_t omega' + G
+        (p_a - p_b) + h) the motor flow from P to R:
+
+        Pump:   a (P - p_P)  = |Q_cmd| - Q_m' - Q_rv(P) - Q_x(R)        (P1), (P2)
+        Return: c (R - p_R) = Q_m' - Q_ex - Q_r(R) - Q_rv(R)             (P1), (P2), (P3)
+
+        Each relief valve is tried in its last state and switched if the
+        solution contradicts it.
         """
         g, h, _, qx = lin
         qt, a, c, e0, e1, gr, pr0, kv, pcr = self._solve_constants
+        d = 1.0 if q_cmd >= 0.0 else -1.0
+        if d < 0.0:  # the directional valve feeds B: the lines swap
+            a, c = c, a
+            p_pump, p_return, on_pump, on_return = self._p_out, self._p_in, relief[1], relief[0]
+        else:
+            p_pump, p_return, on_pump, on_return = self._p_in, self._p_out, relief[0], relief[1]
         qwk = qt * wk
-        qw0 = qt * w0
+        qw0 = qt * (d * w0)
         a11 = a + g + qwk
         a12 = e1 - g - qwk
         a21 = -g - qwk
         a22 = c + g + gr + qwk
-        b1 = a * self._p_in + q_cmd - h - e0 - qw0
-        b2 = c * self._p_out + h - qx + gr * pr0 + qw0
+        b1 = a * p_pump + d * q_cmd - d * h - e0 - qw0
+        b2 = c * p_return + d * h - qx + gr * pr0 + qw0
         p = r = 0.0
-        for _ in range(3):
-            if relief:
-                c11, d1 = a11 + kv, b1 + kv * pcr
-            else:
-                c11, d1 = a11, b1
-            det = c11 * a22 - a12 * a21
-            p = (d1 * a22 - a12 * b2) / det
-            r = (c11 * b2 - a21 * d1) / det
-            if (p > pcr) == relief:
+        for _ in range(4):
+            c11, d1 = (a11 + kv, b1 + kv * pcr) if on_pump else (a11, b1)
+            c22, d2 = (a22 + kv, b2 + kv * pcr) if on_return else (a22, b2)
+            det = c11 * c22 - a12 * a21
+            p = (d1 * c22 - a12 * d2) / det
+            r = (c11 * d2 - a21 * d1) / det
+            if (p > pcr) == on_pump and (r > pcr) == on_return:
                 break
-            relief = not relief
-        return p, r, relief
+            if (p > pcr) != on_pump:
+                on_pump = not on_pump
+            else:
+                on_return = not on_return
+        if d < 0.0:
+            return r, p, (on_return, on_pump)
+        return p, r, (on_pump, on_return)
 
     def _drift(self) -> None:
         """Rebuild the motor when a drifting effect has moved its viscosity or clearances."""
@@ -469,11 +485,13 @@ class Plant:
         cav_in = max(self._pv - p, 0.0) * self._a
         cav_out = max(self._pv - r, 0.0) * self._c
         motor = self._qt * self._w + g * (p - r) + h
+        back = r if q_cmd >= 0.0 else p  # the return line
         return StepFlows(
             command=q_cmd, motor=motor,
-            relief=self._kv * (p - self._pcr) if relief else 0.0,
-            leakage=self._e1 * r + self._e0, model_external=qx,
-            returned=return_flow(r, self._pr0, 0.0, self._gr),
+            relief=(self._kv * (p - self._pcr) if relief[0] else 0.0)
+            + (self._kv * (r - self._pcr) if relief[1] else 0.0),
+            leakage=self._e1 * back + self._e0, model_external=qx,
+            returned=return_flow(back, self._pr0, 0.0, self._gr),
             cavitation_in=cav_in, cavitation_out=cav_out)
 
     @property
@@ -542,10 +560,9 @@ class Plant:
         """
         if not isinstance(flow_command, (int, float)) or not math.isfinite(flow_command):
             return f'flow command {flow_command!r} is not a finite number'
-        if flow_command < 0.0:
-            return f'flow command {flow_command!r} m^3/s is negative'
-        if flow_command > MAX_FLOW_COMMAND:
-            return f'flow command {flow_command!r} m^3/s is above {MAX_FLOW_COMMAND} m^3/s'
+        if abs(flow_command) > MAX_FLOW_COMMAND:
+            return (f'flow command {flow_command!r} m^3/s is beyond +-{MAX_FLOW_COMMAND} '
+                    'm^3/s')
         return None
 
 

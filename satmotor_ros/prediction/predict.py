@@ -351,12 +351,11 @@ def describe(snap: Snapshot, timeout: float, status: int, channels: tuple[str, .
 
     """
     level, notes = Level.OK, []
-    p_in = snap.values[INPUTS.index('p_in')]
     for name, value, age, state in zip(INPUTS, snap.values, snap.ages, snap.states):
         rated = input_level(name, state)
         if rated:
             level = max(level, rated)
-            notes.append(describe_input(name, state, value, age, timeout, p_in))
+            notes.append(describe_input(name, state, value, age, timeout))
     why = _channel_problem(channels, snap) if level < Level.ERROR else ''
     if why:
         level = Level.ERROR

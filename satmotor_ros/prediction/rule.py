@@ -41,8 +41,8 @@ FIELDS = {name: f'{CHANNELS[name].topic}.{CHANNELS[name].field}' for name in INP
 REQUIRED = ('flow', 'p_in', 'p_out')
 """Inputs without which no prediction is made."""
 
-NON_NEGATIVE = ('flow', 'p_in', 'p_out', 'p_case')
-"""Inputs whose negative values are invalid (flow into the motor, absolute pressures)."""
+NON_NEGATIVE = ('p_in', 'p_out', 'p_case')
+"""Inputs whose negative values are invalid: absolute pressures (flow and speed are signed)."""
 
 MODES = ('on_flow', 'rate')
 """Publish modes: on every flow_command, or at a fixed rate."""
@@ -63,8 +63,7 @@ class InputState(enum.IntEnum):
     MISSING = 1  # never arrived
     STALE = 2  # older than the timeout
     NOT_FINITE = 3  # NaN or inf
-    NEGATIVE = 4  # negative flow or absolute pressure
-    REVERSED = 5  # outlet pressure above inlet pressure
+    NEGATIVE = 4  # negative absolute pressure
 
 
 @dataclass(frozen=True)
@@ -109,8 +108,7 @@ class Rule:
 
 _FLOAT_MAX = sys.float_info.max
 # plain ints: an enum member looked up on its class costs a microsecond per message
-_FRESH, _MISSING, _STALE, _NOT_FINITE, _NEGATIVE, _REVERSED = (int(s) for s in InputState)
-_I_IN, _I_OUT = INPUTS.index('p_in'), INPUTS.index('p_out')
+_FRESH, _MISSING, _STALE, _NOT_FINITE, _NEGATIVE = (int(s) for s in InputState)
 
 
 def input_state(name: str, value: Any, age_ns: Any, timeout_ns: int) -> Any:
@@ -131,8 +129,7 @@ def input_state(name: str, value: Any, age_ns: Any, timeout_ns: int) -> Any:
     Returns
     -------
     int or ndarray of int
-        An :class:`InputState`: FRESH, MISSING, STALE, NOT_FINITE or NEGATIVE (REVERSED
-        needs both pressures, see :func:`input_states`).
+        An :class:`InputState`: FRESH, MISSING, STALE, NOT_FINITE or NEGATIVE.
 
     """
     # Operators only, so that Python's bools and numpy's bool arrays go through alike:
@@ -162,16 +159,12 @@ def input_states(values: Sequence[float] | npt.NDArray[np.float64],
     Returns
     -------
     list
-        Per input: an :class:`InputState` value (or an array of them); the outlet pressure is
-        REVERSED where both pressures are fresh and it is above the inlet pressure.
+        Per input: an :class:`InputState` value (or an array of them). An outlet pressure
+        above the inlet pressure is fine: a negative drop (doc/quadrants.md).
 
     """
-    states = [input_state(name, value, age, timeout_ns)
-              for name, value, age in zip(INPUTS, values, ages_ns)]
-    reversed_ = (states[_I_IN] == _FRESH) & (states[_I_OUT] == _FRESH) \
-        & (values[_I_OUT] > values[_I_IN])
-    states[_I_OUT] += reversed_ * (_REVERSED - states[_I_OUT])
-    return states
+    return [input_state(name, value, age, timeout_ns)
+            for name, value, age in zip(INPUTS, values, ages_ns)]
 
 
 class Snapshot(NamedTuple):
@@ -352,8 +345,7 @@ def input_level(name: str, state: int) -> Level:
     return Level.ERROR if name == 'p_case' else Level.WARN
 
 
-def describe_input(name: str, state: int, value: float, age: float, timeout: float,
-                   p_in: float = math.nan) -> str:
+def describe_input(name: str, state: int, value: float, age: float, timeout: float) -> str:
     """
     Spell out what is wrong with an input, naming the field and the value.
 
@@ -369,8 +361,6 @@ def describe_input(name: str, state: int, value: float, age: float, timeout: flo
         Its age at the driving time, [s]
     timeout : float
         The input timeout, [s]
-    p_in : float
-        The inlet pressure, quoted when the outlet pressure is above it, [Pa]
 
     Returns
     -------
@@ -387,7 +377,4 @@ def describe_input(name: str, state: int, value: float, age: float, timeout: flo
         return f'{field} = {value!r} {unit}: not finite'
     if state == InputState.NEGATIVE:
         return f'{field} = {value!r} {unit}: negative'
-    if state == InputState.REVERSED:
-        return (f'{field} = {value!r} {unit} is above {FIELDS["p_in"]} = {p_in!r} Pa: '
-                f'the pressure drop would be negative')
     return f'{field} = {value!r} {unit}: ok'

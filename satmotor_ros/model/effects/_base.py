@@ -226,11 +226,12 @@ class CandidateData(NamedTuple):
 class Synthetic(NamedTuple):
     """Operating points a synthetic injection scales its coefficient on."""
 
-    speed: FloatArray  # true speed [rad/s]
-    dp_i: FloatArray  # chamber drop of the model without the effect [Pa]
+    speed: FloatArray  # true speed |n| [rad/s]
+    dp_i: FloatArray  # chamber drop |dp_i| of the model without the effect [Pa]
     channels: Mapping[str, FloatArray]  # time [s], temperature [degC], p_case [Pa], ...
     law: ViscosityLaw  # the liquid's standard viscosity law
     shape: tuple[tuple[str, float], ...] = ()  # kind-specific numbers (a threshold, ...)
+    rotation: FloatArray | float = 1.0  # sign of the true speed, -1, 0 or +1 [-]
 
 
 @dataclass(frozen=True)
