@@ -81,7 +81,12 @@ CHANNELS = {
     'flow_measured': Channel('flow_measured', 'data', 'm^3/s'),
     'torque': Channel('load_torque', 'data', 'N*m'),
 }
-"""Each measured quantity by its short name (the bench-table column where there is one)."""
+"""
+Each measured quantity by its short name (the bench-table column where there is one).
+
+Signs (doc/quadrants.md): ``p_in`` and ``p_out`` are the pressures at ports A and B, the
+flow is positive entering port A, and every flow and JointState velocity keeps its sign.
+"""
 
 PREDICTION_INPUTS = ('flow', 'p_in', 'p_out', 'p_case', 'temperature', 'measured_speed')
 """The :data:`CHANNELS` a ``motor_model`` prediction reads, in its order."""

@@ -6,6 +6,7 @@ import math
 import pytest
 
 from satmotor_ros.model import MotorModel
+from satmotor_ros.model.effects import Effect, with_effects
 from satmotor_ros.model.units import LPM, MPA
 from satmotor_ros.plant import ConstantLoad, Plant, PlantParams, ShaftParams
 
@@ -76,3 +77,17 @@ def test_the_shaft_reverses_through_zero_without_a_jump():
     assert speeds[0] > 0.0 > speeds[-1]
     assert max(abs(b - a) for a, b in zip(speeds, speeds[1:])) < 0.05 * abs(speeds[0])
     assert plant.invalid_points == 0
+
+
+def test_an_injected_reverse_loss_acts_on_the_reversed_plant_only():
+    effect = Effect('reverse_loss', 4e-15)
+    model = MODELS['oil']
+    params = PlantParams(effects=(effect,))
+    ahead = _settle(Plant(model, params, load=ConstantLoad(60.0)), 20.0 * LPM)
+    plain = _settle(Plant(model, load=ConstantLoad(60.0)), 20.0 * LPM)
+    assert ahead.speed == pytest.approx(plain.speed, rel=1e-9)
+    back = _settle(Plant(model, params, load=ConstantLoad(60.0)), -20.0 * LPM)
+    dp = back.inlet_pressure - back.outlet_pressure
+    assert back.speed > -plain.speed  # the extra loss costs speed backwards
+    expected = with_effects(model, (effect,)).speed_point(-20.0 * LPM, dp).speed
+    assert back.speed == pytest.approx(expected, rel=1e-8)

@@ -2,14 +2,16 @@
 """Four-quadrant data in calibration, and the loss keyed on the direction of rotation."""
 
 from dataclasses import replace
+import json
 
 import numpy as np
 import pytest
 
 from satmotor_ros.identify import calibrate
 from satmotor_ros.identify.parts import loss_parts, predict_flow
-from satmotor_ros.identify.synthetic import generate, Injection, Plan
-from satmotor_ros.identify.table import BenchTable
+from satmotor_ros.cli.main import main
+from satmotor_ros.identify.synthetic import generate, Injection, Plan, to_columns
+from satmotor_ros.identify.table import BenchTable, read_csv, write_csv
 from satmotor_ros.model import load_motor, MotorModel, PointStatus
 from satmotor_ros.model.effects import effect_from_mapping, effect_to_mapping
 from satmotor_ros.model.units import LPM, MPA, RPM
@@ -108,3 +110,16 @@ def test_reverse_loss_in_the_array_maps_equals_the_points():
         point = model.absorbency_point(float(n[i]), dp=float(dp[i]))
         assert op.flow[i] == pytest.approx(point.flow, rel=1e-12)
         assert not op.status[i] & PointStatus.NO_ROOT
+
+
+def test_a_bench_csv_with_port_pressures_and_signed_speed_calibrates(tmp_path):
+    table = generate(FOUR, Injection('reverse_loss', 0.6 * LPM), seed=6)
+    columns = to_columns(table)
+    columns['p_a'], columns['p_b'] = columns.pop('p_in'), columns.pop('p_out')
+    write_csv(tmp_path / 'bench.csv', columns)
+    back = read_csv(tmp_path / 'bench.csv')
+    assert (back.speed < 0).any() and (back.flow < 0).any() and (back.dp < 0).any()
+    assert main(['calibrate', str(tmp_path / 'bench.csv'), '--liquid', 'oil',
+                 '--out', str(tmp_path / 'out')]) == 0
+    summary = json.loads((tmp_path / 'out' / 'calibration.json').read_text())
+    assert summary['effect'] == 'reverse_loss'

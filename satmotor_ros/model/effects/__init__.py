@@ -18,6 +18,7 @@ defines ``KIND = MyKind()`` (doc/effects.md). The kinds shipped:
 ``clearance_wear``         h_R and h_S grow by k (x - reference) >= 0, x = ``time`` [s]
                            or ``revolutions`` [rev], in eqs. (1), (2) and (5)
 ``channel:<name>``         extra loss k (x - reference) in Q_vl, x the channel <name>
+``reverse_loss``           extra loss k |dp_i| |n| in Q_vl while the shaft turns backwards
 ``term:<expression>``      extra loss k dp_i^a n^b in Q_vl, the exponents fitted
 ``threshold:dp``           extra loss k max(0, dp_i - x_c)^e in Q_vl (a valve cracking open)
 ``flow_sensor_offset``     the flowmeter reads Q + k
