@@ -148,13 +148,13 @@ def test_node_publishes_the_library_prediction_and_recovers_from_bad_input(
         assert keys['model status'] == 'OK'
         assert keys['predictions published'] == str(len(motor.predicted))
 
-        cases = [({'p_in': P_IN, 'p_out': 30 * MPA}, FLOW,
-                  'outlet_pressure.fluid_pressure = 30000000.0 Pa is above '
-                  'inlet_pressure.fluid_pressure'),
+        # p_out above p_in and a negative flow are quadrants, not bad input (issue 13)
+        cases = [({'p_in': P_IN, 'p_out': -1.0}, FLOW,
+                  'outlet_pressure.fluid_pressure = -1.0 Pa: negative'),
                  ({'p_in': math.nan, 'p_out': P_OUT}, FLOW,
                   'inlet_pressure.fluid_pressure = nan Pa: not finite'),
-                 ({'p_in': P_IN, 'p_out': P_OUT}, -1e-4,
-                  'flow_command.data = -0.0001 m^3/s: negative'),
+                 ({'p_in': P_IN, 'p_out': P_OUT}, math.inf,
+                  'flow_command.data = inf m^3/s: not finite'),
                  ({'p_in': 60 * MPA, 'p_out': P_OUT}, FLOW, 'model status BEYOND_LIMIT')]
         for inputs, flow, text in cases:
             motor.clear()

@@ -7,9 +7,9 @@ import json
 import numpy as np
 import pytest
 
+from satmotor_ros.cli.main import main
 from satmotor_ros.identify import calibrate
 from satmotor_ros.identify.parts import loss_parts, predict_flow
-from satmotor_ros.cli.main import main
 from satmotor_ros.identify.synthetic import generate, Injection, Plan, to_columns
 from satmotor_ros.identify.table import BenchTable, read_csv, write_csv
 from satmotor_ros.model import load_motor, MotorModel, PointStatus

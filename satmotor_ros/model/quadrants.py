@@ -130,7 +130,7 @@ class Quadrants:
 
     def __init__(self, magnitudes: Magnitudes) -> None:
         """Keep the maps at magnitudes."""
-        self.m = magnitudes
+        self.maps = magnitudes
         self.qt = magnitudes.qt
 
     def speed(self, flow: float, dp: float, port: bool, p_ex: float,
@@ -158,11 +158,11 @@ class Quadrants:
 
         """
         if not (abs(flow) < _INF and abs(dp) < _INF):  # flagged NOT_FINITE at the magnitudes
-            return self.m.speed(abs(flow), abs(dp), port, p_ex, channels, False)
+            return self.maps.speed(abs(flow), abs(dp), port, p_ex, channels, False)
         s = direction(dp, flow)
         q, d = s * flow, s * dp
         if q >= 0.0:  # the flow runs with the pressure: motor mode, turning with s
-            return mirror(self.m.speed(q, d, port, p_ex, channels, s < 0.0), s)
+            return mirror(self.maps.speed(q, d, port, p_ex, channels, s < 0.0), s)
         return mirror(self._pump_speed(-q, d, port, p_ex, channels, s > 0.0), s)
 
     def absorbency(self, speed: float, dp: float, port: bool, p_ex: float,
@@ -192,12 +192,12 @@ class Quadrants:
 
         """
         if not (abs(speed) < _INF and abs(dp) < _INF):
-            return self.m.absorbency(abs(speed), abs(dp), port, p_ex, None, channels, False)
+            return self.maps.absorbency(abs(speed), abs(dp), port, p_ex, None, channels, False)
         s = direction(dp, speed)
         n, d = s * speed, s * dp
         guess = None if flow_guess is None else s * flow_guess
         if n >= 0.0:
-            return mirror(self.m.absorbency(n, d, port, p_ex, guess, channels, s < 0.0), s)
+            return mirror(self.maps.absorbency(n, d, port, p_ex, guess, channels, s < 0.0), s)
         return mirror(self._pump_flow(-n, d, port, p_ex, guess, channels, s > 0.0), s)
 
     # -- pump mode, in the mirrored frame: dp >= 0, the shaft turning backwards ---------------
@@ -213,12 +213,12 @@ class Quadrants:
     def _pump_speed(self, delivered: float, d: float, port: bool, p_ex: float,
                     channels: Channels, reverse: bool) -> Point:
         """Solve q_t m - Q_vl(m, dp_i) = `delivered` for m > 0, the point at n = -m."""
-        m_, qt = self.m, self.qt
-        drop = m_.channel_drop(p_ex, channels)
+        maps, qt = self.maps, self.qt
+        drop = maps.channel_drop(p_ex, channels)
         dp_i = d + drop(delivered) if port else d
 
         def at(speed: float) -> Point:
-            return m_.absorbency(speed, dp_i, False, p_ex, None, channels, reverse)
+            return maps.absorbency(speed, dp_i, False, p_ex, None, channels, reverse)
 
         stall = at(0.0)
         if stall.status & _INVALID:
@@ -250,11 +250,11 @@ class Quadrants:
     def _pump_flow(self, speed: float, d: float, port: bool, p_ex: float,
                    flow_guess: float | None, channels: Channels, reverse: bool) -> Point:
         """Return Q = -(q_t m - Q_vl(m, dp_i)) at n = -m, dp_i from eqs. (34)-(35) if `port`."""
-        m_, qt = self.m, self.qt
-        drop = m_.channel_drop(p_ex, channels)
+        maps, qt = self.maps, self.qt
+        drop = maps.channel_drop(p_ex, channels)
 
         def at(dp_i: float) -> Point:
-            return m_.absorbency(speed, dp_i, False, p_ex, None, channels, reverse)
+            return maps.absorbency(speed, dp_i, False, p_ex, None, channels, reverse)
 
         first = at(d)
         if first.status & _INVALID:
