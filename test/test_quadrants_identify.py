@@ -31,8 +31,9 @@ def _mirrored(table):
                       table.units, table.source)
 
 
-def test_loss_parts_of_a_mirrored_table_are_the_forward_parts():
-    model = MotorModel.default('oil')
+@pytest.mark.parametrize('family', ['sliwinski2017', 'balawender', 'paszota'])
+def test_loss_parts_of_a_mirrored_table_are_the_forward_parts(family):
+    model = MotorModel.for_displacement(None, family)
     table = generate(Plan(n_points=40), Injection(), seed=2)
     forward, usable = loss_parts(model, table)
     mirrored, usable_m = loss_parts(model, _mirrored(table))

@@ -183,9 +183,9 @@ def loss_parts(model: MotorModel, table: BenchTable) -> tuple[LossParts, np.ndar
                f'{model.dp_limit / 1e6:.1f} MPa)')
         raise IdentificationError(msg)
     n, dpi = speed[usable], dp_i[usable]
-    signs = {'sign': s[usable], 'rotation': np.sign(table.speed[usable])}
+    sign, rotation = s[usable], np.sign(table.speed[usable])
     if model.family.name != 'sliwinski2017':
-        return _family_parts(model, flow[usable], n, dp[usable], dpi, signs), usable
+        return _family_parts(model, flow[usable], n, dp[usable], dpi, sign, rotation), usable
     coef = model.coef
     d = model.derived
     magnitude = np.abs(n)
@@ -207,7 +207,7 @@ def loss_parts(model: MotorModel, table: BenchTable) -> tuple[LossParts, np.ndar
         clearance_satellites=model.geometry.clearance_satellites,
         h_exponent=3.0 / (2.0 - beta), hs_exponent=coef.c2,
         nu_exponent_lfg=-beta / (2.0 - beta), nu_exponent_c=-coef.gamma,
-        components=components, **signs)
+        components=components, sign=sign, rotation=rotation)
     return parts, usable
 
 
@@ -217,13 +217,13 @@ effects scale them as a plane gap would (Q ~ h^3 / nu)."""
 
 
 def _family_parts(model: MotorModel, flow: FloatArray, n: FloatArray, dp: FloatArray,
-                  dp_i: FloatArray, signs: Mapping[str, FloatArray]) -> LossParts:
+                  dp_i: FloatArray, sign: FloatArray, rotation: FloatArray) -> LossParts:
     """
     Components of a family other than eqs. (31)-(33): one factor per linear part of its Q_vl.
 
     A part that is zero at every point (the external leakage of a set without one) is left
     out: no factor could be fitted on it. `n` is the speed in the row's frame (negative
-    for a pump), `signs` the rows' ``sign`` and ``rotation``.
+    for a pump); `sign` and `rotation` are the rows' (:class:`LossParts`).
     """
     magnitude = np.abs(n)
     losses = model.family.linear_losses(model, magnitude, dp_i)
@@ -241,4 +241,4 @@ def _family_parts(model: MotorModel, flow: FloatArray, n: FloatArray, dp: FloatA
                      displacement=model.geometry.displacement * n,
                      clearance=np.full(n.shape, h), clearance_satellites=h, h_exponent=3.0,
                      hs_exponent=3.0, nu_exponent_lfg=-1.0, nu_exponent_c=-1.0,
-                     components=tuple(components), **signs)
+                     components=tuple(components), sign=sign, rotation=rotation)
