@@ -9,18 +9,9 @@ from satmotor_ros.model import MotorModel
 from satmotor_ros.model.effects import Effect, with_effects
 from satmotor_ros.model.units import LPM, MPA
 from satmotor_ros.plant import ConstantLoad, Plant, PlantParams, ShaftParams
+from test_plant_physics import _settle
 
 MODELS = {name: MotorModel.default(name) for name in ('oil', 'water')}
-
-
-def _settle(plant, flow, steps=1500):
-    plant.run(steps, flow)
-    for _ in range(40):
-        before = plant.state
-        plant.run(steps // 4, flow)
-        if all(abs(a - b) <= 1e-10 * abs(b) for a, b in zip(plant.state[1:4], before[1:4])):
-            break
-    return plant.state
 
 
 @pytest.mark.parametrize('liquid', ['oil', 'water'])
