@@ -190,3 +190,15 @@ def test_calibrate_the_stepped_mbari_log_with_the_f11_displacement(tmp_path, cap
     assert code == 0, capsys.readouterr().err
     validation = json.loads((tmp_path / 'val' / 'validation.json').read_text())
     assert validation['n_points'] >= result['n_points'] - len(result['outliers'])
+
+
+def test_an_older_log_of_the_rig_with_fewer_columns_reads_through_the_same_mapping(tmp_path):
+    header = ('#time(s),Pos(in),Spd(in/s),RPM,LowerHydPress(psig),UpperHydPress(psig),VBus,'
+              'WindCurr(A),BattCurr(A),LoadCurr(A),Scale,Retract,LowerSpringPressure(psia),'
+              'UpperSpringPressure(psia)\n')
+    rows = ''.join(f'{0.02 * i:.2f} 2.910 {-2.0 - 0.01 * i:.3f} {600 + i}.000 -1.730 {250 + i}.1 '
+                   '301.9 0.022 -0.050 0.000 1.000 0.600 152.100 113.000\n' for i in range(5))
+    table = read_log(_log(tmp_path, header + rows), load_mapping('mbari_pto'))
+    assert len(table) == 5 and set(table.channels) == {'time', 'position', 'winding_current'}
+    assert table.flow[4] == pytest.approx(2.04 * 1.375 * INCH ** 3)
+    assert table.p_in[1] == pytest.approx(251.1 * PSI)
