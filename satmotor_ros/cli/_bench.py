@@ -15,7 +15,8 @@ from satmotor_ros.identify.table import IMPOSSIBLE
 from satmotor_ros.model import ModelError
 
 
-def add_data_arguments(parser: argparse.ArgumentParser) -> None:
+def add_data_arguments(parser: argparse.ArgumentParser,
+                       modes: tuple[str, ...] = ('auto', 'points', 'series')) -> None:
     """
     Add DATA, ``--out``, ``--mode`` and ``--columns``, shared by the bench-data commands.
 
@@ -23,6 +24,8 @@ def add_data_arguments(parser: argparse.ArgumentParser) -> None:
     ----------
     parser : argparse.ArgumentParser
         The subcommand's parser, [-]
+    modes : tuple of str
+        The ``--mode`` choices the command takes, [-]
 
     """
     parser.add_argument('data', metavar='DATA', help='bench CSV or rosbag2 directory')
@@ -31,9 +34,12 @@ def add_data_arguments(parser: argparse.ArgumentParser) -> None:
                              'is replaced only if this command wrote it')
     parser.add_argument('--force', action='store_true',
                         help='replace an existing --out that this command did not write')
-    parser.add_argument('--mode', choices=('auto', 'points', 'series'), default='auto',
-                        help='rows are steady points, a time series, or decide from the data '
-                             '(default: auto)')
+    transient = (', transient: a time series, every sample with the transient terms'
+                 if 'transient' in modes else '')
+    parser.add_argument('--mode', choices=modes, default='auto',
+                        help='points: rows are steady points; series: a time series, its '
+                             f'steady windows{transient}; auto: decide from the data '
+                             '(default)')
     parser.add_argument('--columns', default='', metavar='MAPPING',
                         help='read a log with its own column names and units through a column '
                              'mapping: a YAML file or a packaged name such as mbari_pto '

@@ -11,7 +11,7 @@ from satmotor_ros.cli._common import add_motor_options
 from satmotor_ros.cli._output import check_target, output_dir, written_by
 from satmotor_ros.identify import calibrate, Options
 from satmotor_ros.identify.output import write_json, write_yaml
-from satmotor_ros.identify.pipeline import Mode
+from satmotor_ros.identify.pipeline import Mode, MODES
 from satmotor_ros.identify.report import write_report
 from satmotor_ros.interface import MotorOptions
 
@@ -26,7 +26,7 @@ DESCRIPTION = ('Fit the loss model to a bench table (CSV with "name [unit]" head
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Add the options of ``satmotor calibrate``."""
-    add_data_arguments(parser)
+    add_data_arguments(parser, MODES)
     parser.add_argument('--alpha', type=float, default=0.05,
                         help='family-wise significance level of the effect test (default 0.05)')
     parser.add_argument('--folds', type=int, default=5,
@@ -92,6 +92,9 @@ def _calibrate(data: str, out: str, mode: Mode, alpha: float, folds: int,
     line += f'; family {summary["family"]}'
     if summary['outliers']:
         line += f'; {len(summary["outliers"])} outlier(s) left out'
+    rows = f'{summary["n_points"]} points'
+    if cal.samples is not None:
+        rows = (f'{summary["n_points"]} rows of {summary["n_samples"]} samples (mode '
+                'transient: every usable sample, with the transient terms)')
     return (f'{line}; out-of-sample RMSE of Q_vl {before:.4g} -> {after:.4g} l/min over '
-            f'{summary["n_points"]} points; wrote {target}/calibration.json, '
-            'coefficients.yaml, report.md')
+            f'{rows}; wrote {target}/calibration.json, coefficients.yaml, report.md')

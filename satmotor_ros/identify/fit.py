@@ -392,13 +392,21 @@ class LossFit:
                 offset.append(s_.to_unit[0])
         return tuple(names), np.array(unit), np.array(offset)
 
-    def report(self) -> FitReport:
+    def report(self, inflation: float = 1.0) -> FitReport:
         """
         Summarise the fit with 95 % confidence intervals and correlations from the Jacobian.
 
         The covariance is s^2 (J^T J)^-1 with s^2 = sum rho / (N - p), and the
         half-width t_{0.975, N-p} times its root diagonal; J includes the
         prior's rows, so an interval never exceeds what the prior allows.
+        Residuals correlated in time (a time series' samples) multiply the
+        covariance and divide N by `inflation`.
+
+        Parameters
+        ----------
+        inflation : float
+            Variance inflation of the residuals, >= 1
+            (:func:`~satmotor_ros.identify.transient.variance_inflation`), [-]
 
         Returns
         -------
@@ -427,8 +435,10 @@ class LossFit:
             msg = (f'{which} is not determined by the data: it trades off exactly against '
                    f'the other coefficients at these points')
             raise IdentificationError(msg)
-        s2 = self.objective_ / dof
+        inflation = max(inflation, 1.0)
+        s2 = self.objective_ / dof * inflation
         cov = s2 * np.linalg.pinv(jac.T @ jac) * np.outer(unit, unit)
+        dof = max(int(self.n_ / inflation) - self.n_params, 1)
         half = special.stdtrit(dof, 0.975) * np.sqrt(np.maximum(np.diag(cov), 0.0))
         values = offset + self.u_ * unit
         ci = np.column_stack([values - half, values + half])

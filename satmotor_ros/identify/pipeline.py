@@ -17,19 +17,23 @@ import numpy as np
 from satmotor_ros.identify.candidates import build_library, Candidate
 from satmotor_ros.identify.errors import DataError, IdentificationError
 from satmotor_ros.identify.families import compare_families, family_specs, FamilyChoice
-from satmotor_ros.identify.fit import check_identifiable, FitReport
+from satmotor_ros.identify.fit import check_identifiable, FitReport, MIN_POINTS
 from satmotor_ros.identify.parts import loss_parts, LossParts, predict_flow
 from satmotor_ros.identify.selection import (CrossValidatedSelector, Errors, Forward, Score,
                                              Selection)
 from satmotor_ros.identify.steady import extract_steady, looks_like_series, SteadyTolerance
 from satmotor_ros.identify.table import BenchTable
+from satmotor_ros.identify.transient import (dynamics_summary, Samples, transient_samples,
+                                             TransientOptions)
 from satmotor_ros.model import load_motor, MotorModel, MotorSpec
 from satmotor_ros.model.effects import Effect
 from satmotor_ros.model.revolutions import sampled_revolutions
 from satmotor_ros.model.units import LPM
 from satmotor_ros.model.viscosity import standard_law, ViscosityLaw
 
-Mode = Literal['auto', 'points', 'series']
+Mode = Literal['auto', 'points', 'series', 'transient']
+MODES: tuple[Mode, ...] = ('auto', 'points', 'series', 'transient')
+"""Rows are steady points, a series' steady windows, a series' every sample, or decide."""
 
 
 @dataclass(frozen=True)
@@ -41,10 +45,11 @@ class Options:
     min_gain: float = 0.05  # least cut of the cross-validated error [-]
     tie: float = 0.05  # near-tie margin of cross-validated error [-]
     max_effects: int = 4  # most effects the forward selection adds [-]
-    mode: Mode = 'auto'  # rows are steady points, a time series, or decide from the data
+    mode: Mode = 'auto'  # see MODES
     seed: int = 0  # fold shuffle [-]
     compare_families: bool = True  # choose the model family first; False: the motor's, pinned
     steady: SteadyTolerance = field(default_factory=SteadyTolerance)
+    transient: TransientOptions = field(default_factory=TransientOptions)
 
 
 @dataclass(frozen=True)
@@ -67,6 +72,10 @@ class Calibration:
     error_after: Errors  # with every effect, out of sample (outliers left out)
     rows: np.ndarray | None  # row of the table each point came from (None: a time series)
     family: FamilyChoice | None = None  # the families compared (None: pinned by the user)
+    mode: Mode = 'points'  # how the rows were read (never 'auto')
+    mode_reason: str = ''  # why, one sentence
+    samples: Samples | None = None  # the time series' samples in 'transient' mode
+    inflation: float = 1.0  # variance inflation of the final fit's residuals [-]
 
     @property
     def selection(self) -> Selection:
@@ -181,6 +190,7 @@ class Calibration:
                 {'effect': s.effect, 'regressor': s.candidate.regressor if s.candidate else None,
                  'cv_rmse_lpm': _round(s.cv_rmse / LPM)} for s in ranked],
             'family_comparison': self.family_comparison(),
+            **self.mode_fields(),
         }
 
     def family_comparison(self) -> dict[str, Any]:
@@ -190,6 +200,26 @@ class Calibration:
                     'n_points': None, 'families': []}
         return {'verdict': self.family.verdict, 'n_points': self.family.n_points,
                 'families': self.family.as_list()}
+
+    def mode_fields(self) -> dict[str, Any]:
+        """
+        Build calibration.json's fields beyond DESIGN.md's, in ``'transient'`` mode only.
+
+        Returns
+        -------
+        dict
+            Empty for steady points; for all samples ``mode``, ``mode_reason``,
+            ``n_samples``, ``bin_size`` (sample steps per row), ``variance_inflation``
+            and ``dynamics`` (each transient term's coefficient with its ci95, unit and
+            meaning, :func:`~satmotor_ros.identify.transient.dynamics_summary`).
+
+        """
+        if self.samples is None:
+            return {}
+        return {'mode': self.mode, 'mode_reason': self.mode_reason,
+                'n_samples': self.samples.n_samples, 'bin_size': self.samples.bin_size,
+                'variance_inflation': _round(self.inflation),
+                'dynamics': dynamics_summary(self.final, self.samples)}
 
 
 def _coefficient_interval(report: FitReport, position: int,
@@ -221,6 +251,11 @@ def _round(x: float) -> float:
     return float(f'{float(x):.5g}')
 
 
+def is_series(table: BenchTable) -> bool:
+    """Return whether the rows are a time series' samples (a bag, or rows that look so)."""
+    return table.time_series or looks_like_series(table)
+
+
 def steady_points(table: BenchTable, mode: Mode = 'auto',
                   tol: SteadyTolerance | None = None) -> BenchTable:
     """
@@ -247,10 +282,9 @@ def steady_points(table: BenchTable, mode: Mode = 'auto',
 
     """
     if mode not in ('auto', 'points', 'series'):
-        msg = f"mode = {mode!r}: use 'auto', 'points' or 'series'"
+        msg = f"mode = {mode!r}: steady points come from 'auto', 'points' or 'series'"
         raise DataError(msg)
-    series = table.time_series or looks_like_series(table)
-    if mode == 'series' or (mode == 'auto' and series):
+    if mode == 'series' or (mode == 'auto' and is_series(table)):
         return extract_steady(table, tol)
     if 'time' in table.channels:
         order = np.argsort(table.channels['time'], kind='stable')
@@ -263,6 +297,67 @@ def steady_points(table: BenchTable, mode: Mode = 'auto',
                                table.notes + ('revolutions integrated from speed between '
                                               'the rows (trapezoid)',))
     return table
+
+
+@dataclass(frozen=True)
+class _Rows:
+    """The rows a calibration fits, and how they were read."""
+
+    table: BenchTable
+    parts: LossParts
+    source_rows: np.ndarray | None
+    mode: Mode
+    reason: str
+    samples: Samples | None = None
+
+
+def _steady_rows(model: MotorModel, table: BenchTable, points: BenchTable, mode: Mode,
+                 reason: str) -> _Rows:
+    rows = _source_rows(table, points)
+    parts, usable = loss_parts(model, points)
+    if not usable.all():
+        points = points.select(usable, f'left out {int((~usable).sum())} points outside the '
+                                       'model (no flow the model can give, or a chamber '
+                                       'drop out of range)')
+        rows = None if rows is None else rows[usable]
+    check_identifiable(parts)
+    return _Rows(points, parts, rows, mode, reason)
+
+
+def _transient_rows(model: MotorModel, table: BenchTable, options: Options,
+                    reason: str) -> _Rows:
+    samples = transient_samples(model, table, options.transient)
+    check_identifiable(samples.parts)
+    return _Rows(samples.table, samples.parts, None, 'transient', reason, samples)
+
+
+def _rows(model: MotorModel, table: BenchTable, options: Options) -> _Rows:
+    """Read the rows as the mode says; in 'auto', every sample when steady windows are few."""
+    mode = options.mode
+    if mode not in MODES:
+        msg = f'mode = {mode!r}: use one of {", ".join(MODES)}'
+        raise DataError(msg)
+    if mode == 'transient':
+        return _transient_rows(model, table, options, 'asked for (--mode transient)')
+    if mode != 'auto' or not is_series(table):
+        why = {'points': 'asked for (--mode points)', 'series': 'asked for (--mode series)',
+               'auto': 'the rows are not a time series: each is a steady point'}[mode]
+        points = steady_points(table, mode, options.steady)
+        return _steady_rows(model, table, points, 'series' if mode == 'series' else 'points',
+                            why)
+    least = max(options.transient.min_steady, MIN_POINTS)
+    try:
+        rows = _steady_rows(model, table, extract_steady(table, options.steady), 'series', '')
+    except (DataError, IdentificationError) as err:
+        why = f'no usable steady windows ({err})'
+    else:
+        if len(rows.parts) >= least:
+            return replace(rows, reason=f'a time series with {len(rows.parts)} steady '
+                                        f'windows (>= {least})')
+        why = f'only {len(rows.parts)} steady windows (< {least})'
+    return _transient_rows(model, table, options,
+                           f'a time series of {len(table)} samples with {why}: every sample '
+                           'used, with the transient terms')
 
 
 def _without_effects(spec: MotorSpec, liquid: str,
@@ -314,40 +409,58 @@ def calibrate(table: BenchTable, liquid: str = 'oil', spec: MotorSpec | None = N
         msg = f'liquid {liquid!r} is not a coefficient set of {spec.name} ({", ".join(spec.sets)})'
         raise IdentificationError(msg)
     spec, table = _without_effects(spec, liquid, table)
-    points = steady_points(table, options.mode, options.steady)
-
-    def selector() -> CrossValidatedSelector:
-        return CrossValidatedSelector(options.alpha, options.n_folds, options.min_gain,
-                                      options.tie, 'time' in points.channels, options.seed,
-                                      options.max_effects)
-
-    choice = None
-    if options.compare_families:
-        specs = family_specs(spec, spec.source == load_motor().source)
-        choice = compare_families(points, liquid, specs, selector, options.min_gain)
-        spec = specs[choice.chosen]
-    model = MotorModel.from_spec(spec, liquid)
-    rows = _source_rows(table, points)
-    parts, usable = loss_parts(model, points)
-    if not usable.all():
-        points = points.select(usable, f'left out {int((~usable).sum())} points outside the '
-                                       'model (no flow the model can give, or a chamber '
-                                       'drop out of range)')
-        rows = None if rows is None else rows[usable]
-    check_identifiable(parts)
+    spec, model, read, choice = _family_and_rows(spec, liquid, table, options)
+    points, parts, rows, samples = read.table, read.parts, read.source_rows, read.samples
     law = standard_law(model.liquid, liquid)
     channels = {**points.channels, 'p_out': points.p_out}
     candidates, skipped = build_library(parts, channels, law)
-    forward = selector().select(parts, candidates)
+    selector = _selector(options, points, samples)
+    forward = selector.select(parts, candidates)
     first = forward.steps[0]
     packaged_error = parts.flow - predict_flow(parts, np.ones(len(parts.components)))
     at = ~forward.outliers
+    index = np.flatnonzero(at)
+    inflation = selector.inflation(parts, forward.final.fit, forward.sigma, index)
+    base_inflation = selector.inflation(parts, first.baseline.fit, forward.sigma, index)
     return Calibration(liquid, spec, model, points, parts, law, tuple(candidates),
-                       tuple(skipped), forward, first.baseline.fit.report(),
-                       forward.final.fit.report(),
+                       tuple(skipped), forward, first.baseline.fit.report(base_inflation),
+                       forward.final.fit.report(inflation),
                        Errors.of(packaged_error[at], parts.loss[at]),
                        Errors.of(first.baseline.cv_error[at], parts.loss[at]),
-                       Errors.of(forward.final.cv_error[at], parts.loss[at]), rows, choice)
+                       Errors.of(forward.final.cv_error[at], parts.loss[at]), rows, choice,
+                       read.mode, read.reason, samples, inflation)
+
+
+def _selector(options: Options, points: BenchTable,
+              samples: Samples | None) -> CrossValidatedSelector:
+    return CrossValidatedSelector(options.alpha, options.n_folds, options.min_gain, options.tie,
+                                  'time' in points.channels, options.seed, options.max_effects,
+                                  samples.guard if samples else 0, samples is not None)
+
+
+def _family_and_rows(spec: MotorSpec, liquid: str, table: BenchTable,
+                     options: Options) -> tuple[MotorSpec, MotorModel, _Rows, FamilyChoice | None]:
+    """Read the rows with the motor's family, compare the families there, re-read if another."""
+    model = MotorModel.from_spec(spec, liquid)
+    if not options.compare_families:
+        return spec, model, _rows(model, table, options), None
+    read: _Rows | None = None
+    try:
+        read = _rows(model, table, options)
+        compared = read.table  # in transient mode the bins' means: the steady maps compared
+    except IdentificationError:  # the motor's own family cannot use the data; another may
+        steady: Mode = options.mode if options.mode != 'transient' else 'auto'
+        compared = steady_points(table, steady, options.steady)
+    samples = read.samples if read is not None else None
+    specs = family_specs(spec, spec.source == load_motor().source)
+    choice = compare_families(compared, liquid, specs,
+                              lambda: _selector(options, compared, samples), options.min_gain)
+    if read is not None and choice.chosen == model.family.name:
+        return spec, model, read, choice
+    spec = specs[choice.chosen]
+    model = MotorModel.from_spec(spec, liquid)
+    again = options if read is None else replace(options, mode=read.mode)
+    return spec, model, _rows(model, table, again), choice
 
 
 def _source_rows(table: BenchTable, points: BenchTable) -> np.ndarray | None:
@@ -359,4 +472,5 @@ def _source_rows(table: BenchTable, points: BenchTable) -> np.ndarray | None:
     return np.arange(len(table))
 
 
-__all__ = ['Calibration', 'IdentificationError', 'Options', 'calibrate', 'steady_points']
+__all__ = ['Calibration', 'IdentificationError', 'MODES', 'Mode', 'Options', 'calibrate',
+           'steady_points']

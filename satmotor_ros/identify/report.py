@@ -16,6 +16,7 @@ from satmotor_ros.identify.parts import LossParts
 from satmotor_ros.identify.pipeline import Calibration
 from satmotor_ros.identify.selection import Errors
 from satmotor_ros.identify.table import BenchTable
+from satmotor_ros.identify.transient import transient_section
 from satmotor_ros.model import MotorModel
 from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.units import LPM, MPA, RPM
@@ -291,8 +292,10 @@ def write_report(cal: Calibration, out: Path, summary: dict[str, object]) -> Pat
         plot(cal, out / f'{name}.png')
     sel = cal.selection
     found = ', '.join(f'`{s.label}`' for s in cal.found) or '`none`'
+    data = (f'{len(cal.parts)} rows of {cal.samples.n_samples} samples'
+            if cal.samples is not None else f'{len(cal.parts)} steady operating points')
     lines = [f'# Calibration of {cal.spec.name} on {cal.liquid}', '',
-             f'Data: `{cal.table.source}`, {len(cal.parts)} steady operating points.']
+             f'Data: `{cal.table.source}`, {data}. Mode `{cal.mode}`: {cal.mode_reason}.']
     lines += [f'- {note}' for note in cal.table.notes]
     lines += [''] + _families(cal)
     lines += ['## Result', '', f'**Effects: {found}**, found one after the other:', '']
@@ -311,6 +314,8 @@ def write_report(cal: Calibration, out: Path, summary: dict[str, object]) -> Pat
     lines += [f'`{c.name}` multiplies {c.describes or c.name}.' for c in cal.parts.components]
     lines += ['The other coefficients of Table 1 are not identifiable from Q, n and dp and keep '
               'their packaged values.', '']
+    if cal.samples is not None:
+        lines += transient_section(summary, cal.inflation)
     lines += _identifiability(cal) + _outliers(cal, summary)
     lines += ['## Candidates of the first step', '', _table(
         [[f'`{s.label}`', f'{s.cv_rmse / LPM:.4g}', f'{s.p_value:.2g}',

@@ -25,6 +25,11 @@ cross-validated error are those of standardised residuals, through Huber's
 loss, and the points that are outliers even under that model are left out of
 the step's fits, so that a bad row decides nothing, while a point that an
 effect explains is never mistaken for one.
+
+Rows of a time series (:mod:`.transient`) have correlated residuals: a test
+fold then also keeps ``guard`` rows on each side out of its training, and the
+F-test divides the statistic and the number of rows by the fit's variance
+inflation.
 """
 
 from __future__ import annotations
@@ -38,6 +43,7 @@ from satmotor_ros.identify.errors import IdentificationError
 from satmotor_ros.identify.fit import HUBER, LossFit
 from satmotor_ros.identify.noise import noise_model, outliers, robust_scale
 from satmotor_ros.identify.parts import LossParts
+from satmotor_ros.identify.transient import variance_inflation
 from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.units import LPM
 from scipy import special
@@ -227,12 +233,18 @@ class CrossValidatedSelector:
         Seed of the fold shuffle, [-]
     max_effects : int
         Most effects the loop adds, [-]
+    guard : int
+        Rows on each side of a contiguous test fold also kept out of its training
+        (neighbours that share a sample); 0 for independent rows, [-]
+    correlated : bool
+        Whether neighbouring residuals are correlated (a time series' rows): the
+        F-test then uses the variance inflation, [-]
 
     """
 
     def __init__(self, alpha: float = 0.05, n_folds: int = 5, min_gain: float = 0.05,
                  tie: float = 0.05, time_ordered: bool = False, seed: int = 0,
-                 max_effects: int = 4) -> None:
+                 max_effects: int = 4, guard: int = 0, correlated: bool = False) -> None:
         """Validate and store the hyperparameters."""
         if not 0.0 < alpha < 1.0:
             msg = f'alpha = {alpha!r}: must be in (0, 1)'
@@ -246,6 +258,8 @@ class CrossValidatedSelector:
             raise IdentificationError(msg)
         self.alpha, self.n_folds, self.min_gain, self.tie = alpha, n_folds, min_gain, tie
         self.time_ordered, self.seed, self.max_effects = time_ordered, seed, max_effects
+        self.guard = guard if time_ordered else 0
+        self.correlated = correlated
         self._tried: dict[int, FloatArray] = {}  # candidate id -> its parameters last fitted
 
     def score(self, parts: LossParts, effects: Sequence[Candidate], sigma: FloatArray,
@@ -278,7 +292,7 @@ class CrossValidatedSelector:
         full = LossFit(effects, sigma, HUBER).fit(parts, index, start)
         error = parts.flow - full.predict(parts)  # out of sample where not fitted
         for test in folds(index.size, self.n_folds, self.time_ordered, self.seed):
-            u = full.without(test)
+            u = full.without(_guarded(test, self.guard, index.size))
             error[index[test]] = parts.flow[index[test]] - full.predict(parts, index[test], u)
         z = error[index] / sigma[index]
         rho = np.where(np.abs(z) <= HUBER, z * z, 2.0 * HUBER * np.abs(z) - HUBER ** 2)
@@ -288,11 +302,41 @@ class CrossValidatedSelector:
             q = full.n_params - baseline.fit.n_params
             dof = index.size - full.n_params
             drop = max(baseline.fit.objective_ - full.objective_, 0.0)
+            inflation = self.inflation(parts, full, sigma, index)
             if dof > 0 and full.objective_ > 0.0:
-                p_value = float(special.fdtrc(q, dof, drop / q / (full.objective_ / dof)))
+                f = drop / q / (full.objective_ / dof) / inflation
+                p_value = float(special.fdtrc(q, max(int(index.size / inflation)
+                                                     - full.n_params, 1), f))
             elif drop > 0.0:
                 p_value = 0.0
         return Score(effects[-1] if baseline is not None else None, full, error, cv, p_value)
+
+    def inflation(self, parts: LossParts, fit: LossFit, sigma: FloatArray,
+                  index: np.ndarray) -> float:
+        """
+        Return the variance inflation of a fit's standardised residuals (1 unless correlated).
+
+        Parameters
+        ----------
+        parts : LossParts
+            Components at the points, [-]
+        fit : LossFit
+            A fit on the points in `index`, [-]
+        sigma : ndarray
+            Noise at every point, [m^3/s]
+        index : ndarray of int
+            The points fitted, in time order, [-]
+
+        Returns
+        -------
+        float
+            :func:`~satmotor_ros.identify.transient.variance_inflation`, >= 1, [-]
+
+        """
+        if not self.correlated:
+            return 1.0
+        return variance_inflation((parts.flow[index] - fit.predict(parts, index))
+                                  / sigma[index])
 
     def _passes(self, score: Score, baseline: Score, m: int) -> bool:
         return (score.p_value < self.alpha / m
@@ -425,6 +469,13 @@ class CrossValidatedSelector:
         residual = parts.flow - final.fit.predict(parts)
         sigma = steps[-1].sigma
         return Forward(tuple(steps), final, sigma, outliers(residual, sigma))
+
+
+def _guarded(test: np.ndarray, guard: int, n: int) -> np.ndarray:
+    """Return a contiguous test fold widened by `guard` positions on each side."""
+    if not guard:
+        return test
+    return np.arange(max(int(test[0]) - guard, 0), min(int(test[-1]) + guard + 1, n))
 
 
 def _with_verdict(step: Selection, verdict: str) -> Selection:

@@ -30,6 +30,7 @@ from satmotor_ros.model.effects import Effect, kind_of, sensor_error, Synthetic,
 from satmotor_ros.model.revolutions import revolutions
 from satmotor_ros.model.units import LPM, MPA, RPM
 from satmotor_ros.model.viscosity import standard_law
+from scipy.signal import lfilter
 
 EFFECTS = ('none', 'external_leakage', 'viscosity_temperature', 'clearance_wear',
            'flow_sensor_offset', 'flow_sensor_gain', 'speed_sensor_gain', 'channel:aux',
@@ -394,6 +395,118 @@ def generate_series(plan: Plan, injection: Injection | Sequence[Injection], seed
     return replace(table, time_series=True)
 
 
+def first_order(x: FloatArray, dt: float, tau: float) -> FloatArray:
+    r"""
+    Follow a sampled input with a first-order lag, starting at rest on its first value.
+
+    Exact for an input linear between the samples (first-order hold):
+
+    .. math:: y_i = E y_{i-1} + (1 - E - c)\,x_{i-1} + c\,x_i, \quad E = e^{-dt/\tau},
+        \quad c = 1 - \frac{\tau}{dt}(1 - E)
+
+    Parameters
+    ----------
+    x : ndarray
+        Input samples, [any]
+    dt : float
+        Sample step, [s]
+    tau : float
+        Time constant; 0 returns `x`, [s]
+
+    Returns
+    -------
+    ndarray
+        The lagged samples, [unit of x]
+
+    """
+    if tau <= 0.0:
+        return np.asarray(x, dtype=float).copy()
+    e = np.exp(-dt / tau)
+    c = 1.0 - tau / dt * (1.0 - e)
+    y, _ = lfilter([c, 1.0 - e - c], [1.0, -e], x, zi=[(1.0 - c) * x[0]])
+    return np.asarray(y, dtype=float)
+
+
+@dataclass(frozen=True)
+class Dynamics:
+    """The transient terms to inject into a generated recording (eqs. T1-T3 of `.transient`)."""
+
+    line_compliance: float = 0.0  # V/K of the inlet line between flowmeter and motor [m^3/Pa]
+    speed_lag: float = 0.0  # first-order time constant of the speed reading [s]
+    flow_lag: float = 0.0  # first-order time constant of the flow reading [s]
+
+
+REALISTIC_DYNAMICS = Dynamics(line_compliance=5.0e-13, speed_lag=0.02, flow_lag=0.05)
+"""About 0.5 l of oil in hoses (effective bulk modulus 1 GPa), a 20 ms speed, a 50 ms flow lag."""
+
+
+def generate_transient(plan: Plan, injection: Injection | Sequence[Injection],
+                       dynamics: Dynamics = Dynamics(), seed: int = 0, duration_s: float = 90.0,
+                       rate: float = 100.0, hold_s: tuple[float, float] = (0.6, 1.5),
+                       tau_s: float = 0.15, noise: float = 3.0,
+                       oversample: int = 5) -> BenchTable:
+    """
+    Generate a recording whose set-points change every `hold_s` seconds, with its dynamics.
+
+    Speed, pressure drop and outlet pressure follow random set-points through a
+    first-order lag `tau_s`. The flowmeter sits upstream of the inlet line and reads
+    the motor's flow plus (V/K) dp_in/dt (T1); the speed and flow readings lag
+    through first-order filters (T2, T3). Simulated at `oversample` times the rate.
+
+    Parameters
+    ----------
+    plan : Plan
+        Range and noise (multiplied by `noise` per sample), [-]
+    injection : Injection or sequence of Injection
+        The effect(s) to inject, [-]
+    dynamics : Dynamics
+        Line compliance and sensor lags, [-]
+    seed : int
+        Seed, [-]
+    duration_s : float
+        Length of the recording, [s]
+    rate : float
+        Sample rate, [Hz]
+    hold_s : (float, float)
+        Shortest and longest time a set-point holds, [s]
+    tau_s : float
+        Time constant of speed and pressures between set-points, [s]
+    noise : float
+        Factor on the plan's noise for raw samples, [-]
+    oversample : int
+        Simulation steps per sample, [-]
+
+    Returns
+    -------
+    BenchTable
+        Raw samples, ``time_series`` True.
+
+    """
+    rng = np.random.default_rng(seed)
+    dt = 1.0 / (rate * oversample)
+    time = np.arange(int(round(duration_s / dt)), dtype=float) * dt
+    changes = np.cumsum(rng.uniform(*hold_s, int(duration_s / hold_s[0]) + 2))
+    k = np.searchsorted(changes, time, side='right')
+    steps = int(k[-1]) + 1
+    sp_speed, sp_dp = _operating_points(plan, rng, steps)
+    speed, dp = (first_order(x[k], dt, tau_s) for x in (sp_speed, sp_dp))
+    injections = _injections(injection)
+    channels = _channels(plan, injections, rng, time, steps, k)
+    channels['p_out'] = first_order(channels['p_out'], dt, tau_s)
+    channels['revolutions'] = revolutions(speed, dt)
+    base = MotorModel.from_spec(load_motor(), plan.liquid)
+    effects = _effects(base, injections, speed, dp, channels)
+    flow = true_flow(base, effects, speed, dp, channels)
+    flow = flow + dynamics.line_compliance * np.gradient(channels['p_out'] + dp, dt)
+    flow = first_order(flow, dt, dynamics.flow_lag)
+    read_speed = first_order(speed, dt, dynamics.speed_lag)
+    pick = slice(None, None, oversample)
+    channels = {name: x[pick] for name, x in channels.items()}
+    table = _measure(plan, effects, rng, flow[pick], read_speed[pick], dp[pick], channels,
+                     noise)
+    return replace(table, time_series=True)
+
+
 def write_bag_of(path: str | Path, table: BenchTable, storage: str = 'mcap',
                  flow_topic: str = 'flow_measured') -> None:
     """
@@ -490,14 +603,23 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument('--points', type=int, default=100)
     parser.add_argument('--series', type=int, default=0, metavar='SAMPLES',
                         help='write a 100 Hz time series of this many samples instead')
+    parser.add_argument('--transient', type=float, default=0.0, metavar='SECONDS',
+                        help='write a 100 Hz recording of this length whose set-points change '
+                             'every 0.6-1.5 s, with a line volume and sensor lags '
+                             '(REALISTIC_DYNAMICS) instead')
     parser.add_argument('--bag', choices=('mcap', 'sqlite3'), default=None,
                         help='write the time series as a rosbag2 bag (directory --out)')
     parser.add_argument('--out', required=True, help='CSV file (or bag directory) to write')
     args = parser.parse_args(argv)
     plan = Plan(liquid=args.liquid, n_points=args.points)
     injection = Injection.realistic(args.effect, args.scale, args.liquid)
-    table = (generate_series(plan, injection, args.seed, samples=args.series) if args.series
-             else generate(plan, injection, args.seed))
+    if args.transient:
+        table = generate_transient(plan, injection, REALISTIC_DYNAMICS, args.seed,
+                                   duration_s=args.transient)
+    elif args.series:
+        table = generate_series(plan, injection, args.seed, samples=args.series)
+    else:
+        table = generate(plan, injection, args.seed)
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
     if args.bag:
         write_bag_of(args.out, table, args.bag)

@@ -1,0 +1,568 @@
+# SPDX-License-Identifier: Apache-2.0
+r"""
+Every sample of a time series as data: the steady model plus the terms of a transient.
+
+While the operating point moves, what the sensors read differs from the steady map
+(eqs. 34-36) by the dynamics of the lines and of the sensors. Each difference here is linear
+in one parameter, so it enters every fit as a nuisance regressor (``LossParts.nuisance``: a
+free coefficient, no prior):
+
+- (T1) line compliance: the flowmeter sits upstream of a line volume V, so it also reads the
+  flow that compresses the liquid in it, :math:`Q_{meas} = Q + (V/K)\,\dot p_{in}`;
+- (T2) speed lag: the speed reading lags the shaft by :math:`\tau_n`, so the model's flow at
+  the true speed is :math:`Q(n_{true}) = Q(n) + \tau_n\,(\partial Q/\partial n)\,\dot n`
+  (:math:`n_{true} = n + \tau_n \dot n` is exact for a first-order lag; :math:`\partial
+  Q/\partial n` is :math:`q_t` plus the speed-dependent losses' share);
+- (T3) flow lag: the flowmeter lags the flow by :math:`\tau_Q`,
+  :math:`Q_{meas} = Q - \tau_Q \dot Q_{meas}` (exact for a first-order lag).
+
+No derivative is estimated. The model is evaluated at every sample, and the whole equation
+is averaged over short bins of consecutive samples (trapezoid rule, :data:`BIN_SECONDS`):
+the mean of a derivative over a bin is exactly the change across the bin over its length,
+so the derivative terms and the averaged model are filtered alike, and the average of the
+model's components is exact however nonlinear the steady map. Bins never span a gap or a
+sample the model cannot use; neighbouring bins share one end sample. A bin's change carries
+the noise of its two end values (errors in variables, which shrink a lag's estimate by the
+noise's share of the change's variance): the end values are taken from a local quadratic fit
+over :data:`END_SAMPLES` samples, which leaves a third of that noise.
+
+(T2) and (T3) differ only by the change of the loss (:math:`\dot Q = q_t \dot n +
+\dot Q_{vl}`): where that is small, the data determine :math:`\tau_n - \tau_Q` well and each
+lag poorly; the report says so. Neighbouring residuals are correlated: the selection's F-test
+and the intervals use the variance inflation of :func:`variance_inflation`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, fields, replace
+from typing import Any
+
+import numpy as np
+from satmotor_ros.identify.errors import DataError, IdentificationError
+from satmotor_ros.identify.fit import FitReport
+from satmotor_ros.identify.parts import loss_parts, LossParts, NO_EFFECT
+from satmotor_ros.identify.table import BenchTable
+from satmotor_ros.model import MotorModel
+from satmotor_ros.model._typing import FloatArray
+from satmotor_ros.model.revolutions import sampled_revolutions
+
+BIN_SECONDS = 0.2
+"""
+Shortest bin [s]: long against the sample step (each row averages the sensors' white noise
+down), short against a hydraulic transient (0.05-0.5 s), so the rows still resolve it.
+"""
+
+MAX_ROWS = 20_000
+"""Most rows a fit takes: longer series get longer bins."""
+
+MAX_CORRELATION = 0.9999
+"""A dynamic term this correlated with the others (r of its fit on them) is left out."""
+
+MIN_BLOCKS = 10
+"""Fewest blocks a batch-means estimate of the variance inflation uses."""
+
+END_SAMPLES = 7
+"""Samples of the local fit that gives a bin's end values (a third of their noise variance)."""
+
+LAG_CORRELATION = 0.95
+"""Above this |r| between the two lags' regressors the report says they barely separate."""
+
+
+@dataclass(frozen=True)
+class DynamicTerm:
+    """One term of a transient that the steady map lacks (eqs. T1-T3)."""
+
+    name: str  # id in calibration.json
+    symbol: str  # the coefficient's symbol
+    regressor: str  # what the coefficient multiplies
+    unit: str  # the coefficient's unit
+    equation: str  # tag in this module's docstring
+    meaning: str  # one line for the report
+
+
+DYNAMIC_TERMS = (
+    DynamicTerm('line_compliance', 'V/K', 'dp_in/dt', 'm^3/Pa', 'T1',
+                'flow into the inlet line volume V at bulk modulus K (flowmeter upstream)'),
+    DynamicTerm('speed_lag', 'tau_n', 'dQ/dn*dn/dt', 's', 'T2',
+                'the speed reading lags the shaft (first-order time constant)'),
+    DynamicTerm('flow_lag', 'tau_Q', '-dQ/dt', 's', 'T3',
+                'the flow reading lags the flow (first-order time constant)'),
+)
+"""The transient's terms, in the order they enter the fit."""
+
+
+@dataclass(frozen=True)
+class TransientOptions:
+    """How a time series becomes rows for the fit."""
+
+    bin_seconds: float = BIN_SECONDS  # shortest bin [s]
+    gap: float = 3.0  # a time step over gap x the median step cuts the series [-]
+    min_steady: int = 20  # 'auto' takes steady windows only when they give this many points [-]
+    max_rows: int = MAX_ROWS  # rows a fit takes at most [-]
+
+    def __post_init__(self) -> None:
+        """Reject a bin <= 0, a gap <= 1 and counts < 1."""
+        if not (self.bin_seconds > 0.0 and self.gap > 1.0 and self.min_steady >= 1
+                and self.max_rows >= 1):
+            msg = ('TransientOptions: need bin_seconds > 0, gap > 1, min_steady >= 1 and '
+                   'max_rows >= 1')
+            raise DataError(msg)
+
+
+@dataclass(frozen=True)
+class Samples:
+    """The samples of a time series as rows for the fit, with the transient's regressors."""
+
+    table: BenchTable  # one row per bin (trapezoid means), in time order
+    parts: LossParts  # the model's components averaged alike, the dynamic terms as nuisance
+    n_samples: int  # samples in the bins [-]
+    bin_size: int  # sample steps a bin spans (at least; a run's last bin up to twice) [-]
+    step: float  # median sample step [s]
+    segments: int  # stretches without a gap [-]
+    left_out: tuple[tuple[str, str], ...]  # dynamic terms not fitted: (name, why)
+    correlation: float  # of the speed_lag and flow_lag regressors (NaN if one is out) [-]
+
+    guard = 1
+    """Rows a test fold keeps out of training on each side: neighbours share a sample."""
+
+
+def dynamic_regressors(dp_in_dt: FloatArray, dn_dt: FloatArray, dq_dt: FloatArray,
+                       dq_dn: FloatArray) -> dict[str, FloatArray]:
+    r"""
+    Compute the flow per unit coefficient of each transient term, eqs. (T1)-(T3).
+
+    .. math:: Q_{meas} = Q(n, \Delta p_i) + \frac{V}{K}\,\dot p_{in}
+        + \tau_n\,\frac{\partial Q}{\partial n}\,\dot n - \tau_Q\,\dot Q_{meas}
+
+    Parameters
+    ----------
+    dp_in_dt : ndarray
+        Rate of change of the inlet pressure, [Pa/s]
+    dn_dt : ndarray
+        Rate of change of the speed reading, [rad/s^2]
+    dq_dt : ndarray
+        Rate of change of the flow reading, [m^3/s^2]
+    dq_dn : ndarray
+        The steady model's flow per unit speed (:func:`flow_per_speed`), [m^3/rad]
+
+    Returns
+    -------
+    dict of str to ndarray
+        Term name -> regressor: dp_in/dt [Pa/s] for V/K, dQ/dn dn/dt [m^3/s^2] for
+        tau_n, -dQ/dt [m^3/s^2] for tau_Q.
+
+    """
+    return {'line_compliance': dp_in_dt, 'speed_lag': dq_dn * dn_dt, 'flow_lag': -dq_dt}
+
+
+def flow_per_speed(parts: LossParts) -> FloatArray:
+    r"""
+    Differentiate the steady model's flow by speed at the packaged coefficients.
+
+    .. math:: \frac{\partial Q}{\partial n} = \frac{q_t n + \sum_j e_j Q_j}{n}
+
+    from eq. (36): each component Q_j grows as n^e_j at a fixed chamber drop
+    (for eqs. 31-33: the pressure-speed losses of eqs. 11-13 with n, the inertia
+    loss of eq. 14 with n^0.5, the leakage of eqs. 1, 5 not at all).
+
+    Parameters
+    ----------
+    parts : LossParts
+        Components at the rows, [-]
+
+    Returns
+    -------
+    ndarray
+        dQ/dn; q_t where the speed is 0, [m^3/rad]
+
+    """
+    speed_part = parts.displacement + sum(
+        (c.speed_power * c.flow(NO_EFFECT) for c in parts.components),
+        np.zeros_like(parts.displacement))
+    qt = parts.displacement / np.where(parts.speed > 0.0, parts.speed, np.inf)
+    qt_value = float(np.nanmax(qt)) if np.any(parts.speed > 0.0) else 0.0
+    return np.where(parts.speed > 0.0, speed_part / np.where(parts.speed > 0.0, parts.speed,
+                                                             1.0), qt_value)
+
+
+def segments(time: FloatArray, gap: float) -> tuple[np.ndarray, float]:
+    """
+    Find where a time series is cut by a step over `gap` times the median step.
+
+    Parameters
+    ----------
+    time : ndarray
+        Sample times, increasing, [s]
+    gap : float
+        Factor on the median step, [-]
+
+    Returns
+    -------
+    ndarray of bool
+        True at the first sample of each stretch without a gap.
+    float
+        The median step, [s]
+
+    """
+    dt = np.diff(time)
+    positive = dt[dt > 0.0]
+    step = float(np.median(positive)) if positive.size else 0.0
+    first = np.ones(time.size, dtype=bool)
+    first[1:] = (dt > gap * step) | (dt <= 0.0)
+    return first, step
+
+
+def bins(usable: np.ndarray, first: np.ndarray, size: int) -> tuple[np.ndarray, np.ndarray]:
+    """
+    Cut the runs of usable samples into bins of `size` sample steps.
+
+    Parameters
+    ----------
+    usable : ndarray of bool
+        Samples the model can use, [-]
+    first : ndarray of bool
+        First sample of each stretch without a gap (:func:`segments`), [-]
+    size : int
+        Sample steps per bin (>= 1); a run's remainder joins its last bin, [-]
+
+    Returns
+    -------
+    ndarray of int
+        First sample of each bin.
+    ndarray of int
+        Last sample of each bin (the next bin's first when they touch).
+
+    """
+    start = usable & (first | ~np.concatenate(([False], usable[:-1])))
+    stop = usable & np.concatenate((first[1:] | ~usable[1:], [True]))  # a run's last sample
+    lo, hi = np.flatnonzero(start), np.flatnonzero(stop)
+    count = (hi - lo) // size  # bins per run (runs of one sample give none)
+    keep = count > 0
+    lo, hi, count = lo[keep], hi[keep], count[keep]
+    run = np.repeat(np.arange(lo.size), count)
+    k = np.arange(run.size) - np.repeat(np.cumsum(count) - count, count)
+    a = lo[run] + k * size
+    b = np.where(k == count[run] - 1, hi[run], a + size)
+    return a, b
+
+
+def bin_means(time: FloatArray, x: FloatArray, a: np.ndarray, b: np.ndarray) -> FloatArray:
+    r"""
+    Average a sampled signal over each bin by the trapezoid rule.
+
+    .. math:: \bar x = \frac{1}{t_b - t_a} \int_{t_a}^{t_b} x\,dt
+
+    of the piecewise-linear signal through the samples; the mean of its derivative
+    over the same bin is :math:`(x_b - x_a) / (t_b - t_a)`.
+
+    Parameters
+    ----------
+    time : ndarray
+        Sample times, [s]
+    x : ndarray
+        Samples (NaN makes the bins that hold it NaN), [any]
+    a, b : ndarray of int
+        First and last sample of each bin (:func:`bins`), [-]
+
+    Returns
+    -------
+    ndarray
+        Mean of each bin, [unit of x]
+
+    """
+    piece = 0.5 * (x[1:] + x[:-1]) * np.diff(time)
+    bad = ~np.isfinite(piece)
+    area = np.concatenate(([0.0], np.cumsum(np.where(bad, 0.0, piece))))
+    holes = np.concatenate(([0], np.cumsum(bad)))
+    return np.where(holes[b] > holes[a], np.nan, (area[b] - area[a]) / (time[b] - time[a]))
+
+
+def smooth(x: FloatArray, first: np.ndarray, window: int) -> FloatArray:
+    r"""
+    Smooth samples by a local quadratic fit over `window` samples (Savitzky-Golay), per stretch.
+
+    .. math:: \hat x_i = \sum_{k=-m}^{m} \frac{3(3m^2 + 3m - 1) - 15k^2}
+        {(2m - 1)(2m + 1)(2m + 3)}\,x_{i+k}
+
+    exact for a quadratic, with 3(3m^2 + 3m - 1) / ((2m - 1)(2m + 1)(2m + 3)) of the
+    white noise's variance left (1/3 for 7 samples); the m samples at each end of a
+    stretch, and stretches shorter than the window, stay as measured.
+
+    Parameters
+    ----------
+    x : ndarray
+        Samples, [any]
+    first : ndarray of bool
+        First sample of each stretch without a gap, [-]
+    window : int
+        Odd number of samples 2m + 1 >= 5, [-]
+
+    Returns
+    -------
+    ndarray
+        The smoothed samples, [unit of x]
+
+    """
+    m = window // 2
+    k = np.arange(-m, m + 1, dtype=float)
+    weight = ((3.0 * (3 * m * m + 3 * m - 1) - 15.0 * k * k)
+              / ((2 * m - 1) * (2 * m + 1) * (2 * m + 3)))
+    out = x.astype(float, copy=True)
+    starts = np.flatnonzero(first)
+    for lo, hi in zip(starts, np.append(starts[1:], x.size)):
+        if hi - lo >= window:
+            out[lo + m:hi - m] = np.convolve(x[lo:hi], weight, 'valid')
+    return out
+
+
+def _channel_means(time: FloatArray, x: FloatArray, a: np.ndarray,
+                   b: np.ndarray) -> FloatArray:
+    """Trapezoid means of a channel; a bin with a NaN sample takes its finite samples' mean."""
+    out = bin_means(time, x, a, b)
+    finite = np.isfinite(x)
+    if finite.all():
+        return out
+    total = np.concatenate(([0.0], np.cumsum(np.where(finite, x, 0.0))))
+    count = np.concatenate(([0], np.cumsum(finite)))
+    with np.errstate(invalid='ignore', divide='ignore'):
+        plain = (total[b + 1] - total[a]) / (count[b + 1] - count[a])
+    return np.where(np.isfinite(out), out, plain)
+
+
+def _base(parts: LossParts) -> FloatArray:
+    return np.column_stack([*(c.flow(NO_EFFECT) for c in parts.components),
+                            parts.displacement])
+
+
+def _screen(regressors: dict[str, FloatArray],
+            parts: LossParts) -> tuple[dict[str, FloatArray], list[tuple[str, str]]]:
+    """Leave out the dynamic terms the data cannot determine, saying why."""
+    kept: dict[str, FloatArray] = {}
+    left_out = []
+    base = _base(parts)
+    for term in DYNAMIC_TERMS:
+        x = regressors[term.name]
+        if not np.all(np.isfinite(x)) or not np.any(x):
+            left_out.append((term.name, f'{term.regressor} is zero throughout'))
+            continue
+        others = np.column_stack([base, *kept.values()])
+        coef, *_ = np.linalg.lstsq(others, x, rcond=None)
+        r2 = 1.0 - float(np.sum((x - others @ coef) ** 2) / np.sum(x ** 2))
+        if r2 > MAX_CORRELATION ** 2:
+            left_out.append((term.name, f'{term.regressor} is a combination of the other '
+                                        f'regressors (r = {np.sqrt(max(r2, 0.0)):.5f})'))
+            continue
+        kept[term.name] = x
+    return kept, left_out
+
+
+def transient_samples(model: MotorModel, table: BenchTable,
+                      options: TransientOptions | None = None) -> Samples:
+    """
+    Turn every usable sample of a time series into bins for the fit, with the transient terms.
+
+    Parameters
+    ----------
+    model : MotorModel
+        The model whose steady map is evaluated at each sample, [-]
+    table : BenchTable
+        Raw samples with a ``time`` channel, [-]
+    options : TransientOptions, optional
+        Bin length, gap and row limit, [-]
+
+    Returns
+    -------
+    Samples
+        Bins, their model components and the dynamic regressors.
+
+    Raises
+    ------
+    DataError
+        If there is no time channel.
+    IdentificationError
+        If no two neighbouring samples are usable.
+
+    """
+    options = options or TransientOptions()
+    if 'time' not in table.channels:
+        msg = "all-samples mode needs a 'time [s]' column for the transient terms"
+        raise DataError(msg)
+    order = np.argsort(table.channels['time'], kind='stable')
+    if np.any(np.diff(order) != 1):
+        table = table.select(order)
+    time = table.channels['time']
+    first, step = segments(time, options.gap)
+    channels = dict(table.channels)
+    if 'revolutions' not in channels:
+        channels['revolutions'] = sampled_revolutions(table.speed, time)
+    table = replace(table, channels=channels, units={**table.units, 'revolutions': 'rev'})
+    all_parts, usable = loss_parts(model, table)
+    size = max(1, int(round(options.bin_seconds / step)) if step > 0.0 else 1)
+    size = max(size, int(np.ceil(int(usable.sum()) / options.max_rows)))
+    a, b = bins(usable, first, size)
+    if not a.size:
+        msg = (f'{table.source}: no two neighbouring usable samples (need flow > 0, speed >= 0 '
+               f'and a chamber drop between 0 and {model.dp_limit / 1e6:.1f} MPa)')
+        raise IdentificationError(msg)
+    where = np.flatnonzero(usable)  # parts are at the usable samples only
+
+    def at_samples(x: FloatArray) -> FloatArray:
+        full = np.full(time.size, np.nan)
+        full[where] = x
+        return full
+
+    def mean(x: FloatArray) -> FloatArray:
+        return bin_means(time, x, a, b)
+
+    averaged: dict[str, Any] = {f.name: mean(at_samples(getattr(all_parts, f.name)))
+                                for f in fields(all_parts)
+                                if isinstance(getattr(all_parts, f.name), np.ndarray)}
+    averaged['components'] = tuple(
+        replace(c, pieces=tuple((k, mean(at_samples(x))) for k, x in c.pieces))
+        for c in all_parts.components)
+    parts = replace(all_parts, **averaged)
+    ends = [smooth(x, first, END_SAMPLES) for x in (table.p_in, table.speed, table.flow)]
+    rates = [(x[b] - x[a]) / (time[b] - time[a]) for x in ends]
+    regressors = dynamic_regressors(rates[0], rates[1], rates[2], flow_per_speed(parts))
+    nuisance, left_out = _screen(regressors, parts)
+    parts = parts.with_nuisance(nuisance)
+    rows = BenchTable(mean(table.speed), mean(table.flow), mean(table.p_in), mean(table.p_out),
+                      {k: _channel_means(time, v, a, b) for k, v in table.channels.items()},
+                      table.units,
+                      table.source, True, table.notes)
+    in_bins = np.zeros(time.size + 1, dtype=int)
+    np.add.at(in_bins, a, 1)
+    np.add.at(in_bins, b + 1, -1)
+    n_samples = int(np.count_nonzero(np.cumsum(in_bins)[:-1]))
+    n_segments = int(first.sum())
+    note = (f'all samples: {n_samples} of {len(table)} ({100.0 * n_samples / len(table):.0f} %) '
+            f'in {n_segments} stretch(es) without a gap, step {step:.4g} s, averaged over '
+            f'bins of {size} steps ({size * step:.3g} s, {a.size} rows)')
+    rows = replace(rows, notes=rows.notes + (note,))
+    lags = [nuisance[name] for name in ('speed_lag', 'flow_lag') if name in nuisance]
+    correlation = float(np.corrcoef(lags[0], lags[1])[0, 1]) if len(lags) == 2 else np.nan
+    return Samples(rows, parts, n_samples, size, step, n_segments, tuple(left_out),
+                   correlation)
+
+
+def dynamics_summary(fit: FitReport, samples: Samples) -> list[dict[str, Any]]:
+    """
+    Describe the fitted dynamic terms for calibration.json and the report.
+
+    Parameters
+    ----------
+    fit : FitReport
+        A fit on the samples; the dynamic terms are among its names, [-]
+    samples : Samples
+        The samples it was fitted on, [-]
+
+    Returns
+    -------
+    list of dict
+        Per term of :data:`DYNAMIC_TERMS`: ``term``, ``symbol``, ``regressor``,
+        ``equation``, ``meaning``, ``unit``, and either ``coefficient`` and
+        ``ci95`` (SI, in ``unit``) with ``nonzero`` (the interval excludes 0), or
+        ``left_out`` with the reason; a ``note`` on the two lags when their
+        regressors correlate beyond :data:`LAG_CORRELATION`.
+
+    """
+    at = {name.removeprefix('nuisance:'): i for i, name in enumerate(fit.names)}
+    reasons = dict(samples.left_out)
+    out = []
+    for term in DYNAMIC_TERMS:
+        entry: dict[str, Any] = {'term': term.name, 'symbol': term.symbol,
+                                 'regressor': term.regressor, 'unit': term.unit,
+                                 'equation': term.equation, 'meaning': term.meaning}
+        if term.name in at:
+            lo, hi = (float(v) for v in fit.ci95[at[term.name]])
+            entry.update(coefficient=_sig(fit.values[at[term.name]]),
+                         ci95=[_sig(lo), _sig(hi)], nonzero=bool(lo > 0.0 or hi < 0.0))
+            if term.name != 'line_compliance' and abs(samples.correlation) > LAG_CORRELATION:
+                entry['note'] = (f"the two lags' regressors correlate (r = "
+                                 f'{samples.correlation:.4f}): the data determine tau_n - '
+                                 'tau_Q far better than either')
+        else:
+            entry['left_out'] = reasons.get(term.name, 'not fitted')
+        out.append(entry)
+    return out
+
+
+def _sig(x: float) -> float:
+    return float(f'{float(x):.5g}')
+
+
+def variance_inflation(residual: FloatArray) -> float:
+    """
+    Estimate how much the correlation of neighbouring residuals inflates a variance.
+
+    Batch means: the residuals in time order are cut into blocks of b and the
+    inflation is b var(block means) / var(residuals), the factor by which the
+    variance of a mean (and of a least-squares coefficient on a slowly varying
+    regressor) exceeds the independent case; N / inflation is the effective
+    number of samples. Blocks shorter than the residuals' memory underestimate
+    it, so b doubles from ceil(sqrt(N)) while at least :data:`MIN_BLOCKS` blocks
+    remain, and the largest estimate counts.
+
+    Parameters
+    ----------
+    residual : ndarray
+        Residuals in time order, [any]
+
+    Returns
+    -------
+    float
+        The inflation, >= 1, [-]
+
+    """
+    r = residual[np.isfinite(residual)]
+    if r.size < 2 * MIN_BLOCKS:
+        return 1.0
+    r = r - r.mean()
+    variance = float(np.mean(r ** 2))
+    if variance == 0.0:
+        return 1.0
+    inflation = 1.0
+    b = int(np.ceil(np.sqrt(r.size)))
+    while r.size // b >= MIN_BLOCKS:
+        blocks = r.size // b
+        means = r[:blocks * b].reshape(blocks, b).mean(axis=1)
+        inflation = max(inflation, b * float(np.mean(means ** 2)) / variance)
+        b *= 2
+    return inflation
+
+
+def transient_section(summary: dict[str, Any], inflation: float) -> list[str]:
+    """
+    Write the report's lines on the transient terms.
+
+    Parameters
+    ----------
+    summary : dict
+        calibration.json's object, with ``dynamics``, [-]
+    inflation : float
+        Variance inflation of the final fit's residuals, [-]
+
+    Returns
+    -------
+    list of str
+        Markdown lines.
+
+    """
+    lines = ['## Transient terms', '',
+             f'Fitted with the model on every sample, each as a nuisance regressor without '
+             f'prior (`satmotor_ros.identify.transient`); intervals and F-tests allow for the '
+             f'correlation of neighbouring residuals (variance inflation {inflation:.3g}).', '']
+    rows = []
+    for d in summary['dynamics']:
+        if 'coefficient' in d:
+            lo, hi = d['ci95']
+            value = f'{d["coefficient"]:.4g}'
+            interval = f'[{lo:.4g}, {hi:.4g}]' + ('' if d['nonzero'] else ' (includes 0)')
+        else:
+            value, interval = 'left out', d['left_out']
+        rows.append([f'`{d["term"]}` ({d["equation"]})', f'{d["symbol"]} [{d["unit"]}]',
+                     value, interval, d['meaning']])
+    lines += ['| term | coefficient | value | ci95 | meaning |', '| --- | --- | --- | --- | --- |']
+    lines += ['| ' + ' | '.join(row) + ' |' for row in rows]
+    notes = {d['note'] for d in summary['dynamics'] if 'note' in d}
+    return lines + [''] + [f'{note}.' for note in sorted(notes)] + ([''] if notes else [])

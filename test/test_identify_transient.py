@@ -1,0 +1,217 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Calibration from every sample of a transient recording: the model plus lines and sensor lags."""
+
+from dataclasses import replace
+import json
+
+import numpy as np
+import pytest
+
+from satmotor_ros.cli import main
+from satmotor_ros.identify import calibrate, IdentificationError, Options
+from satmotor_ros.identify.candidates import build_library
+from satmotor_ros.identify.fit import LossFit
+from satmotor_ros.identify.selection import CrossValidatedSelector
+from satmotor_ros.identify.synthetic import (Dynamics, first_order, generate_series,
+                                             generate_transient, Injection, Plan,
+                                             REALISTIC_DYNAMICS, write_bag_of)
+from satmotor_ros.identify.transient import (bin_means, bins, segments, transient_samples,
+                                             variance_inflation)
+from satmotor_ros.model import MotorModel
+from satmotor_ros.model.units import LPM
+from satmotor_ros.model.viscosity import standard_law
+
+
+def _recording(liquid, effect='none', dynamics=REALISTIC_DYNAMICS, seed=0, **kw):
+    return generate_transient(Plan(liquid=liquid), Injection.realistic(effect, 1.0, liquid),
+                              dynamics, seed=seed, **kw)
+
+
+def _dynamics(cal):
+    return {d['term']: d for d in cal.summary()['dynamics']}
+
+
+def _covers(d, truth):
+    """
+    Tell whether the interval holds the truth, give or take 2 % of it or 1 ms of a lag.
+
+    A bin's change carries its end values' noise, which shrinks the lags by up to about a
+    millisecond here (errors in variables), and the generator's 2 ms steps add a little.
+    """
+    lo, hi = d['ci95']
+    slack = max(0.02 * abs(truth), 1e-3 if d['unit'] == 's' else 1e-14)
+    return lo - slack < truth < hi + slack
+
+
+def test_bin_means_are_trapezoid_means_and_a_derivative_mean_is_the_change():
+    rng = np.random.default_rng(1)
+    time = np.cumsum(rng.uniform(0.005, 0.015, 200))  # uneven steps
+    x = np.sin(3 * time) + rng.normal(0, 0.1, time.size)
+    first, _ = segments(time, 3.0)
+    a, b = bins(np.ones(time.size, dtype=bool), first, 7)
+    assert np.all(b > a) and np.all(a[1:] == b[:-1])  # neighbours share one sample
+    for lo, hi, m in zip(a, b, bin_means(time, x, a, b)):
+        assert m == pytest.approx(np.trapezoid(x[lo:hi + 1], time[lo:hi + 1])
+                                  / (time[hi] - time[lo]))
+    # d/dt of the piecewise-linear x, averaged over a bin, is the change across it
+    rate = np.repeat(np.diff(x) / np.diff(time), 2)
+    t2 = np.repeat(time, 2)[1:-1]
+    for lo, hi in zip(a, b):
+        inside = (t2 >= time[lo]) & (t2 <= time[hi])
+        assert np.trapezoid(rate[inside], t2[inside]) == pytest.approx(x[hi] - x[lo])
+
+
+def test_bins_never_span_a_gap_or_an_unusable_sample():
+    time = np.concatenate((np.arange(100) * 0.01, 5.0 + np.arange(50) * 0.01))
+    usable = np.ones(time.size, dtype=bool)
+    usable[40] = False
+    first, step = segments(time, 3.0)
+    assert step == pytest.approx(0.01) and np.flatnonzero(first).tolist() == [0, 100]
+    a, b = bins(usable, first, 10)
+    for lo, hi in zip(a, b):
+        assert usable[lo:hi + 1].all()
+        assert not first[lo + 1:hi + 1].any()
+        assert 10 <= hi - lo < 20  # a run's remainder joins its last bin
+    x = np.where(usable, 1.0, np.nan)
+    assert np.all(np.isfinite(bin_means(time, x, a, b)))
+
+
+def test_first_order_lag_is_exact_for_a_ramp_and_starts_at_rest():
+    t = np.arange(0.0, 1.0, 1e-3)
+    assert np.allclose(first_order(t, 1e-3, 0.05), t - 0.05 * (1 - np.exp(-t / 0.05)),
+                       atol=1e-12)
+    assert np.allclose(first_order(np.full(5, 3.0), 0.01, 0.1), 3.0, rtol=1e-14)
+
+
+def test_variance_inflation_is_one_for_white_noise_and_large_for_correlated_noise():
+    rng = np.random.default_rng(0)
+    white = rng.normal(size=20000)
+    assert variance_inflation(white) < 1.6  # conservative: the largest of a few estimates
+    correlated = first_order(rng.normal(size=20000), 1.0, 20.0)  # AR(1), ~20-sample memory
+    assert variance_inflation(correlated) > 10.0
+
+
+@pytest.mark.parametrize('effect', ['external_leakage', 'viscosity_temperature',
+                                    'clearance_wear', 'flow_sensor_offset', 'term:dp^2*n',
+                                    'channel:aux'])
+def test_a_recording_with_too_few_steady_windows_is_calibrated_from_every_sample(effect):
+    liquid = 'oil' if effect in ('term:dp^2*n', 'flow_sensor_offset') else 'water'
+    table = _recording(liquid, effect, seed=1)
+    cal = calibrate(table, liquid)
+    assert cal.mode == 'transient' and 'steady windows' in cal.mode_reason
+    assert cal.samples is not None and cal.samples.n_samples == len(table)
+    runner = cal.selection.runner_up
+    named = [cal.summary()['effect'], runner.effect if runner else '']
+    assert any(n == effect or (effect.startswith('term:') and n.startswith('term:'))
+               for n in named)
+    assert cal.error_after.rmse_lpm < cal.error_before.rmse_lpm
+
+
+def test_dynamic_parameters_are_recovered_within_their_intervals():
+    truth = {'line_compliance': 5e-13, 'speed_lag': 0.02, 'flow_lag': 0.05}
+    cal = calibrate(_recording('water', seed=2), 'water')
+    found = _dynamics(cal)
+    for term, value in truth.items():
+        lo, hi = found[term]['ci95']
+        assert _covers(found[term], value), (term, found[term])
+        assert found[term]['nonzero']
+        assert hi - lo < 0.2 * value  # and the interval says something
+    assert 'tau_n - tau_Q' in found['speed_lag']['note']
+
+
+@pytest.mark.parametrize('term', ['line_compliance', 'speed_lag', 'flow_lag'])
+def test_one_dynamic_term_alone_is_found_and_the_others_are_not(term):
+    dynamics = replace(Dynamics(), **{term: getattr(REALISTIC_DYNAMICS, term)})
+    cal = calibrate(_recording('oil', dynamics=dynamics, seed=3), 'oil', options=Options(
+        mode='transient'))
+    for name, d in _dynamics(cal).items():
+        lo, hi = d['ci95']
+        if name == term:
+            assert _covers(d, getattr(dynamics, term)) and d['nonzero'], d
+        else:
+            assert _covers(d, 0.0), (name, d)
+
+
+@pytest.mark.parametrize('seed', [4, 5, 6])
+def test_clean_transient_recording_says_none(seed):
+    cal = calibrate(_recording('water', seed=seed), 'water')
+    assert cal.mode == 'transient'
+    assert cal.summary()['effect'] == 'none', cal.selection.verdict
+
+
+def test_correlated_residuals_do_not_make_a_random_channel_significant():
+    """A slow flowmeter drift and an unrelated slow channel: the naive F-test bites."""
+    liquid = 'water'
+    table = _recording(liquid, seed=7, duration_s=120.0)
+    rng = np.random.default_rng(7)
+    n = len(table)
+    drift = first_order(rng.normal(size=n), 0.01, 8.0) * 0.6 * LPM
+    channel = first_order(rng.normal(size=n), 0.01, 8.0)
+    table = replace(table, flow=table.flow + drift,
+                    channels={**table.channels, 'aux': channel})
+    model = MotorModel.default(liquid)
+    samples = transient_samples(model, table)
+    channels = {**samples.table.channels, 'p_out': samples.table.p_out}
+    candidates, _ = build_library(samples.parts, channels, standard_law(model.liquid, liquid))
+    aux = next(c for c in candidates if c.effect == 'channel:aux')
+    parts = samples.parts
+    index = np.arange(len(parts))
+    sigma = np.full(len(parts), np.std(parts.flow - LossFit().fit(parts).predict(parts)))
+    p = {}
+    for correlated in (False, True):
+        selector = CrossValidatedSelector(time_ordered=True, guard=1, correlated=correlated)
+        base = selector.score(parts, (), sigma, index)
+        p[correlated] = selector.score(parts, (aux,), sigma, index, baseline=base).p_value
+    assert p[False] < 1e-5  # ignoring the correlation, chance looks like an effect
+    assert p[True] > 0.05 / len(candidates)
+    assert calibrate(table, liquid).summary()['effect'] == 'none'
+
+
+def test_gaps_missing_rows_and_uneven_steps_are_handled():
+    table = _recording('oil', seed=8)
+    time = table.channels['time']
+    keep = ~((time > 30.0) & (time < 32.0))  # a 2 s gap
+    keep[::97] = False  # single missing rows
+    table = table.select(keep)
+    rng = np.random.default_rng(8)
+    jitter = table.channels['time'] + rng.uniform(-2e-3, 2e-3, len(table))
+    table = replace(table, channels={**table.channels, 'time': np.sort(jitter)})
+    cal = calibrate(table, 'oil')
+    assert cal.mode == 'transient' and cal.samples.segments == 2
+    assert '2 stretch(es)' in cal.table.notes[-1]
+    for term, d in _dynamics(cal).items():
+        assert _covers(d, getattr(REALISTIC_DYNAMICS, term)), (term, d)
+
+
+def test_one_speed_only_is_refused_saying_what_cannot_be_told_apart():
+    plan = Plan(liquid='oil', speed_rpm=(800.0, 800.0))
+    table = generate_transient(plan, Injection(), REALISTIC_DYNAMICS, seed=9, duration_s=60.0)
+    with pytest.raises(IdentificationError, match='one speed only.*C_id'):
+        calibrate(table, 'oil')
+
+
+def test_auto_keeps_steady_windows_when_there_are_enough():
+    table = generate_series(Plan(liquid='oil'), Injection(), seed=2, samples=30000)
+    cal = calibrate(table, 'oil')
+    assert cal.mode == 'series' and cal.samples is None
+    assert 'mode' not in cal.summary()  # DESIGN.md's fields only
+
+
+def test_transient_bag_through_satmotor_calibrate(tmp_path, capsys):
+    table = _recording('water', 'external_leakage', seed=10, duration_s=75.0)
+    write_bag_of(tmp_path / 'bag', table, 'mcap')
+    code = main(['calibrate', str(tmp_path / 'bag'), '--liquid', 'water', '--out',
+                 str(tmp_path / 'out')])
+    out = capsys.readouterr()
+    assert code == 0, out.err
+    assert 'mode transient' in out.out
+    result = json.loads((tmp_path / 'out' / 'calibration.json').read_text())
+    assert result['effect'] == 'external_leakage'
+    assert result['mode'] == 'transient' and result['n_samples'] == len(table)
+    assert 'steady windows' in result['mode_reason']
+    terms = {d['term']: d for d in result['dynamics']}
+    assert set(terms) == {'line_compliance', 'speed_lag', 'flow_lag'}
+    lo, hi = terms['line_compliance']['ci95']
+    assert terms['line_compliance']['unit'] == 'm^3/Pa' and lo < 5e-13 < hi
+    report = (tmp_path / 'out' / 'report.md').read_text()
+    assert '## Transient terms' in report and 'Mode `transient`' in report
