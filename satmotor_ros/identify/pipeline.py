@@ -327,6 +327,13 @@ def _steady_rows(model: MotorModel, table: BenchTable, points: BenchTable, mode:
 def _transient_rows(model: MotorModel, table: BenchTable, options: Options,
                     reason: str) -> _Rows:
     samples = transient_samples(model, table, options.transient)
+    if len(samples.parts) < MIN_POINTS:
+        msg = (f'too few rows: {samples.n_samples} of {len(table)} samples are usable, '
+               f'{len(samples.parts)} rows of {samples.bin_size} sample steps, need >= '
+               f'{MIN_POINTS}; the model covers forward motor operation (flow > 0, speed >= 0, '
+               'chamber drop between 0 and its limit), and a row needs neighbouring samples '
+               'without a gap')
+        raise IdentificationError(msg)
     check_identifiable(samples.parts)
     return _Rows(samples.table, samples.parts, None, 'transient', reason, samples)
 
