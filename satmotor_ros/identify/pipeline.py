@@ -455,9 +455,12 @@ def _family_and_rows(spec: MotorSpec, liquid: str, table: BenchTable,
     try:
         read = _rows(model, table, options)
         compared = read.table  # in transient mode the bins' means: the steady maps compared
-    except IdentificationError:  # the motor's own family cannot use the data; another may
+    except IdentificationError as err:  # the motor's own family cannot use the data; another may
         steady: Mode = options.mode if options.mode != 'transient' else 'auto'
-        compared = steady_points(table, steady, options.steady)
+        try:
+            compared = steady_points(table, steady, options.steady)
+        except DataError:
+            raise err from None
     samples = read.samples if read is not None else None
     specs = family_specs(spec, spec.source == load_motor().source)
     choice = compare_families(compared, liquid, specs,
