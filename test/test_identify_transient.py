@@ -14,7 +14,8 @@ from satmotor_ros.identify.fit import LossFit
 from satmotor_ros.identify.selection import CrossValidatedSelector
 from satmotor_ros.identify.synthetic import (Dynamics, first_order, generate_series,
                                              generate_transient, Injection, Plan,
-                                             REALISTIC_DYNAMICS, write_bag_of)
+                                             REALISTIC_DYNAMICS, to_columns, write_bag_of)
+from satmotor_ros.identify.table import write_csv
 from satmotor_ros.identify.transient import (bin_means, bins, segments, transient_samples,
                                              variance_inflation)
 from satmotor_ros.model import MotorModel
@@ -215,3 +216,19 @@ def test_transient_bag_through_satmotor_calibrate(tmp_path, capsys):
     assert terms['line_compliance']['unit'] == 'm^3/Pa' and lo < 5e-13 < hi
     report = (tmp_path / 'out' / 'report.md').read_text()
     assert '## Transient terms' in report and 'Mode `transient`' in report
+
+
+def test_validate_reads_a_transient_recording_as_calibrate_does(tmp_path, capsys):
+    table = _recording('water', 'external_leakage', seed=11, duration_s=60.0)
+    data = tmp_path / 'run.csv'
+    write_csv(data, to_columns(table))
+    assert main(['calibrate', str(data), '--liquid', 'water', '--out', str(tmp_path / 'c')]) == 0
+    assert main(['validate', str(data), '--liquid', 'water', '--motor',
+                 str(tmp_path / 'c' / 'coefficients.yaml'), '--out', str(tmp_path / 'v')]) == 0
+    capsys.readouterr()
+    cal = json.loads((tmp_path / 'c' / 'calibration.json').read_text())
+    val = json.loads((tmp_path / 'v' / 'validation.json').read_text())
+    assert cal['mode'] == 'transient'
+    assert val['n_points'] + val['n_flagged'] >= cal['n_points'] - len(cal['outliers'])
+    # the model as calibrated, the bench's transient terms refitted: the in-sample error
+    assert val['error']['rmse_lpm'] < 1.2 * cal['error_after']['rmse_lpm']

@@ -9,7 +9,7 @@ from pathlib import Path
 from satmotor_ros.cli._bench import add_data_arguments, load_data, run_bench_command
 from satmotor_ros.cli._common import add_motor_options
 from satmotor_ros.cli._output import check_target, output_dir, written_by
-from satmotor_ros.identify.pipeline import Mode
+from satmotor_ros.identify.pipeline import Mode, MODES
 from satmotor_ros.identify.validate import validate
 from satmotor_ros.identify.validation_report import write_validation
 from satmotor_ros.interface import MotorOptions
@@ -23,7 +23,7 @@ DESCRIPTION = ('Hold a model (the packaged one, a motor file or a calibrated coe
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Add the options of ``satmotor validate``."""
-    add_data_arguments(parser)
+    add_data_arguments(parser, MODES)
     add_motor_options(parser, liquid_required=True)
 
 

@@ -300,19 +300,19 @@ def steady_points(table: BenchTable, mode: Mode = 'auto',
 
 
 @dataclass(frozen=True)
-class _Rows:
+class Rows:
     """The rows a calibration fits, and how they were read."""
 
-    table: BenchTable
-    parts: LossParts
-    source_rows: np.ndarray | None
-    mode: Mode
-    reason: str
-    samples: Samples | None = None
+    table: BenchTable  # steady points, or a time series' bins
+    parts: LossParts  # the model's components at them
+    source_rows: np.ndarray | None  # row of the data each came from (None: a time series)
+    mode: Mode  # 'points', 'series' or 'transient'
+    reason: str  # why that mode, one sentence
+    samples: Samples | None = None  # the time series' samples in 'transient' mode
 
 
 def _steady_rows(model: MotorModel, table: BenchTable, points: BenchTable, mode: Mode,
-                 reason: str) -> _Rows:
+                 reason: str, check: bool) -> Rows:
     rows = _source_rows(table, points)
     parts, usable = loss_parts(model, points)
     if not usable.all():
@@ -320,12 +320,13 @@ def _steady_rows(model: MotorModel, table: BenchTable, points: BenchTable, mode:
                                        'model (no flow the model can give, or a chamber '
                                        'drop out of range)')
         rows = None if rows is None else rows[usable]
-    check_identifiable(parts)
-    return _Rows(points, parts, rows, mode, reason)
+    if check:
+        check_identifiable(parts)
+    return Rows(points, parts, rows, mode, reason)
 
 
 def _transient_rows(model: MotorModel, table: BenchTable, options: Options,
-                    reason: str) -> _Rows:
+                    reason: str, check: bool) -> Rows:
     samples = transient_samples(model, table, options.transient)
     if len(samples.parts) < MIN_POINTS:
         msg = (f'too few rows: {samples.n_samples} of {len(table)} samples are usable, '
@@ -334,27 +335,51 @@ def _transient_rows(model: MotorModel, table: BenchTable, options: Options,
                'chamber drop between 0 and its limit), and a row needs neighbouring samples '
                'without a gap')
         raise IdentificationError(msg)
-    check_identifiable(samples.parts)
-    return _Rows(samples.table, samples.parts, None, 'transient', reason, samples)
+    if check:
+        check_identifiable(samples.parts)
+    return Rows(samples.table, samples.parts, None, 'transient', reason, samples)
 
 
-def _rows(model: MotorModel, table: BenchTable, options: Options) -> _Rows:
-    """Read the rows as the mode says; in 'auto', every sample when steady windows are few."""
+def read_rows(model: MotorModel, table: BenchTable, options: Options,
+              check: bool = True) -> Rows:
+    """
+    Read the rows as the mode says; in ``'auto'``, every sample when steady windows are few.
+
+    Parameters
+    ----------
+    model : MotorModel
+        The model evaluated at the rows, [-]
+    table : BenchTable
+        The data as read, [-]
+    options : Options
+        Its ``mode``, ``steady`` and ``transient`` settings, [-]
+    check : bool
+        Refuse rows that cannot determine the fitted coefficients
+        (:func:`~satmotor_ros.identify.fit.check_identifiable`); False to evaluate
+        a model without fitting it, [-]
+
+    Returns
+    -------
+    Rows
+        The rows, the model's components there, and the mode and why.
+
+    """
     mode = options.mode
     if mode not in MODES:
         msg = f'mode = {mode!r}: use one of {", ".join(MODES)}'
         raise DataError(msg)
     if mode == 'transient':
-        return _transient_rows(model, table, options, 'asked for (--mode transient)')
+        return _transient_rows(model, table, options, 'asked for (--mode transient)', check)
     if mode != 'auto' or not is_series(table):
         why = {'points': 'asked for (--mode points)', 'series': 'asked for (--mode series)',
                'auto': 'the rows are not a time series: each is a steady point'}[mode]
         points = steady_points(table, mode, options.steady)
         return _steady_rows(model, table, points, 'series' if mode == 'series' else 'points',
-                            why)
+                            why, check)
     least = max(options.transient.min_steady, MIN_POINTS)
     try:
-        rows = _steady_rows(model, table, extract_steady(table, options.steady), 'series', '')
+        rows = _steady_rows(model, table, extract_steady(table, options.steady), 'series', '',
+                            check)
     except (DataError, IdentificationError) as err:
         why = f'no usable steady windows ({err})'
     else:
@@ -364,7 +389,7 @@ def _rows(model: MotorModel, table: BenchTable, options: Options) -> _Rows:
         why = f'only {len(rows.parts)} steady windows (< {least})'
     return _transient_rows(model, table, options,
                            f'a time series of {len(table)} samples with {why}: every sample '
-                           'used, with the transient terms')
+                           'used, with the transient terms', check)
 
 
 def _without_effects(spec: MotorSpec, liquid: str,
@@ -446,14 +471,14 @@ def _selector(options: Options, points: BenchTable,
 
 
 def _family_and_rows(spec: MotorSpec, liquid: str, table: BenchTable,
-                     options: Options) -> tuple[MotorSpec, MotorModel, _Rows, FamilyChoice | None]:
+                     options: Options) -> tuple[MotorSpec, MotorModel, Rows, FamilyChoice | None]:
     """Read the rows with the motor's family, compare the families there, re-read if another."""
     model = MotorModel.from_spec(spec, liquid)
     if not options.compare_families:
-        return spec, model, _rows(model, table, options), None
-    read: _Rows | None = None
+        return spec, model, read_rows(model, table, options), None
+    read: Rows | None = None
     try:
-        read = _rows(model, table, options)
+        read = read_rows(model, table, options)
         compared = read.table  # in transient mode the bins' means: the steady maps compared
     except IdentificationError as err:  # the motor's own family cannot use the data; another may
         steady: Mode = options.mode if options.mode != 'transient' else 'auto'
@@ -470,7 +495,7 @@ def _family_and_rows(spec: MotorSpec, liquid: str, table: BenchTable,
     spec = specs[choice.chosen]
     model = MotorModel.from_spec(spec, liquid)
     again = options if read is None else replace(options, mode=read.mode)
-    return spec, model, _rows(model, table, again), choice
+    return spec, model, read_rows(model, table, again), choice
 
 
 def _source_rows(table: BenchTable, points: BenchTable) -> np.ndarray | None:
@@ -482,5 +507,5 @@ def _source_rows(table: BenchTable, points: BenchTable) -> np.ndarray | None:
     return np.arange(len(table))
 
 
-__all__ = ['Calibration', 'IdentificationError', 'MODES', 'Mode', 'Options', 'calibrate',
-           'steady_points']
+__all__ = ['Calibration', 'IdentificationError', 'MODES', 'Mode', 'Options', 'Rows',
+           'calibrate', 'read_rows', 'steady_points']

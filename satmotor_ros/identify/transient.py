@@ -121,6 +121,9 @@ class Samples:
     segments: int  # stretches without a gap [-]
     left_out: tuple[tuple[str, str], ...]  # dynamic terms not fitted: (name, why)
     correlation: float  # of the speed_lag and flow_lag regressors (NaN if one is out) [-]
+    samples: BenchTable  # the raw samples in time order (with revolutions)
+    usable: np.ndarray  # which of them the model can use [-]
+    bounds: tuple[np.ndarray, np.ndarray]  # first and last sample of each row [-]
 
     guard = 1
     """Rows a test fold keeps out of training on each side: neighbours share a sample."""
@@ -442,7 +445,52 @@ def transient_samples(model: MotorModel, table: BenchTable,
     lags = [nuisance[name] for name in ('speed_lag', 'flow_lag') if name in nuisance]
     correlation = float(np.corrcoef(lags[0], lags[1])[0, 1]) if len(lags) == 2 else np.nan
     return Samples(rows, parts, n_samples, size, step, n_segments, tuple(left_out),
-                   correlation)
+                   correlation, table, usable, (a, b))
+
+
+def averaged(samples: Samples, x: FloatArray) -> FloatArray:
+    """
+    Average a quantity given at every raw sample over the rows' bins, as the rows were.
+
+    Parameters
+    ----------
+    samples : Samples
+        The rows, [-]
+    x : ndarray
+        The quantity at each of ``samples.samples`` (NaN where unknown), [any]
+
+    Returns
+    -------
+    ndarray
+        Its trapezoid mean over each row's bin, [unit of x]
+
+    """
+    return bin_means(samples.samples.channels['time'], x, *samples.bounds)
+
+
+def parts_at(parts: LossParts, keep: np.ndarray) -> LossParts:
+    """
+    Return the components at the rows where `keep` is true.
+
+    Parameters
+    ----------
+    parts : LossParts
+        Components at every row, [-]
+    keep : ndarray of bool
+        Rows to keep, [-]
+
+    Returns
+    -------
+    LossParts
+        The same fields, nuisance columns and components at the kept rows.
+
+    """
+    kept: dict[str, Any] = {f.name: getattr(parts, f.name)[keep] for f in fields(parts)
+                            if isinstance(getattr(parts, f.name), np.ndarray)}
+    kept['components'] = tuple(replace(c, pieces=tuple((k, x[keep]) for k, x in c.pieces))
+                               for c in parts.components)
+    kept['nuisance'] = {k: x[keep] for k, x in parts.nuisance.items()}
+    return replace(parts, **kept)
 
 
 def dynamics_summary(fit: FitReport, samples: Samples) -> list[dict[str, Any]]:

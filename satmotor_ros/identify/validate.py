@@ -22,10 +22,11 @@ import numpy as np
 from satmotor_ros.identify.effects import CalibratedModel
 from satmotor_ros.identify.errors import DataError, IdentificationError
 from satmotor_ros.identify.parts import loss_parts, LossParts
-from satmotor_ros.identify.pipeline import Mode, steady_points
+from satmotor_ros.identify.pipeline import Mode, Options, read_rows
 from satmotor_ros.identify.selection import Errors
 from satmotor_ros.identify.steady import SteadyTolerance
 from satmotor_ros.identify.table import BenchTable
+from satmotor_ros.identify.transient import averaged, parts_at, Samples
 from satmotor_ros.model import MotorModel
 from satmotor_ros.model._typing import FloatArray
 
@@ -41,6 +42,7 @@ class Validation:
     residual: FloatArray  # measured minus predicted Q_vl [m^3/s]
     error: Errors  # the residual summarised as calibration.json does
     effects: tuple[dict[str, Any], ...]  # the model's effects as loaded
+    flagged: int = 0  # points (rows) left out because the model flags them invalid [-]
 
     def describe_effects(self) -> str:
         """Return the effects' names, comma-separated, or ``'none'``."""
@@ -53,12 +55,14 @@ class Validation:
         Returns
         -------
         dict
-            n_points and error first, then the liquid, motor, effects and source.
+            n_points and error first, then the liquid, motor, effects, source and
+            n_flagged (points or rows left out where the model flags itself invalid).
 
         """
         return {'n_points': len(self.parts), 'error': self.error.as_dict(),
                 'liquid': self.liquid, 'motor': self.model.name,
-                'effects': list(self.effects), 'data': self.table.source}
+                'effects': list(self.effects), 'data': self.table.source,
+                'n_flagged': self.flagged}
 
 
 def _bare(model: MotorModel) -> MotorModel:
@@ -82,8 +86,9 @@ def validate(table: BenchTable, model: MotorModel, liquid: str, mode: Mode = 'au
         all), [-]
     liquid : str
         Its coefficient set, for the report, [-]
-    mode : {'auto', 'points', 'series'}
-        How to read the rows, as for a calibration, [-]
+    mode : {'auto', 'points', 'series', 'transient'}
+        How to read the rows, as for a calibration (in ``'transient'`` mode the bench's
+        transient terms are fitted to the residual: the model file does not hold them), [-]
     tol : SteadyTolerance, optional
         Steady-state tolerances, [-]
 
@@ -100,7 +105,11 @@ def validate(table: BenchTable, model: MotorModel, liquid: str, mode: Mode = 'au
         If the model's effects need a channel the data lack (the message names it).
 
     """
-    points = steady_points(table, mode, tol)
+    read = read_rows(_bare(model), table, Options(mode=mode, steady=tol or SteadyTolerance()),
+                     check=False)
+    if read.samples is not None:
+        return _validate_samples(read.samples, model, liquid)
+    points = read.table
     parts, usable = loss_parts(_bare(model), points)
     if not usable.all():
         points = points.select(usable, f'left out {int((~usable).sum())} points outside the '
@@ -128,7 +137,50 @@ def validate(table: BenchTable, model: MotorModel, liquid: str, mode: Mode = 'au
         predicted = predicted[keep]
     residual = parts.flow - predicted
     return Validation(liquid, model, points, parts, residual, Errors.of(residual, parts.loss),
-                      tuple(calibrated.describe()))
+                      tuple(calibrated.describe()), int(flagged.sum()))
+
+
+def _validate_samples(samples: Samples, model: MotorModel, liquid: str) -> Validation:
+    """
+    Hold the model against a time series' rows, as a calibration in transient mode reads them.
+
+    The model is evaluated at every usable sample and averaged over the rows' bins; the
+    bench's transient terms (line compliance, sensor lags) are fitted to what is left by
+    linear least squares, since the model file does not hold them; nothing of the model
+    is refitted.
+    """
+    raw = samples.samples
+    keep = raw.select(samples.usable)
+    channels = {**keep.channels, 'p_out': keep.p_out}
+    missing = [name for name in model.channels if name not in channels]
+    if missing:
+        msg = (f'{raw.source}: no {", ".join(missing)} column, which the effects of '
+               f'{model.name} need')
+        raise DataError(msg)
+    at_samples, _ = loss_parts(_bare(model), keep)
+    calibrated = CalibratedModel(model)
+    predicted = np.full(len(raw), np.nan)
+    predicted[samples.usable] = calibrated.measured_flow(at_samples.speed, channels,
+                                                         dp_i=at_samples.dp_i)
+    residual = samples.parts.flow - averaged(samples, predicted)
+    good = np.isfinite(residual)
+    if not good.any():
+        msg = f'{raw.source}: the model flags every sample invalid'
+        raise IdentificationError(msg)
+    points, parts = samples.table, samples.parts
+    if not good.all():
+        points = points.select(good, f'left out {int((~good).sum())} rows where the model '
+                                     'flags a sample invalid')
+        parts = parts_at(parts, good)
+    residual = residual[good]
+    if parts.nuisance:
+        x = np.column_stack(list(parts.nuisance.values()))
+        residual = residual - x @ np.linalg.lstsq(x, residual, rcond=None)[0]
+        points = replace(points, notes=points.notes + (
+            'the transient terms (' + ', '.join(parts.nuisance) + ') fitted to the residual: '
+            'they describe the bench, not the model',))
+    return Validation(liquid, model, points, parts, residual, Errors.of(residual, parts.loss),
+                      tuple(calibrated.describe()), int((~good).sum()))
 
 
 __all__ = ['Validation', 'validate']
