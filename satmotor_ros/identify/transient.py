@@ -158,34 +158,38 @@ def dynamic_regressors(dp_in_dt: FloatArray, dn_dt: FloatArray, dq_dt: FloatArra
     return {'line_compliance': dp_in_dt, 'speed_lag': dq_dn * dn_dt, 'flow_lag': -dq_dt}
 
 
-def flow_per_speed(parts: LossParts) -> FloatArray:
+def flow_per_speed(parts: LossParts, qt: float) -> FloatArray:
     r"""
     Differentiate the steady model's flow by speed at the packaged coefficients.
 
-    .. math:: \frac{\partial Q}{\partial n} = \frac{q_t n + \sum_j e_j Q_j}{n}
+    .. math:: \frac{\partial Q}{\partial n} = q_t + \frac{\sum_j e_j Q_j}{n}
 
     from eq. (36): each component Q_j grows as n^e_j at a fixed chamber drop
     (for eqs. 31-33: the pressure-speed losses of eqs. 11-13 with n, the inertia
     loss of eq. 14 with n^0.5, the leakage of eqs. 1, 5 not at all).
 
+    In a row's frame (:class:`~satmotor_ros.identify.parts.LossParts`: flow and speed
+    times the sign of dp) the components grow with |n|, so the same ratio holds for a
+    shaft that turns against the flow.
+
     Parameters
     ----------
     parts : LossParts
         Components at the rows, [-]
+    qt : float
+        Theoretical displacement q_t, [m^3/rad]
 
     Returns
     -------
     ndarray
-        dQ/dn; q_t where the speed is 0, [m^3/rad]
+        dQ/dn in each row's frame; q_t where the speed is 0, [m^3/rad]
 
     """
-    speed_part = parts.displacement + sum(
-        (c.speed_power * c.flow(NO_EFFECT) for c in parts.components),
-        np.zeros_like(parts.displacement))
-    qt = parts.displacement / np.where(parts.speed > 0.0, parts.speed, np.inf)
-    qt_value = float(np.nanmax(qt)) if np.any(parts.speed > 0.0) else 0.0
-    return np.where(parts.speed > 0.0, speed_part / np.where(parts.speed > 0.0, parts.speed,
-                                                             1.0), qt_value)
+    speed_part = sum((c.speed_power * c.flow(NO_EFFECT) for c in parts.components),
+                     np.zeros_like(parts.displacement))
+    n = parts.displacement / qt if qt > 0.0 else np.zeros_like(parts.displacement)
+    moving = np.abs(n) > 0.0
+    return qt + np.where(moving, speed_part / np.where(moving, n, 1.0), 0.0)
 
 
 def segments(time: FloatArray, gap: float) -> tuple[np.ndarray, float]:
@@ -402,17 +406,20 @@ def transient_samples(model: MotorModel, table: BenchTable,
     all_parts, usable = loss_parts(model, table)
     size = max(1, int(round(options.bin_seconds / step)) if step > 0.0 else 1)
     size = max(size, int(np.ceil(int(usable.sum()) / options.max_rows)))
-    a, b = bins(usable, first, size)
-    if not a.size:
-        msg = (f'{table.source}: no two neighbouring usable samples (need flow > 0, speed >= 0 '
-               f'and a chamber drop between 0 and {model.dp_limit / 1e6:.1f} MPa)')
-        raise IdentificationError(msg)
     where = np.flatnonzero(usable)  # parts are at the usable samples only
 
-    def at_samples(x: FloatArray) -> FloatArray:
+    def at_samples(x: FloatArray | float) -> FloatArray:
         full = np.full(time.size, np.nan)
         full[where] = x
         return full
+
+    # a bin stays in one frame of the loss (the sign of dp: quadrants, LossParts.sign)
+    frame = at_samples(all_parts.sign)
+    a, b = bins(usable, first | np.concatenate(([True], frame[1:] != frame[:-1])), size)
+    if not a.size:
+        msg = (f'{table.source}: no two neighbouring usable samples (need a flow the model can '
+               f'give and a chamber drop between 0 and {model.dp_limit / 1e6:.1f} MPa)')
+        raise IdentificationError(msg)
 
     def mean(x: FloatArray) -> FloatArray:
         return bin_means(time, x, a, b)
@@ -425,8 +432,10 @@ def transient_samples(model: MotorModel, table: BenchTable,
         for c in all_parts.components)
     parts = replace(all_parts, **averaged)
     ends = [smooth(x, first, END_SAMPLES) for x in (table.p_in, table.speed, table.flow)]
-    rates = [(x[b] - x[a]) / (time[b] - time[a]) for x in ends]
-    regressors = dynamic_regressors(rates[0], rates[1], rates[2], flow_per_speed(parts))
+    sign = frame[a]  # the row's frame: its flow, loss and regressors are s times the readings'
+    rates = [sign * (x[b] - x[a]) / (time[b] - time[a]) for x in ends]
+    regressors = dynamic_regressors(rates[0], rates[1], rates[2],
+                                    flow_per_speed(parts, model.geometry.displacement))
     nuisance, left_out = _screen(regressors, parts)
     parts = parts.with_nuisance(nuisance)
     rows = BenchTable(mean(table.speed), mean(table.flow), mean(table.p_in), mean(table.p_out),
