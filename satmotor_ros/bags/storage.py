@@ -17,7 +17,7 @@ split into several files, with zstd FILE or MESSAGE compression, or without meta
 from __future__ import annotations
 
 from collections.abc import Iterator
-from contextlib import contextmanager
+from contextlib import closing, contextmanager
 from dataclasses import dataclass, field
 import gc
 from pathlib import Path
@@ -76,9 +76,16 @@ class RawTopic(NamedTuple):
         return self.buf[start:start + int(self.lengths[i])].tobytes()
 
 
-def _packed(t_ns: list[int], payloads: list[bytes]) -> RawTopic:
+def _packed(name: str, t_ns: list[int], payloads: list[bytes]) -> RawTopic:
     """Pack one topic's messages into a RawTopic, in log-time order."""
-    raw = RawTopic(np.array(t_ns, dtype=np.int64), *pack_payloads(payloads))
+    try:
+        times = np.array(t_ns, dtype=np.int64)
+    except OverflowError:  # an MCAP log time >= 2**63: rosbag2's times are int64
+        times = np.array([-1])
+    if len(times) and times.min() < 0:
+        raise BagError(f'{name}: a log time is outside [0, 2**63) ns (1970 to 2262), as no '
+                       'rosbag2 recorder writes it')
+    raw = RawTopic(times, *pack_payloads(payloads))
     if len(t_ns) > 1 and np.any(np.diff(raw.t_ns) < 0):
         order = np.argsort(raw.t_ns, kind='stable')
         return raw._replace(t_ns=raw.t_ns[order], offsets=raw.offsets[order],
@@ -174,7 +181,7 @@ class Bag:
                     t_ns.extend(topic.t_ns)
                     payloads.extend(topic.payloads)
         self._check_metadata(infos)
-        return infos, {name: _packed(t_ns, _decompressed(payloads, name, budget))
+        return infos, {name: _packed(name, t_ns, _decompressed(payloads, name, budget))
                        for name, (t_ns, payloads) in messages.items()}
 
     def _uncompressed(self, path: Path, budget: _Budget) -> Path:
@@ -248,6 +255,8 @@ def _read_file(path: Path, wanted: set[str], name: str) -> list[FileTopic]:
     from rosbags.rosbag2 import ReaderError
 
     try:
+        if path.suffix == '.db3':
+            _check_sqlite(path, name)
         channels = _read_with_rosbags(path, wanted)
         if channels is None:
             channels = _read_with_mcap(path, wanted)
@@ -274,6 +283,39 @@ def _read_file(path: Path, wanted: set[str], name: str) -> list[FileTopic]:
                                       seen.t_ns + channel.t_ns,
                                       seen.payloads + channel.payloads)
     return list(topics.values())
+
+
+def _check_sqlite(path: Path, name: str) -> None:
+    """
+    Refuse a ``.db3`` file whose rows rosbag2 cannot have written, before they are read.
+
+    rosbags reads any SQLite value: a text log time, a text or integer payload or a
+    message whose topic id names no topic would pass through it, to end in a numpy
+    error or be dropped without a word.
+
+    Raises
+    ------
+    BagError
+        Naming the first offending message id and how many there are.
+
+    """
+    checks = (
+        ("typeof(timestamp) != 'integer'", 'a log time that is not an integer'),
+        ("typeof(data) != 'blob'", 'a payload that is not a blob'),
+        ('topic_id NOT IN (SELECT id FROM topics)', 'a topic id with no topic'),
+    )
+    with closing(sqlite3.connect(f'{path.resolve().as_uri()}?mode=ro&immutable=1',
+                                 uri=True)) as db:
+        bad = db.execute("SELECT count(*) FROM topics WHERE typeof(name) != 'text' "
+                         "OR typeof(type) != 'text'").fetchone()[0]
+        if bad:
+            raise BagError(f'{name}: {bad} topics have a name or type that is not text')
+        for where, what in checks:
+            count, first = db.execute(
+                f'SELECT count(*), min(id) FROM messages WHERE {where}').fetchone()
+            if count:
+                raise BagError(f'{name}: {count} messages have {what} (the first: id '
+                               f'{first}); not written by rosbag2')
 
 
 def _read_with_rosbags(path: Path, wanted: set[str]) -> list[FileTopic] | None:
