@@ -11,7 +11,7 @@ import sys
 from satmotor_ros.cli._common import CliError, fail
 from satmotor_ros.identify import BenchTable, DataError, IdentificationError, read_csv
 from satmotor_ros.identify.columns import load_mapping, read_log
-from satmotor_ros.identify.table import IMPOSSIBLE
+from satmotor_ros.identify.table import BAD_CELLS, IMPOSSIBLE
 from satmotor_ros.model import ModelError
 
 
@@ -50,7 +50,8 @@ def load_data(data: str, columns: str = '') -> BenchTable:
     """
     Load a bench CSV, a log through a column mapping, or a rosbag2 directory.
 
-    Rows dropped for a physically impossible value are named on stderr too.
+    Rows dropped for a physically impossible value, absurd or missing cells are named on
+    stderr too.
 
     Parameters
     ----------
@@ -82,7 +83,7 @@ def load_data(data: str, columns: str = '') -> BenchTable:
         return read_bag(path)
     table = read_log(path, load_mapping(columns)) if columns else read_csv(path)
     for note in table.notes:
-        if note.startswith(IMPOSSIBLE):
+        if note.startswith((IMPOSSIBLE, BAD_CELLS)):
             print(f'warning: {data}: {note}', file=sys.stderr)
     return table
 

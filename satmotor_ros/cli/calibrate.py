@@ -5,13 +5,14 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+import sys
 
 from satmotor_ros.cli._bench import add_data_arguments, load_data, run_bench_command
 from satmotor_ros.cli._common import add_motor_options
 from satmotor_ros.cli._output import check_target, output_dir, written_by
 from satmotor_ros.identify import calibrate, Options
 from satmotor_ros.identify.output import write_json, write_yaml
-from satmotor_ros.identify.pipeline import Mode, MODES
+from satmotor_ros.identify.pipeline import IMPLAUSIBLE, Mode, MODES
 from satmotor_ros.identify.report import write_report
 from satmotor_ros.interface import MotorOptions
 
@@ -73,6 +74,9 @@ def _calibrate(data: str, out: str, mode: Mode, alpha: float, folds: int,
     table = load_data(data, columns)
     cal = calibrate(table, options.liquid, spec, Options(alpha=alpha, n_folds=folds, mode=mode,
                                                          compare_families=not options.family))
+    for note in cal.table.notes:
+        if note.startswith(IMPLAUSIBLE):
+            print(f'warning: {data}: {note}', file=sys.stderr)
     with output_dir('--out', out, 'calibrate', inputs, force) as tmp:
         summary = write_json(cal, tmp / 'calibration.json')
         write_yaml(cal, tmp / 'coefficients.yaml')

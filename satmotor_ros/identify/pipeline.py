@@ -76,6 +76,7 @@ class Calibration:
     mode_reason: str = ''  # why, one sentence
     samples: Samples | None = None  # the time series' samples in 'transient' mode
     inflation: float = 1.0  # variance inflation of the final fit's residuals [-]
+    n_folds: int = 5  # cross-validation folds asked for (at most one per point) [-]
 
     @property
     def selection(self) -> Selection:
@@ -443,6 +444,9 @@ def calibrate(table: BenchTable, liquid: str = 'oil', spec: MotorSpec | None = N
     spec, table = _without_effects(spec, liquid, table)
     spec, model, read, choice = _family_and_rows(spec, liquid, table, options)
     points, parts, rows, samples = read.table, read.parts, read.source_rows, read.samples
+    note = implausible(parts)
+    if note:
+        points = replace(points, notes=points.notes + (note,))
     law = standard_law(model.liquid, liquid)
     channels = {**points.channels, 'p_out': points.p_out}
     candidates, skipped = build_library(parts, channels, law)
@@ -460,7 +464,8 @@ def calibrate(table: BenchTable, liquid: str = 'oil', spec: MotorSpec | None = N
                        Errors.of(packaged_error[at], parts.loss[at]),
                        Errors.of(first.baseline.cv_error[at], parts.loss[at]),
                        Errors.of(forward.final.cv_error[at], parts.loss[at]), rows, choice,
-                       read.mode, read.reason, samples, inflation)
+                       read.mode, read.reason, samples, inflation,
+                       options.n_folds)
 
 
 def _selector(options: Options, points: BenchTable,
@@ -496,6 +501,39 @@ def _family_and_rows(spec: MotorSpec, liquid: str, table: BenchTable,
     model = MotorModel.from_spec(spec, liquid)
     again = options if read is None else replace(options, mode=read.mode)
     return spec, model, read_rows(model, table, again), choice
+
+
+IMPLAUSIBLE = 'implausible data'
+"""How the note on data no motor can produce begins (the report and stderr give it)."""
+
+
+def implausible(parts: LossParts) -> str | None:
+    """
+    Say whether the volumetric losses exceed the flow itself at more than a tenth of the points.
+
+    Q_vl = Q - q_t n is larger in magnitude than Q only where q_t n > 2 Q: a motor turning
+    twice as fast as its flow allows. That is a wrong unit (a speed in rpm labelled
+    [rad/s]), a wrong displacement or a wrong flow unit, not an effect to fit.
+
+    Parameters
+    ----------
+    parts : LossParts
+        The model's components at the points, [-]
+
+    Returns
+    -------
+    str or None
+        The note (beginning :data:`IMPLAUSIBLE`), or None when the data are plausible.
+
+    """
+    over = np.abs(parts.loss) > np.abs(parts.flow)
+    if over.sum() <= 0.1 * over.size:
+        return None
+    ratio = float(np.median(np.abs(parts.loss) / np.abs(parts.flow)))
+    return (f'{IMPLAUSIBLE}: the volumetric losses Q - q_t n are larger than the flow itself '
+            f'at {int(over.sum())} of {over.size} points (median |Q_vl|/Q = {ratio:.3g}); '
+            'check the units of speed and flow (a speed in rpm labelled [rad/s]?) and the '
+            'displacement')
 
 
 def _source_rows(table: BenchTable, points: BenchTable) -> np.ndarray | None:

@@ -212,8 +212,8 @@ def _steps(cal: Calibration) -> list[str]:
     header = ['model', 'RMSE [l/min]', 'mean abs [% of mean Q_vl]', 'max abs [l/min]']
     return lines + ['', _table(rows, header), '',
                     'Errors are of the volumetric losses Q_vl = Q - q_t n, out of sample '
-                    f'({min(5, len(cal.parts))}-fold cross-validation), at the points that '
-                    'are not outliers.']
+                    f'({min(cal.n_folds, len(cal.parts))}-fold cross-validation), at the points '
+                    'that are not outliers.']
 
 
 def _outliers(cal: Calibration, summary: dict[str, Any]) -> list[str]:

@@ -36,6 +36,20 @@ _FLOORS = {'pressure': (-ATMOSPHERE, 1.0e3, 'kPa', 'a gauge pressure below vacuu
            'temperature': (-273.15, 1.0, 'degC', 'a temperature below absolute zero')}
 """Kind -> (least possible SI value, display scale, display unit, what a lower value is)."""
 
+BAD_CELLS = 'bad cells'
+"""How the notes on absurd or missing cells begin (rows dropped or cells ignored)."""
+
+_CEILINGS = {'pressure': 1.0e10, 'temperature': 1.0e4, 'speed': 1.0e5, 'flow': 10.0,
+             'torque': 1.0e7}
+"""Kind -> magnitude in SI no bench reaches (10 GPa, 10^4 degC, about 10^6 rpm, 10 m^3/s,
+10^7 N m): a cell beyond it is a broken cell or a wrong unit, not a measurement."""
+
+_ABSURD_RATIO = 1.0e6
+"""A cell this many times larger in magnitude than 90 % of its column's cells is absurd."""
+
+_MOST_MISSING = 0.1
+"""Share of rows a channel may miss and still be tested on the others (its rows dropped)."""
+
 _NOT_CHANNEL_KINDS = ('velocity', 'area')
 """Kinds that only describe a derived flow's inputs (doc/columns.md): a channel in mm/s stays
 as given rather than being read as a velocity."""
@@ -257,6 +271,62 @@ def _impossible(si: Mapping[str, FloatArray], labels: Mapping[str, str],
     return bad, tuple(notes)
 
 
+def _absurd(values: FloatArray, kind: str | None) -> np.ndarray:
+    """Flag the finite cells beyond the kind's ceiling or far beyond the column's own scale."""
+    finite = np.isfinite(values)
+    magnitude = np.where(finite, np.abs(values), 0.0)
+    out = magnitude > _CEILINGS.get(kind or '', np.inf)
+    typical = float(np.percentile(magnitude[finite], 90)) if finite.any() else 0.0
+    if typical > 0.0:
+        out |= magnitude > _ABSURD_RATIO * typical
+    return out
+
+
+def _rows(mask: np.ndarray) -> str:
+    """Name the 1-based data rows of `mask`, the first five of them."""
+    rows = np.flatnonzero(mask) + 1
+    more = f' and {rows.size - 5} more' if rows.size > 5 else ''
+    return ', '.join(str(r) for r in rows[:5]) + more
+
+
+def _bad_cells(si: dict[str, FloatArray], labels: Mapping[str, str],
+               time_series: bool) -> tuple[np.ndarray, tuple[str, ...]]:
+    """
+    Find absurd cells in every column and the rows a channel misses, and say what is done.
+
+    An absurd cell (:func:`_absurd`) of a required column drops its row; one of another
+    channel is made missing (NaN) in `si`. In a table of operating points, a channel
+    missing in a few rows (at most :data:`_MOST_MISSING` of them) drops those rows, so
+    that its effects are tested on the others rather than not at all. Returns the rows to
+    drop and one note per column naming it and the rows.
+    """
+    n = len(si['speed'])
+    drop = np.zeros(n, dtype=bool)
+    notes = []
+    for name, values in si.items():
+        label = labels.get(name, name)
+        absurd = _absurd(values, _kind_of(name))
+        largest = f' (up to {float(np.abs(values[absurd]).max()):.3g} in SI)' \
+            if absurd.any() else ''
+        if name in REQUIRED:
+            drop |= absurd
+        else:
+            si[name] = values = np.where(absurd, np.nan, values)
+        missing = ~np.isfinite(values)
+        if (name not in REQUIRED and not time_series and missing.any()
+                and missing.sum() <= _MOST_MISSING * n):
+            drop |= missing
+            notes.append(f"{BAD_CELLS}: column '{label}': dropped {int(missing.sum())} rows "
+                         f'where it is missing{" or absurd" if largest else ""}{largest} '
+                         f'(data rows {_rows(missing)}), '
+                         'so that its effects are tested on the others')
+        elif absurd.any():
+            action = 'dropped the rows of' if name in REQUIRED else 'ignored'
+            notes.append(f"{BAD_CELLS}: column '{label}': {action} {int(absurd.sum())} absurd "
+                         f'values{largest} at data rows {_rows(absurd)}')
+    return drop, tuple(notes)
+
+
 def table_from_columns(columns: Mapping[str, tuple[str, np.ndarray]], source: str,
                        time_series: bool = False,
                        labels: Mapping[str, str] | None = None) -> BenchTable:
@@ -298,16 +368,19 @@ def table_from_columns(columns: Mapping[str, tuple[str, np.ndarray]], source: st
     si = {PORTS.get(name, name): column_to_si(name, unit, np.asarray(values, dtype=float))
           for name, (unit, values) in columns.items()}
     labels = {PORTS.get(name, name): labels.get(name, name) for name in columns}
-    good = np.ones(len(si['speed']), dtype=bool)
+    dropped, cells = _bad_cells(si, labels, time_series)
+    good = ~dropped
     for name in REQUIRED:
         good &= np.isfinite(si[name])
     if not good.any():
         msg = f'{source}: no row has finite values in all of {", ".join(REQUIRED)}'
         raise DataError(msg)
     notes: tuple[str, ...] = ()
-    if not good.all():
-        notes = (f'dropped {int((~good).sum())} rows with a missing or non-finite value in '
+    missing = ~good & ~dropped
+    if missing.any():
+        notes = (f'dropped {int(missing.sum())} rows with a missing or non-finite value in '
                  f'{", ".join(REQUIRED)}',)
+    notes += cells
     bad, flagged = _impossible(si, labels, source)
     good &= ~bad
     units = {PORTS.get(name, name): unit for name, (unit, _) in columns.items()}
