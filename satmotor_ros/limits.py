@@ -42,6 +42,12 @@ BAG_FLOOR_BYTES = 64 << 20
 RATE_MAX_PREDICTIONS = _cap('SATMOTOR_RATE_MAX_PREDICTIONS', 20_000_000)
 """Most predictions ``replay --mode rate`` makes (5.5 h at 1 kHz; about 5 GB of results), [-]."""
 
+CSV_MAX_COLUMNS = _cap('SATMOTOR_CSV_MAX_COLUMNS', 256)
+"""Most columns of a CSV or text log read; calibration's work grows with each, [-]."""
+
+PLOT_MAX_PANELS = _cap('SATMOTOR_PLOT_MAX_PANELS', 24)
+"""Most panels of a report's residual grid (24: 960 x 1920 pixels), [-]."""
+
 
 def bag_budget(stored_bytes: int) -> int:
     """
@@ -61,6 +67,6 @@ def bag_budget(stored_bytes: int) -> int:
     return min(BAG_MAX_BYTES, max(BAG_FLOOR_BYTES, BAG_MAX_RATIO * stored_bytes))
 
 
-__all__ = ['BAG_FLOOR_BYTES', 'BAG_MAX_BYTES', 'BAG_MAX_RATIO', 'RATE_MAX_PREDICTIONS',
-           'YAML_MAX_BYTES',
+__all__ = ['BAG_FLOOR_BYTES', 'BAG_MAX_BYTES', 'BAG_MAX_RATIO', 'CSV_MAX_COLUMNS',
+           'PLOT_MAX_PANELS', 'RATE_MAX_PREDICTIONS', 'YAML_MAX_BYTES',
            'YAML_MAX_DEPTH', 'YAML_MAX_DIGITS', 'YAML_MAX_NODES', 'bag_budget']

@@ -17,6 +17,7 @@ from satmotor_ros.identify.pipeline import Calibration
 from satmotor_ros.identify.selection import Errors
 from satmotor_ros.identify.table import BenchTable
 from satmotor_ros.identify.transient import transient_section
+from satmotor_ros.limits import PLOT_MAX_PANELS
 from satmotor_ros.model import MotorModel
 from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.units import LPM, MPA, RPM
@@ -67,6 +68,9 @@ def plot_residual_grid(axes_data: dict[str, FloatArray], residuals: dict[str, Fl
     """
     Plot residuals of Q_vl against each quantity, one panel per quantity, three a row.
 
+    Only the first :data:`~satmotor_ros.limits.PLOT_MAX_PANELS` quantities are plotted
+    (:func:`grid_note` says so in the report).
+
     Parameters
     ----------
     axes_data : dict
@@ -80,6 +84,7 @@ def plot_residual_grid(axes_data: dict[str, FloatArray], residuals: dict[str, Fl
 
     """
     plt = pyplot()
+    axes_data = dict(list(axes_data.items())[:PLOT_MAX_PANELS])
     cols = 3
     rows = int(np.ceil(len(axes_data) / cols))
     fig, axes = plt.subplots(rows, cols, figsize=(12, 3.0 * rows), squeeze=False)
@@ -98,6 +103,15 @@ def plot_residual_grid(axes_data: dict[str, FloatArray], residuals: dict[str, Fl
                         hspace=0.45, wspace=0.3)
     fig.savefig(path, dpi=80, format='png')
     plt.close(fig)
+
+
+def grid_note(axes_data: dict[str, FloatArray]) -> list[str]:
+    """Return the report's sentence on quantities left out of the residual grid, if any."""
+    if len(axes_data) <= PLOT_MAX_PANELS:
+        return []
+    return [f'The residual plot shows the first {PLOT_MAX_PANELS} of {len(axes_data)} '
+            'quantities (the cap SATMOTOR_PLOT_MAX_PANELS, doc/outputs.md); the others are '
+            'not plotted.', '']
 
 
 def _plot_residuals(cal: Calibration, path: Path) -> None:
@@ -333,7 +347,7 @@ def write_report(cal: Calibration, out: Path, summary: dict[str, object]) -> Pat
     if block:
         lines += ['', '## The effects in `coefficients.yaml`', '', '```json',
                   json.dumps(block, indent=2), '```']
-    lines += ['', '## Plots', '']
+    lines += ['', '## Plots', ''] + grid_note(channel_axes(cal.parts, cal.table))
     for name in PLOTS:
         lines += [f'![{name}]({name}.png)', '']
     lines += ['## calibration.json', '', '```json', json.dumps(summary, indent=2), '```', '']
@@ -342,4 +356,5 @@ def write_report(cal: Calibration, out: Path, summary: dict[str, object]) -> Pat
     return path
 
 
-__all__ = ['PLOTS', 'channel_axes', 'plot_residual_grid', 'pyplot', 'write_report']
+__all__ = ['PLOTS', 'channel_axes', 'grid_note', 'plot_residual_grid', 'pyplot',
+           'write_report']

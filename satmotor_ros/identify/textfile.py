@@ -17,6 +17,7 @@ import re
 import numpy as np
 
 from satmotor_ros.identify.errors import DataError
+from satmotor_ros.limits import CSV_MAX_COLUMNS
 
 SEPARATORS = {'comma': ',', 'semicolon': ';', 'tab': '\t', 'whitespace': None}
 """Separator names a mapping may give (``auto`` too); ``None`` is any run of blanks."""
@@ -191,6 +192,10 @@ def read_cells(path: str | Path, separator: str = 'auto', comment: str = '#',
     body = [line for _, line in content[first:]]
     lines = [number for number, _ in content[first:]]
     width = len(_split(body[0], sep))
+    if width > CSV_MAX_COLUMNS:
+        msg = (f'{str(file)!r}: {width} columns, more than the {CSV_MAX_COLUMNS} read (the cap '
+               'SATMOTOR_CSV_MAX_COLUMNS; doc/outputs.md)')
+        raise DataError(msg)
     cells: list[str] | None = None
     if first:
         cells = _header_cells(content[0][1], sep, width)

@@ -7,7 +7,7 @@ import json
 from pathlib import Path
 from typing import Any
 
-from satmotor_ros.identify.report import channel_axes, plot_residual_grid
+from satmotor_ros.identify.report import channel_axes, grid_note, plot_residual_grid
 from satmotor_ros.identify.validate import Validation
 
 FILES = ('validation.json', 'report.md', 'residuals.png')
@@ -38,7 +38,8 @@ def _report(val: Validation, summary: dict[str, Any]) -> str:
               'whole table is out of sample for the model. Compare the RMSE with the '
               "calibration's `error_after` (and the sensor noise): much larger, or a trend "
               'in the plots below, means the calibration no longer holds.', '',
-              '## Residual against each channel', '', '![residuals](residuals.png)', '',
+              '## Residual against each channel', '',
+              *grid_note(channel_axes(val.parts, val.table)), '![residuals](residuals.png)', '',
               '## validation.json', '', '```json', json.dumps(summary, indent=2), '```', '']
     return '\n'.join(lines)
 
