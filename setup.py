@@ -45,6 +45,7 @@ setup(
         'PyYAML',
         'matplotlib',  # plots of calibrate, replay, characteristics, demo
         'rosbags',  # bag reading and writing (sqlite3 and MCAP storage, metadata.yaml)
+        'apsw',  # rosbags reads .db3 files through it; bags/storage.py catches its errors
         'mcap',  # MCAP chunks with CRCs (writing), MCAP files rosbags cannot open (reading)
         # zstd FILE and MESSAGE compressed bags; the stdlib has compression.zstd from Python
         # 3.14 on, which backports.zstd backports

@@ -105,8 +105,9 @@ def parse_yaml(text: str) -> Any:
     """
     if len(text) > YAML_MAX_BYTES:
         raise YamlLimitError(f'larger than {YAML_MAX_BYTES} bytes')
-    loader = _BoundedLoader(text)
+    loader = None
     try:
+        loader = _BoundedLoader(text)  # its reader refuses control characters here
         return loader.get_single_data()
     except yaml.YAMLError as err:
         problem = getattr(err, 'problem', None) or str(err).splitlines()[0]
@@ -116,7 +117,8 @@ def parse_yaml(text: str) -> Any:
     except RecursionError:
         raise YamlLimitError(f'nesting deeper than {YAML_MAX_DEPTH} levels') from None
     finally:
-        loader.dispose()
+        if loader is not None:
+            loader.dispose()
 
 
 def read_yaml(path: str | Path) -> Any:

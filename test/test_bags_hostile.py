@@ -105,3 +105,30 @@ def test_mcap_with_3000_nested_chunks_is_one_line(tmp_path):
     path = _mcap(tmp_path / 'x.mcap', [5], nesting=3000)
     with pytest.raises(BagError, match=r'x.mcap: damaged or truncated \(.*[Nn]ested'):
         read_series(path, ['flow_command'])
+
+
+def test_metadata_with_a_control_character_is_one_line(tmp_path):
+    bag = _db3(tmp_path / 'bag', 'SELECT 1')
+    (bag / 'metadata.yaml').write_bytes(b'rosbag2_bagfile_information:\n  version: \x12\n')
+    with pytest.raises(BagError, match=r'metadata.yaml: not valid YAML \(.*special characters'):
+        read_series(bag, ['flow_command'])
+
+
+@pytest.mark.parametrize('at', [9, -28])  # the header's length; the footer's summary offset
+def test_mcap_lengths_and_offsets_of_2_64_are_one_line(tmp_path, at):
+    """Test a length or offset that asks for 2**64 bytes is damage, not a MemoryError."""
+    from mcap.writer import Writer as McapWriter
+    path = tmp_path / 'x.mcap'
+    with path.open('wb') as stream:
+        writer = McapWriter(stream)
+        writer.start(profile='ros2', library='test')
+        schema = writer.register_schema('std_msgs/msg/Float64', 'ros2msg', b'float64 data')
+        channel = writer.register_channel('/flow_command', 'cdr', schema)
+        writer.add_message(channel, log_time=5, publish_time=5,
+                           data=encode_message(FLOAT64, {'data': 1.0}))
+        writer.finish()
+    data = bytearray(path.read_bytes())
+    data[at:at + 8 if at + 8 else None] = b'\xff' * 8
+    path.write_bytes(bytes(data))
+    with pytest.raises(BagError, match=r'x.mcap: damaged or truncated'):
+        read_series(path, ['flow_command'])

@@ -251,6 +251,7 @@ def _read_file(path: Path, wanted: set[str], name: str) -> list[FileTopic]:
         If the file is damaged, truncated or not a storage file.
 
     """
+    from apsw import Error as ApswError  # rosbags reads .db3 files through apsw
     from mcap.exceptions import McapError
     from rosbags.rosbag2 import ReaderError
 
@@ -262,8 +263,9 @@ def _read_file(path: Path, wanted: set[str], name: str) -> list[FileTopic]:
             channels = _read_with_mcap(path, wanted)
     except BagError:
         raise
-    except (ReaderError, McapError, sqlite3.Error, zstd.ZstdError, struct.error, EOFError,
-            ValueError, TypeError, LookupError, RuntimeError) as err:
+    except (ReaderError, McapError, sqlite3.Error, ApswError, zstd.ZstdError, struct.error,
+            EOFError, ValueError, TypeError, LookupError, RuntimeError, OverflowError,
+            MemoryError) as err:  # the last two: a damaged length asks for 2**60 bytes
         detail = (str(err).splitlines() or [type(err).__name__])[0]
         raise BagError(f'{name}: damaged or truncated ({detail})') from None
     topics: dict[str, FileTopic] = {}
@@ -420,18 +422,21 @@ class _Budget:
         from mcap.records import Chunk
         from mcap.stream_reader import StreamReader
 
-        size = 0
+        size, stored = 0, path.stat().st_size
         try:
             with path.open('rb') as stream:
                 for record in StreamReader(stream, emit_chunks=True,
-                                           record_size_limit=self.total).records:
+                                           record_size_limit=stored).records:
                     if isinstance(record, Chunk) and record.compression:
                         size += record.uncompressed_size
                         if size > self.left:
                             self.spend(size, name)
-        except RecordLengthLimitExceeded:
-            self.spend(self.left + 1, name)
-        except McapError:
+        except BagError:
+            raise
+        except RecordLengthLimitExceeded as err:  # a record longer than its file
+            raise BagError(f'{name}: damaged or truncated ({err} bytes, the size of the '
+                           'file)') from None
+        except (McapError, ValueError, struct.error, EOFError, OverflowError, MemoryError):
             return  # damaged: the reader says how
         if size > self.left:
             self.spend(size, name)

@@ -11,7 +11,7 @@ import re
 import numpy as np
 
 from satmotor_ros.identify.errors import DataError
-from satmotor_ros.identify.textfile import read_cells
+from satmotor_ros.identify.textfile import read_cells, shorten
 from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.errors import UnitError
 from satmotor_ros.model.units import (ATMOSPHERE, kinds, pressure_reference, RPM, to_si,
@@ -121,6 +121,7 @@ def _kind_of(name: str) -> str | None:
     return 'pressure' if name.startswith('p_') else None
 
 
+@np.errstate(over='ignore', invalid='ignore')  # 1e308 rpm is inf in rad/s: a bad cell, dropped
 def column_to_si(name: str, unit: str, values: FloatArray) -> FloatArray:
     """
     Convert one column to SI, checking its unit against the column's kind.
@@ -211,7 +212,7 @@ def parse_header(header: list[str]) -> list[tuple[str, str]]:
     for i, cell in enumerate(header):
         match = _HEADER.match(cell)
         if match is None or not match.group(1):
-            msg = f'column {i + 1} header {cell!r}: expected "name [unit]"'
+            msg = f'column {i + 1} header {shorten(cell)!r}: expected "name [unit]"'
             raise DataError(msg)
         name = match.group(1)
         columns.append((name.lower() if name.lower() in KNOWN_KINDS else name,
@@ -219,7 +220,7 @@ def parse_header(header: list[str]) -> list[tuple[str, str]]:
     names = [name for name, _ in columns]
     for name in names:
         if names.count(name) > 1:
-            msg = f"column '{name}' appears {names.count(name)} times"
+            msg = f"column '{shorten(name)}' appears {names.count(name)} times"
             raise DataError(msg)
     ports = [name for name in (*PORTS, *PORTS.values()) if name in names]
     if set(ports) & set(PORTS) and set(ports) & set(PORTS.values()):
@@ -228,7 +229,8 @@ def parse_header(header: list[str]) -> list[tuple[str, str]]:
     need = ('speed', 'flow', *(PORTS if set(ports) & set(PORTS) else PORTS.values()))
     missing = [name for name in need if name not in names]
     if missing:
-        msg = (f"missing required column '{missing[0]}' (have: {', '.join(names)}; need "
+        have = ', '.join(shorten(name) for name in names[:20]) + (', ...' if names[20:] else '')
+        msg = (f"missing required column '{missing[0]}' (have: {have}; need "
                'speed, flow and p_in, p_out (or p_a, p_b) with units, e.g. "speed [rpm]"; '
                'a log with other column names is read through --columns, doc/columns.md)')
         raise DataError(msg)

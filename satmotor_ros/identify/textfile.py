@@ -30,6 +30,19 @@ line before the data (as in ``#time(s),RPM,...``), or nowhere (columns by number
 _UNIT = re.compile(r'^\s*(.*?)\s*(?:\[\s*([^\[\]]*?)\s*\]|\(\s*([^()]*?)\s*\))?\s*$')
 
 
+def shorten(text: str, most: int = 40) -> str:
+    """
+    Return `text` cut to `most` characters, for a message quoting a file's cell.
+
+    Examples
+    --------
+    >>> shorten('x' * 50, 8)
+    'xxxxxxxx...'
+
+    """
+    return text if len(text) <= most else text[:most] + '...'
+
+
 def split_unit(cell: str) -> tuple[str, str]:
     """
     Split a header cell into its name and the unit in brackets or parentheses.
@@ -123,7 +136,8 @@ def _numbers(rows: list[list[str]], lines: list[int], names: list[str]) -> np.nd
             try:
                 data[r, c] = float(text)
             except ValueError:
-                msg = f"column '{names[c]}' row {lines[r]}: {text!r} is not a number"
+                msg = (f"column '{shorten(names[c])}' row {lines[r]}: {shorten(text)!r} is not "
+                       'a number')
                 raise DataError(msg) from None
     return data
 
