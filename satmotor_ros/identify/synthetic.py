@@ -278,6 +278,15 @@ def _effects(base: MotorModel, injections: tuple[Injection, ...], speed: FloatAr
     return tuple(e for e in effects if e is not None)
 
 
+def _motor_flow(plan: Plan, injections: tuple[Injection, ...], speed: FloatArray,
+                dp: FloatArray, channels: dict[str, FloatArray]
+                ) -> tuple[tuple[Effect, ...], FloatArray]:
+    """Return the injected effects and the flow the packaged motor absorbs with them, [m^3/s]."""
+    base = MotorModel.from_spec(load_motor(), plan.liquid)
+    effects = _effects(base, injections, speed, dp, channels)
+    return effects, true_flow(base, effects, speed, dp, channels)
+
+
 def _injections(injection: Injection | Sequence[Injection]) -> tuple[Injection, ...]:
     return (injection,) if isinstance(injection, Injection) else tuple(injection)
 
@@ -310,9 +319,7 @@ def generate(plan: Plan, injection: Injection | Sequence[Injection],
     injections = _injections(injection)
     channels = _channels(plan, injections, rng, time, n, np.arange(n))
     channels['revolutions'] = revolutions(speed, np.diff(time, prepend=0.0))
-    base = MotorModel.from_spec(load_motor(), plan.liquid)
-    effects = _effects(base, injections, speed, dp, channels)
-    flow = true_flow(base, effects, speed, dp, channels)
+    effects, flow = _motor_flow(plan, injections, speed, dp, channels)
     return _measure(plan, effects, rng, flow, speed, dp, channels, 1.0)
 
 
@@ -388,9 +395,7 @@ def generate_series(plan: Plan, injection: Injection | Sequence[Injection], seed
     injections = _injections(injection)
     channels = _channels(plan, injections, rng, time, steps, k)
     channels['revolutions'] = revolutions(speed, 1.0 / rate)
-    base = MotorModel.from_spec(load_motor(), plan.liquid)
-    effects = _effects(base, injections, speed, dp, channels)
-    flow = true_flow(base, effects, speed, dp, channels)
+    effects, flow = _motor_flow(plan, injections, speed, dp, channels)
     table = _measure(plan, effects, rng, flow, speed, dp, channels, noise)
     return replace(table, time_series=True)
 
@@ -494,9 +499,7 @@ def generate_transient(plan: Plan, injection: Injection | Sequence[Injection],
     channels = _channels(plan, injections, rng, time, steps, k)
     channels['p_out'] = first_order(channels['p_out'], dt, tau_s)
     channels['revolutions'] = revolutions(speed, dt)
-    base = MotorModel.from_spec(load_motor(), plan.liquid)
-    effects = _effects(base, injections, speed, dp, channels)
-    flow = true_flow(base, effects, speed, dp, channels)
+    effects, flow = _motor_flow(plan, injections, speed, dp, channels)
     flow = flow + dynamics.line_compliance * np.gradient(channels['p_out'] + dp, dt)
     flow = first_order(flow, dt, dynamics.flow_lag)
     read_speed = first_order(speed, dt, dynamics.speed_lag)

@@ -115,16 +115,8 @@ def validate(table: BenchTable, model: MotorModel, liquid: str, mode: Mode = 'au
         points = points.select(usable, f'left out {int((~usable).sum())} points outside the '
                                        'model (no flow the model can give, or a chamber '
                                        'drop out of range)')
-    channels = {**points.channels, 'p_out': points.p_out}
-    missing = [name for name in model.channels if name not in channels]
-    if missing:
-        msg = (f'{points.source}: no {", ".join(missing)} column, which the effects of '
-               f'{model.name} need')
-        raise DataError(msg)
     calibrated = CalibratedModel(model)
-    # the model takes the signed row; the parts hold it where its loss runs forward
-    predicted = parts.sign * calibrated.measured_flow(parts.rotation * parts.speed, channels,
-                                                      dp_i=parts.sign * parts.dp_i)
+    predicted = _predicted(calibrated, points, parts)
     flagged = ~np.isfinite(predicted)
     if flagged.all():
         msg = f'{points.source}: the model flags every point invalid'
@@ -140,6 +132,20 @@ def validate(table: BenchTable, model: MotorModel, liquid: str, mode: Mode = 'au
                       tuple(calibrated.describe()), int(flagged.sum()))
 
 
+def _predicted(calibrated: CalibratedModel, points: BenchTable, parts: LossParts) -> FloatArray:
+    """Predict the flow reading at the points, in each row's frame (as ``parts.flow``)."""
+    channels = {**points.channels, 'p_out': points.p_out}
+    model = calibrated.model
+    missing = [name for name in model.channels if name not in channels]
+    if missing:
+        msg = (f'{points.source}: no {", ".join(missing)} column, which the effects of '
+               f'{model.name} need')
+        raise DataError(msg)
+    # the model takes the signed row; the parts hold it where its loss runs forward
+    return parts.sign * calibrated.measured_flow(parts.rotation * parts.speed, channels,
+                                                 dp_i=parts.sign * parts.dp_i)
+
+
 def _validate_samples(samples: Samples, model: MotorModel, liquid: str) -> Validation:
     """
     Hold the model against a time series' rows, as a calibration in transient mode reads them.
@@ -151,17 +157,10 @@ def _validate_samples(samples: Samples, model: MotorModel, liquid: str) -> Valid
     """
     raw = samples.samples
     keep = raw.select(samples.usable)
-    channels = {**keep.channels, 'p_out': keep.p_out}
-    missing = [name for name in model.channels if name not in channels]
-    if missing:
-        msg = (f'{raw.source}: no {", ".join(missing)} column, which the effects of '
-               f'{model.name} need')
-        raise DataError(msg)
     at_samples, _ = loss_parts(_bare(model), keep)
     calibrated = CalibratedModel(model)
     predicted = np.full(len(raw), np.nan)
-    predicted[samples.usable] = calibrated.measured_flow(at_samples.speed, channels,
-                                                         dp_i=at_samples.dp_i)
+    predicted[samples.usable] = _predicted(calibrated, keep, at_samples)
     residual = samples.parts.flow - averaged(samples, predicted)
     good = np.isfinite(residual)
     if not good.any():
