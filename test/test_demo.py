@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """``satmotor demo``: a short real run over ROS leaves bags with every topic and a report."""
 
+import json
 from pathlib import Path
 import re
 
@@ -32,6 +33,7 @@ def test_demo_writes_a_report_with_its_plots(demo_run):
     assert 'external_leakage = 2e-12' in report
     assert '| water | model |' in report and '| water | none (PI alone) |' in report
     assert 'Prediction from the motor_model node' in report
+    assert '## Closing the loop' in report  # 6 s may be too short to calibrate: it says so
     # the injected leakage takes k p_case / q_t = 0.55 rpm the model does not know about
     bias = float(re.search(r'has a median of (-?[0-9.]+) rpm', report).group(1))
     assert -1.0 < bias < -0.3
@@ -74,3 +76,28 @@ def test_demo_refuses_bad_options_in_one_line(tmp_path, capsys):
     assert 'bogus' in lines[0] and '-3' in lines[1] and 'clearance_wear' in lines[2]
     assert 'exists' in lines[3]
     assert not Path(tmp_path / 'a').exists()
+
+
+def test_demo_closes_the_loop_on_its_own_recording(tmp_path):
+    """The default demo also calibrates a run with a leak the model lacks, and names it."""
+    out = tmp_path / 'out'
+    assert command(liquid='water', duration='24', effect=[], out=str(out), quiet=True) == 0
+    report = (out / 'report.md').read_text()
+    section = report[report.index('## Closing the loop'):]
+    assert '`external_leakage = 2e-11`' in section and 'It named the injected effect.' in section
+    assert '](loop/report.md)' in section and '](loop/residuals.png)' in section
+    result = json.loads((out / 'loop' / 'calibration.json').read_text())
+    first = result['effects'][0]
+    assert first['effect'] == 'external_leakage'
+    assert first['ci95'][0] < 2e-11 < first['ci95'][1]
+    assert result['error_after']['rmse_lpm'] < result['error_before']['rmse_lpm']
+    assert (out / 'loop' / 'residuals.png').read_bytes().startswith(PNG)
+    assert (out / 'bags' / 'water_model_loop' / 'metadata.yaml').is_file()
+
+
+def test_demo_without_the_loop(tmp_path):
+    out = tmp_path / 'out'
+    assert command(liquid='water', duration='3', effect=[], out=str(out), quiet=True,
+                   no_loop=True) == 0
+    assert '## Closing the loop' not in (out / 'report.md').read_text()
+    assert not (out / 'loop').exists() and not (out / 'bags' / 'water_model_loop').exists()

@@ -288,7 +288,7 @@ def _plot_prediction(out: Path, liquid: str, tr: Tracking,
 
 
 def write_report(out: Path, runs: list[RunResult], cycle: Cycle,
-                 effects: dict[str, Any]) -> Path:
+                 effects: dict[str, Any], closing: Sequence[str] = ()) -> Path:
     """
     Write report.md with its PNG plots.
 
@@ -302,6 +302,8 @@ def write_report(out: Path, runs: list[RunResult], cycle: Cycle,
         The cycle they ran, [-]
     effects : dict
         Injected effects, [-]
+    closing : sequence of str
+        The closing-the-loop section, after the runs (none when empty), [-]
 
     Returns
     -------
@@ -361,8 +363,8 @@ def write_report(out: Path, runs: list[RunResult], cycle: Cycle,
         runs_table.append(f'| {r.liquid} / {r.feedforward} | {r.sim:.1f} | {r.wall:.1f} | '
                           f'{r.sim / r.wall:.1f} | {count} | `{r.bag.relative_to(out)}` |')
     path = out / 'report.md'
-    path.write_text('\n'.join(lines + table + [''] + sections + runs_table) + '\n',
-                    encoding='utf-8')
+    text = '\n'.join(lines + table + [''] + sections + runs_table + ['', *closing])
+    path.write_text(text.rstrip('\n') + '\n', encoding='utf-8')
     return path
 
 

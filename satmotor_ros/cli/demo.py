@@ -20,11 +20,20 @@ from typing import Any
 
 from satmotor_ros.cli._common import CliError, fail
 from satmotor_ros.cli._output import output_dir
+from satmotor_ros.model.units import LPM, MPA, RPM
 from satmotor_ros.plant.config import parameter_specs, params_from_flat
 from satmotor_ros.plant.scenario import default_cycle
 
 LIQUIDS = ('water', 'oil')
 FEEDFORWARDS = ('model', 'none')
+LOOP_EFFECT = 'external_leakage=2e-11'
+"""The default effect of the closing-the-loop run: a leak to the case, k * p_case [m^3/(s*Pa)]."""
+
+BENCH_SENSORS = {'sensors.flow.noise': 0.05 * LPM, 'sensors.speed.noise': 0.5 * RPM,
+                 'sensors.inlet_pressure.noise': 0.01 * MPA,
+                 'sensors.outlet_pressure.noise': 0.01 * MPA,
+                 'sensors.case_pressure.noise': 0.005 * MPA}
+"""The loop run's sensor noise (SI), as on a bench: the other runs have ideal sensors."""
 
 
 HELP = 'run virtual motor, model and controller over ROS; bag + report'
@@ -47,6 +56,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              'external_leakage=2e-12, viscosity_temperature=247.8 (Vogel B '
                              'of water [K]; Walther B of oil: 3.68), clearance_wear=1e-9, '
                              'flow_sensor_gain=0.03 (repeatable)')
+    parser.add_argument('--loop-effect', action='append', default=None, metavar='NAME=VALUE',
+                        help='the effect of the closing-the-loop run, which the model does '
+                             f'not know and the calibration must find (default {LOOP_EFFECT}; '
+                             'repeatable)')
+    parser.add_argument('--no-loop', action='store_true',
+                        help='skip the closing-the-loop run and its calibration')
     parser.add_argument('--out', default='out/demo', metavar='DIR',
                         help='output directory (default out/demo), written whole; an existing '
                              'one is replaced only if the demo wrote it')
@@ -98,7 +113,8 @@ def parse_effects(items: list[str]) -> dict[str, Any]:
 
 
 def command(liquid: str, duration: str, effect: list[str], out: str, quiet: bool,
-            force: bool = False) -> int:
+            force: bool = False, loop_effect: list[str] | None = None,
+            no_loop: bool = False) -> int:
     """
     Run the demo.
 
@@ -116,6 +132,10 @@ def command(liquid: str, duration: str, effect: list[str], out: str, quiet: bool
         Suppress the progress bar, [-]
     force : bool
         Replace an existing ``--out`` that the demo did not write, [-]
+    loop_effect : list of str, optional
+        ``NAME=VALUE`` effects of the closing-the-loop run; :data:`LOOP_EFFECT` when None, [-]
+    no_loop : bool
+        Skip the closing-the-loop run, [-]
 
     Returns
     -------
@@ -131,28 +151,37 @@ def command(liquid: str, duration: str, effect: list[str], out: str, quiet: bool
         if not 2.0 <= seconds <= 3600.0:
             raise CliError(f'--duration {duration!r}: must be within 2..3600 s')
         effects = parse_effects(effect)
+        loop = None if no_loop else {**BENCH_SENSORS, **effects,
+                                     **parse_effects(loop_effect or [LOOP_EFFECT])}
         liquids = LIQUIDS if liquid == 'both' else (liquid,)
         cycle = default_cycle().scaled(seconds)
         os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
         from satmotor_ros.cli import _demo_report as report
         from satmotor_ros.cli._demo_ros import run_cycle
         runs = []
-        steps = len(liquids) * len(FEEDFORWARDS) * cycle.duration
+        steps = (len(liquids) * len(FEEDFORWARDS) + (loop is not None)) * cycle.duration
         progress = None if quiet else Progress(steps)
         with output_dir('--out', out, 'demo', (), force) as out_dir:
             for q in liquids:
                 for ff in FEEDFORWARDS:
                     runs.append(run_cycle(q, ff, cycle, effects, out_dir / 'bags' / f'{q}_{ff}',
                                           progress))
+            section: list[str] = []
+            if loop is not None:
+                from satmotor_ros.cli._demo_loop import close_loop
+                bag = out_dir / 'bags' / f'{liquids[0]}_model_loop'
+                run_cycle(liquids[0], 'model', cycle, loop, bag, progress)
+                section = close_loop(bag, liquids[0], loop, out_dir)
             if progress is not None:
                 progress.done()
-            report.write_report(out_dir, runs, cycle, effects)
+            report.write_report(out_dir, runs, cycle, effects, section)
     except (CliError, OSError) as err:
         return fail(err)
     path, bags = Path(out) / 'report.md', Path(out) / 'bags'
     wall = sum(r.wall for r in runs)
     sim = sum(r.sim for r in runs)
-    print(f'satmotor demo: {len(runs)} runs, {sim:.0f} s simulated in {wall:.1f} s '
+    loop_note = '' if no_loop else f' and the loop run, calibrated into {Path(out) / "loop"}'
+    print(f'satmotor demo: {len(runs)} runs{loop_note}, {sim:.0f} s simulated in {wall:.1f} s '
           f'({sim / wall:.1f}x real time); report: {path}; bags: {bags}')
     return 0
 
