@@ -326,8 +326,10 @@ def write_report(cal: Calibration, out: Path, summary: dict[str, object]) -> Pat
             for name, value, (lo, hi) in zip(cal.final.names, cal.final.values, cal.final.ci95)]
     lines += [_table(rows, ['parameter', 'value', 'ci95']), '']
     lines += [f'`{c.name}` multiplies {c.describes or c.name}.' for c in cal.parts.components]
-    lines += ['The other coefficients of Table 1 are not identifiable from Q, n and dp and keep '
-              'their packaged values.', '']
+    lines += [('The other coefficients of Table 1 are not identifiable from Q, n and dp and keep '
+               'their packaged values.') if cal.model.family.name == 'sliwinski2017' else
+              (f"The family's other coefficients ({cal.model.family.name}, doc/families.md) "
+               'keep their values.'), '']
     if cal.samples is not None:
         lines += transient_section(summary, cal.inflation)
     lines += _identifiability(cal) + _outliers(cal, summary)
