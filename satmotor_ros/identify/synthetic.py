@@ -579,6 +579,50 @@ def to_columns(table: BenchTable) -> dict[str, tuple[str, FloatArray]]:
     return columns
 
 
+def parse_injection(text: str, liquid: str) -> Injection:
+    """
+    Read one ``--effect`` of the command line.
+
+    ``NAME`` or ``NAME*SCALE`` is a :data:`REALISTIC` effect at SCALE times its
+    realistic magnitude; ``term:EXPR=LPM`` a power term (e.g. ``term:dp^0.76=0.8``)
+    whose largest extra loss is LPM l/min; ``threshold:dp=LPM@MPA`` a valve that
+    cracks open at MPA MPa and adds LPM l/min at the top of the range.
+
+    Parameters
+    ----------
+    text : str
+        As typed, [-]
+    liquid : str
+        ``'oil'`` or ``'water'``, [-]
+
+    Returns
+    -------
+    Injection
+        The injection.
+
+    Raises
+    ------
+    ValueError
+        Naming the text and what is expected.
+
+    """
+    name, _, size = text.partition('=')
+    try:
+        if name.startswith('term:') and size:
+            return Injection(name, float(size) * LPM)
+        if name == 'threshold:dp' and '@' in size:
+            loss, _, crack = size.partition('@')
+            return Injection(name, float(loss) * LPM, shape=(('reference', float(crack) * MPA),))
+        effect, _, scale = text.partition('*')
+        if effect in REALISTIC and not size:
+            return Injection.realistic(effect, float(scale or 1.0), liquid)
+    except ValueError:
+        pass
+    msg = (f'--effect {text!r}: use NAME or NAME*SCALE (NAME one of {", ".join(REALISTIC)}), '
+           'term:EXPR=LPM (e.g. term:dp^0.76=0.8) or threshold:dp=LPM@MPA')
+    raise ValueError(msg)
+
+
 def main(argv: list[str] | None = None) -> int:
     """
     Write a synthetic bench CSV: ``python -m satmotor_ros.identify.synthetic``.
@@ -591,17 +635,20 @@ def main(argv: list[str] | None = None) -> int:
     Returns
     -------
     int
-        0.
+        0, or 2 with one line on stderr for a bad ``--effect`` or ``--outlier``.
 
     """
     import argparse
     from satmotor_ros.identify.table import write_csv
     parser = argparse.ArgumentParser(description='Write a synthetic bench table (CSV) from '
-                                                 'the model with one effect injected.')
+                                                 'the model with effects injected.')
     parser.add_argument('--liquid', default='oil')
-    parser.add_argument('--effect', default='none', help=f'one of {", ".join(REALISTIC)}')
-    parser.add_argument('--scale', type=float, default=1.0,
-                        help='factor on the realistic magnitude')
+    parser.add_argument('--effect', action='append', default=[],
+                        help='NAME or NAME*SCALE (NAME one of '
+                             f'{", ".join(REALISTIC)}), term:EXPR=LPM or threshold:dp=LPM@MPA; '
+                             'repeatable (default: none)')
+    parser.add_argument('--outlier', action='append', default=[], metavar='ROW:LPM',
+                        help='add LPM l/min to the flow of row ROW (repeatable)')
     parser.add_argument('--seed', type=int, default=0)
     parser.add_argument('--points', type=int, default=100)
     parser.add_argument('--series', type=int, default=0, metavar='SAMPLES',
@@ -615,21 +662,30 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument('--out', required=True, help='CSV file (or bag directory) to write')
     args = parser.parse_args(argv)
     plan = Plan(liquid=args.liquid, n_points=args.points)
-    injection = Injection.realistic(args.effect, args.scale, args.liquid)
+    try:
+        injections = [parse_injection(e, args.liquid) for e in args.effect] or [Injection()]
+        rows, sizes = zip(*((int(r), float(v)) for r, v in
+                            (o.split(':') for o in args.outlier))) if args.outlier else ((), ())
+    except ValueError as err:
+        parser.error(str(err) if str(err).startswith('--') else
+                     f'--outlier {args.outlier!r}: use ROW:LPM, e.g. 7:1.5')
     if args.transient:
-        table = generate_transient(plan, injection, REALISTIC_DYNAMICS, args.seed,
+        table = generate_transient(plan, injections, REALISTIC_DYNAMICS, args.seed,
                                    duration_s=args.transient)
     elif args.series:
-        table = generate_series(plan, injection, args.seed, samples=args.series)
+        table = generate_series(plan, injections, args.seed, samples=args.series)
     else:
-        table = generate(plan, injection, args.seed)
+        table = generate(plan, injections, args.seed)
+    if rows:
+        table = with_outliers(table, rows, sizes)
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
     if args.bag:
         write_bag_of(args.out, table, args.bag)
     else:
         write_csv(args.out, to_columns(table))
-    print(f'wrote {args.out}: {len(table)} rows, {args.liquid}, {args.effect} '
-          f'(magnitude {injection.magnitude:.4g}, regressor {injection.regressor or "-"})')
+    described = ', '.join(f'{i.effect} (magnitude {i.magnitude:.4g})' for i in injections)
+    print(f'wrote {args.out}: {len(table)} rows, {args.liquid}, {described}'
+          + (f', outliers at rows {", ".join(map(str, rows))}' if rows else ''))
     return 0
 
 
