@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 from satmotor_ros.identify.pipeline import Calibration
 from satmotor_ros.model.effects import effect_to_mapping, kind_of
+from satmotor_ros.model.families.defaults import DEFAULTS_NOTE
 import yaml
 
 
@@ -121,7 +122,7 @@ def _document(cal: Calibration) -> dict[str, Any]:
         entry['effects'] = effects
     g = spec.geometry
     return {
-        'motor': f'{spec.name} (calibrated)',
+        'motor': f'{spec.name.removesuffix(DEFAULTS_NOTE)} (calibrated)',
         'family': cal.model.family.name,
         'geometry': {f.name: float(getattr(g, f.name)) for f in fields(g)},
         'valid_range': {f.name: float(getattr(spec.valid_range, f.name))

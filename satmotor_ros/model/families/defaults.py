@@ -21,6 +21,10 @@ from satmotor_ros.model.families import DEFAULT_FAMILY, family_named
 from satmotor_ros.model.units import CM3_PER_REV
 
 
+DEFAULTS_NOTE = ' (default coefficients, to be calibrated)'
+"""What the name of a motor built from its displacement alone ends with."""
+
+
 def similar_geometry(base: MotorGeometry, displacement: float) -> MotorGeometry:
     """
     Scale a satellite motor's geometry to another displacement, lengths ~ q^(1/3).
@@ -81,8 +85,7 @@ def default_motor(family: str = DEFAULT_FAMILY, displacement: float | None = Non
         msg = f'displacement = {displacement!r} m^3/rad: expected a finite value > 0'
         raise ConfigError(msg)
     else:
-        name = (f'{fam.name} motor of {displacement / CM3_PER_REV:.4g} cm^3/rev '
-                '(default coefficients, to be calibrated)')
+        name = f'{fam.name} motor of {displacement / CM3_PER_REV:.4g} cm^3/rev{DEFAULTS_NOTE}'
     sets = {key: replace(s, coefficients=fam.default_coefficients(s, displacement), effects=())
             for key, s in packaged.sets.items()}
     return MotorSpec(name, similar_geometry(packaged.geometry, displacement),
