@@ -12,7 +12,7 @@ has to earn its place. A family pinned by the user (``--family``) is not compare
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 import math
 from typing import Any
@@ -23,6 +23,7 @@ from satmotor_ros.identify.parts import loss_parts, LossParts
 from satmotor_ros.identify.selection import CrossValidatedSelector, Errors
 from satmotor_ros.identify.table import BenchTable
 from satmotor_ros.model import MotorModel, MotorSpec
+from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.errors import ModelError
 from satmotor_ros.model.families import FAMILY_NAMES
 from satmotor_ros.model.families.defaults import default_motor
@@ -85,8 +86,9 @@ def family_specs(spec: MotorSpec, default: bool) -> dict[str, MotorSpec]:
     return specs
 
 
-def _parts_on(models: dict[str, MotorModel],
-              points: BenchTable) -> tuple[BenchTable, dict[str, LossParts | str]]:
+def _parts_on(models: dict[str, MotorModel], points: BenchTable,
+              nuisance: Mapping[str, FloatArray]
+              ) -> tuple[BenchTable, dict[str, LossParts | str]]:
     """Keep the points every family can use; return them and each family's parts there."""
     common = np.ones(len(points), dtype=bool)
     for model in models.values():
@@ -99,18 +101,19 @@ def _parts_on(models: dict[str, MotorModel],
         raise IdentificationError(msg)
     if not common.all():
         points = points.select(common)
+    kept = {k: x[common] for k, x in nuisance.items()}
     parts: dict[str, LossParts | str] = {}
     for name, model in models.items():
         try:
-            parts[name] = loss_parts(model, points)[0]
+            parts[name] = loss_parts(model, points)[0].with_nuisance(kept)
         except IdentificationError as err:
             parts[name] = str(err)
     return points, parts
 
 
 def compare_families(points: BenchTable, liquid: str, specs: dict[str, MotorSpec],
-                     selector: Callable[[], CrossValidatedSelector],
-                     min_gain: float) -> FamilyChoice:
+                     selector: Callable[[], CrossValidatedSelector], min_gain: float,
+                     nuisance: Mapping[str, FloatArray] | None = None) -> FamilyChoice:
     """
     Fit each family's baseline on the same points and choose the structure.
 
@@ -126,6 +129,9 @@ def compare_families(points: BenchTable, liquid: str, specs: dict[str, MotorSpec
         Makes the selector the effect search uses (same folds and noise model), [-]
     min_gain : float
         Least cut of the out-of-sample error for a family to replace the motor's own, [-]
+    nuisance : mapping of str to ndarray, optional
+        Regressors every family's fit takes beside its own parts (a transient
+        recording's terms, :mod:`.transient`), at the points, [SI]
 
     Returns
     -------
@@ -144,7 +150,7 @@ def compare_families(points: BenchTable, liquid: str, specs: dict[str, MotorSpec
             models[name] = MotorModel.from_spec(spec, liquid)
         except ModelError:
             continue
-    common, parts = _parts_on(models, points)
+    common, parts = _parts_on(models, points, nuisance or {})
     scored = {}
     outlier = np.zeros(len(common), dtype=bool)
     for name, p in parts.items():

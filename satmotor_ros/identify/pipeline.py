@@ -493,8 +493,10 @@ def _family_and_rows(spec: MotorSpec, liquid: str, table: BenchTable,
             raise err from None
     samples = read.samples if read is not None else None
     specs = family_specs(spec, spec.source == load_motor().source)
+    # on a transient recording's bins every family fits its steady map with the transient terms
     choice = compare_families(compared, liquid, specs,
-                              lambda: _selector(options, compared, samples), options.min_gain)
+                              lambda: _selector(options, compared, samples), options.min_gain,
+                              read.parts.nuisance if read is not None else None)
     if read is not None and choice.chosen == model.family.name:
         return spec, model, read, choice
     spec = specs[choice.chosen]
