@@ -5,7 +5,8 @@ from __future__ import annotations
 
 import argparse
 import json
-from typing import TypedDict
+import math
+from typing import Any, TypedDict
 
 from satmotor_ros.cli._common import add_motor_options, CliError, fail, quantity
 from satmotor_ros.interface import MotorOptions
@@ -93,8 +94,18 @@ def command(flow: str, dp: str | None, dp_i: str | None, p_ex: str, as_json: boo
     except (CliError, ModelError) as err:
         return fail(err)
     result = _result(model, op)
-    print(json.dumps(result, indent=2) if as_json else _table(result))
+    print(json.dumps(_json_safe(result), indent=2, allow_nan=False) if as_json
+          else _table(result))
     return 0
+
+
+def _json_safe(value: Any) -> Any:
+    """Return `value` with NaN and inf as None: JSON has no such numbers (the status says why)."""
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if isinstance(value, dict):
+        return {k: _json_safe(v) for k, v in value.items()}
+    return value
 
 
 def _result(model: MotorModel, op: OperatingPoints) -> PointReport:

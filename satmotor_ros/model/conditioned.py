@@ -23,6 +23,7 @@ from satmotor_ros.model.coefficients import MotorGeometry
 from satmotor_ros.model.core import ModelCore
 from satmotor_ros.model.effects import Conditions, Effect, kind_of
 from satmotor_ros.model.errors import ConfigError, InvalidInputError, ModelError
+from satmotor_ros.model.point import invalid_point
 from satmotor_ros.model.results import (COMPONENTS, describe_status, INVALID, LossBreakdown,
                                         OperatingPoints, Point, PointStatus)
 from satmotor_ros.model.screening import CHECK, FLOW_ATOL
@@ -36,10 +37,6 @@ _INVALID_FLAGS = int(INVALID)
 _STALLED = int(PointStatus.STALLED)
 _CHANNEL_LIMITED = int(PointStatus.CHANNEL_LIMITED)
 _SCREENED = int(PointStatus.NOT_FINITE | PointStatus.NEGATIVE | PointStatus.BEYOND_LIMIT)
-
-
-def _invalid(status: int) -> Point:
-    return Point(*(math.nan,) * 12, status)
 
 
 def _solve(excess: Callable[[float], float], lo: float, f_lo: float, hi: float,
@@ -188,7 +185,7 @@ class ConditionedModel:
         q = values['flow'] = point.flow + extra if flow is None else flow
         if not (total >= 0.0 and q >= 0.0 and total < math.inf):
             # a negative or unbounded Q_vl, or flow out of the inlet: past the model
-            return _invalid(int(PointStatus.BEYOND_LIMIT))
+            return invalid_point(int(PointStatus.BEYOND_LIMIT))
         values['dp'] = point.dp_i + model.eqs.channel_drop(q) if dp is None else dp
         values['status'] = (point.status & ~_STALLED) | status
         return Point(**values)
@@ -224,7 +221,7 @@ class ConditionedModel:
         """
         model, p_ex, constant, status = self.conditions(channels, p_ex)
         if model is None:
-            return _invalid(status)
+            return invalid_point(status)
         evaluator = model.point
         first = evaluator.speed(flow, dp, port, p_ex)
         if (not self._terms and constant == 0.0 and not (reverse and self._reverse_terms)
@@ -241,12 +238,12 @@ class ConditionedModel:
         lo = model.eqs.law.floor(dp_i)
         f_lo = excess(lo)
         if f_lo != f_lo:
-            return _invalid(int(PointStatus.NO_ROOT))
+            return invalid_point(int(PointStatus.NO_ROOT))
         if f_lo >= 0.0:
             # eq. (39) has no answer between n = 0 and its speed floor (as in point.py),
             # unless the flow does not even cover the losses at rest: a stall
             if lo > 0.0 and not excess(0.0) >= 0.0:
-                return _invalid(int(PointStatus.NO_ROOT))
+                return invalid_point(int(PointStatus.NO_ROOT))
             speed, status = 0.0, _STALLED
         else:
             hi = max(2.0 * flow / model.derived.qt, 2.0 * lo, 1.0)
@@ -257,10 +254,10 @@ class ConditionedModel:
                 lo, f_lo, hi = hi, f_hi, 4.0 * hi
                 f_hi = excess(hi)
             if not f_hi >= 0.0:
-                return _invalid(int(PointStatus.NO_ROOT))
+                return invalid_point(int(PointStatus.NO_ROOT))
             speed, done = _solve(excess, lo, f_lo, hi, f_hi, CHECK * abs(flow) + FLOW_ATOL)
             if not done:
-                return _invalid(int(PointStatus.NOT_CONVERGED))
+                return invalid_point(int(PointStatus.NOT_CONVERGED))
             status = 0
         point = evaluator.absorbency(speed, dp_i, False, p_ex, None)
         return self._with_extra(model, point, flow, dp if port else None,
@@ -297,7 +294,7 @@ class ConditionedModel:
         """
         model, p_ex, constant, status = self.conditions(channels, p_ex)
         if model is None:
-            return _invalid(status)
+            return invalid_point(status)
         evaluator = model.point
         first = evaluator.absorbency(speed, dp, port, p_ex, flow_guess)
         if (not self._terms and constant == 0.0 and not (reverse and self._reverse_terms)
@@ -331,10 +328,10 @@ class ConditionedModel:
                 hi = q0 + step
                 f_hi = excess(hi)
         if not f_lo < 0.0 < f_hi:
-            return _invalid(int(PointStatus.NO_ROOT))
+            return invalid_point(int(PointStatus.NO_ROOT))
         flow, done = _solve(excess, lo, f_lo, hi, f_hi, CHECK * abs(q0) + FLOW_ATOL)
         if not done:
-            return _invalid(int(PointStatus.NOT_CONVERGED))
+            return invalid_point(int(PointStatus.NOT_CONVERGED))
         dp_i = chamber(flow)
         limited = _CHANNEL_LIMITED if model.eqs.chamber_drop(dp, flow) < 0.0 else 0
         point = evaluator.absorbency(speed, dp_i, False, p_ex, None)

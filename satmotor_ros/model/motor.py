@@ -36,9 +36,9 @@ from satmotor_ros.model.families import DEFAULT_FAMILY, Family
 from satmotor_ros.model.families.defaults import default_motor
 from satmotor_ros.model.forward import absorbency_map
 from satmotor_ros.model.inverse import speed_map
-from satmotor_ros.model.point import as_float
+from satmotor_ros.model.point import as_float, invalid_point
 from satmotor_ros.model.quadrants import chamber_drop, Channels, Quadrants, signed_map
-from satmotor_ros.model.results import LossBreakdown, OperatingPoints, Point
+from satmotor_ros.model.results import LossBreakdown, OperatingPoints, Point, PointStatus
 from satmotor_ros.model.screening import Errors
 
 DisplacementLaw = Literal['eq33', 'eq39']
@@ -419,11 +419,14 @@ class MotorModel:
             flow = as_float('flow', flow)
         if type(p_ex) is not float:
             p_ex = as_float('p_ex', p_ex)
-        if not (flow >= 0.0 and value >= 0.0):  # any other quadrant, or NaN
-            return self._quadrants.speed(flow, value, port, p_ex, channels)
-        if self._conditioned is not None:
-            return self._conditioned.speed_point(flow, value, port, p_ex, channels)
-        return self._point.speed(flow, value, port, p_ex)
+        try:
+            if not (flow >= 0.0 and value >= 0.0):  # any other quadrant, or NaN
+                return self._quadrants.speed(flow, value, port, p_ex, channels)
+            if self._conditioned is not None:
+                return self._conditioned.speed_point(flow, value, port, p_ex, channels)
+            return self._point.speed(flow, value, port, p_ex)
+        except (OverflowError, ZeroDivisionError):  # float arithmetic past its range
+            return invalid_point(int(PointStatus.BEYOND_LIMIT))
 
     def absorbency_point(self, speed: float, dp: float | None = None, *,
                          dp_i: float | None = None, p_ex: float = 0.0,
@@ -473,12 +476,15 @@ class MotorModel:
             p_ex = as_float('p_ex', p_ex)
         if flow_guess is not None and type(flow_guess) is not float:
             flow_guess = as_float('flow_guess', flow_guess)
-        if not (speed >= 0.0 and value >= 0.0):  # any other quadrant, or NaN
-            return self._quadrants.absorbency(speed, value, port, p_ex, flow_guess, channels)
-        if self._conditioned is not None:
-            return self._conditioned.absorbency_point(speed, value, port, p_ex, flow_guess,
-                                                      channels)
-        return self._point.absorbency(speed, value, port, p_ex, flow_guess)
+        try:
+            if not (speed >= 0.0 and value >= 0.0):  # any other quadrant, or NaN
+                return self._quadrants.absorbency(speed, value, port, p_ex, flow_guess, channels)
+            if self._conditioned is not None:
+                return self._conditioned.absorbency_point(speed, value, port, p_ex, flow_guess,
+                                                          channels)
+            return self._point.absorbency(speed, value, port, p_ex, flow_guess)
+        except (OverflowError, ZeroDivisionError):  # float arithmetic past its range
+            return invalid_point(int(PointStatus.BEYOND_LIMIT))
 
     def breakdown_point(self, speed: float, dp_i: float, p_ex: float = 0.0,
                         channels: Mapping[str, float] | None = None) -> Point:

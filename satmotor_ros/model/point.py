@@ -18,7 +18,7 @@ from satmotor_ros.model._inline import inline_equations
 from satmotor_ros.model.composition import Equations
 from satmotor_ros.model.errors import InvalidInputError
 from satmotor_ros.model.results import Point, PointStatus
-from satmotor_ros.model.screening import CHECK, FLOW_ATOL, FLOW_SOLVE, SPEED_SOLVE
+from satmotor_ros.model.screening import CEILINGS, CHECK, FLOW_ATOL, FLOW_SOLVE, SPEED_SOLVE
 from satmotor_ros.model.solve import solve_increasing_scalar
 from satmotor_ros.model.speed import absorbency
 
@@ -31,11 +31,12 @@ _EXTRAPOLATED = int(PointStatus.EXTRAPOLATED)
 _NO_ROOT = int(PointStatus.NO_ROOT)
 _NOT_CONVERGED = int(PointStatus.NOT_CONVERGED)
 _INF = math.inf
+_FLOW_MAX, _SPEED_MAX, _DP_MAX = CEILINGS['m^3/s'], CEILINGS['rad/s'], CEILINGS['Pa']
 _NAN = math.nan
 _new_point = tuple.__new__
 
 
-def _invalid(status: int) -> Point:
+def invalid_point(status: int) -> Point:
     """Return the all-NaN point of an invalid element, as the array maps mask it."""
     return _new_point(Point, (_NAN,) * 12 + (status,))
 
@@ -73,11 +74,11 @@ def as_float(name: str, value: object) -> float:
         raise InvalidInputError(msg) from None
 
 
-def _screen(value: float) -> int:
-    """Return the NOT_FINITE / NEGATIVE flags of one input."""
+def _screen(value: float, ceiling: float) -> int:
+    """Return the NOT_FINITE / NEGATIVE / BEYOND_LIMIT flags of one input."""
     if value != value or value == _INF or value == -_INF:
         return _NOT_FINITE
-    return _NEGATIVE if value < 0.0 else 0
+    return (_NEGATIVE if value < 0.0 else 0) | (_BEYOND_LIMIT if abs(value) > ceiling else 0)
 
 
 class PointEvaluator:
@@ -122,32 +123,35 @@ class PointEvaluator:
             flow = absorbency(speed, total, self._qt)
         if dp is None:
             dp = dp_i + self._channel_drop(flow)
+        if not (abs(flow) < _INF and abs(speed) < _INF and abs(total) < _INF and abs(dp) < _INF):
+            return invalid_point(_BEYOND_LIMIT)  # an input so large that the result overflows
         return _new_point(Point, (flow, speed, dp, dp_i, q_lfg, q_c, fc, dch, bl, ine, q_ex,
                                   total, status))
 
     @inline_equations
     def speed(self, flow: float, dp: float, port: bool, p_ex: float) -> Point:
         """Compute n(Q, dp) at one point: :meth:`MotorModel.speed_point` without effects."""
-        if not (0.0 <= flow < _INF and 0.0 <= dp < _INF and 0.0 <= p_ex < _INF):
-            return _invalid(_screen(flow) | _screen(dp) | _screen(p_ex))
+        if not (0.0 <= flow <= _FLOW_MAX and 0.0 <= dp <= _DP_MAX and 0.0 <= p_ex <= _DP_MAX):
+            return invalid_point(_screen(flow, _FLOW_MAX) | _screen(dp, _DP_MAX)
+                                 | _screen(p_ex, _DP_MAX))
         dp_i = self._chamber_drop(dp, flow) if port else dp
         dp_i, status = (0.0, _CHANNEL_LIMITED) if dp_i < 0.0 else (dp_i, 0)
         if dp_i > self._dp_limit:
-            return _invalid(_BEYOND_LIMIT)
+            return invalid_point(_BEYOND_LIMIT)
         q_lfg, q_c, q_ex = self._leakage(dp_i, p_ex)
         if self._closed_form:
             speed = self._closed_form_speed(flow, dp_i, q_lfg + q_c + q_ex)
         else:
             speed, failed = self._solve_speed(flow, dp_i, q_lfg + q_c + q_ex)
             if failed:
-                return _invalid(failed)
+                return invalid_point(failed)
         if speed == 0.0:
             status |= _STALLED
         point = self._point(flow, speed, dp if port else None, dp_i, q_lfg, q_c, q_ex, status)
         if not self._closed_form and speed > 0.0 and not (
                 abs(absorbency(speed, point.total, self._qt) - flow)
                 <= CHECK * flow + FLOW_ATOL):
-            return _invalid(_NO_ROOT)
+            return invalid_point(_NO_ROOT)
         return point
 
     def _solve_speed(self, flow: float, dp_i: float, leak: float) -> tuple[float, int]:
@@ -163,8 +167,9 @@ class PointEvaluator:
     def absorbency(self, speed: float, dp: float, port: bool, p_ex: float,
                    flow_guess: float | None) -> Point:
         """Compute Q(n, dp) at one point: :meth:`MotorModel.absorbency_point` without effects."""
-        if not (0.0 <= speed < _INF and 0.0 <= dp < _INF and 0.0 <= p_ex < _INF):
-            return _invalid(_screen(speed) | _screen(dp) | _screen(p_ex))
+        if not (0.0 <= speed <= _SPEED_MAX and 0.0 <= dp <= _DP_MAX and 0.0 <= p_ex <= _DP_MAX):
+            return invalid_point(_screen(speed, _SPEED_MAX) | _screen(dp, _DP_MAX)
+                                 | _screen(p_ex, _DP_MAX))
         root = speed  # not used without `port`
         if port:
             lo, upper, residual = self._flow_problem(speed, dp, p_ex)
@@ -175,15 +180,15 @@ class PointEvaluator:
             root, failed = solve_increasing_scalar(residual, lo, hi, start, FLOW_SOLVE, FLOW_ATOL,
                                                    True)
             if failed:
-                return _invalid(failed)
+                return invalid_point(failed)
         dp_i = self._chamber_drop(dp, root) if port else dp
         dp_i, status = (0.0, _CHANNEL_LIMITED) if dp_i < 0.0 else (dp_i, 0)
         if dp_i > self._dp_limit:
-            return _invalid(_BEYOND_LIMIT)
+            return invalid_point(_BEYOND_LIMIT)
         if 0.0 < speed < self._max_floor and speed < self._floor(dp_i):
-            return _invalid(_BEYOND_LIMIT)
+            return invalid_point(_BEYOND_LIMIT)
         q_lfg, q_c, q_ex = self._leakage(dp_i, p_ex)
         point = self._point(None, speed, dp if port else None, dp_i, q_lfg, q_c, q_ex, status)
         if port and not abs(point.flow - root) <= CHECK * root + FLOW_ATOL:
-            return _invalid(_NO_ROOT)
+            return invalid_point(_NO_ROOT)
         return point

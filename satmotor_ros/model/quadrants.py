@@ -29,6 +29,7 @@ import numpy as np
 from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.coefficients import MotorGeometry
 from satmotor_ros.model.errors import InvalidInputError, ModelError
+from satmotor_ros.model.point import invalid_point
 from satmotor_ros.model.results import (COMPONENTS, describe_status, INVALID, LossBreakdown,
                                         OperatingPoints, Point, PointStatus)
 from satmotor_ros.model.screening import CHECK, FLOW_ATOL, numbers, raise_first, SPEED_SOLVE
@@ -236,15 +237,15 @@ class Quadrants:
             lo, hi = hi, 2.0 * hi
             f_hi = excess(hi)
         if not f_hi >= 0.0:  # the loss grows as fast as the displacement: no speed delivers it
-            return _invalid(_NO_ROOT)
+            return invalid_point(_NO_ROOT)
         check = CHECK * delivered + FLOW_ATOL
         speed, failed = solve_increasing_scalar(with_secant_slope(excess, hi, f_hi), lo, hi,
                                                 hi, _SPEED_SOLVE, check)
         point = at(speed)
         if failed or point.status & _INVALID:
-            return _invalid(failed or int(point.status & _INVALID))
+            return invalid_point(failed or int(point.status & _INVALID))
         if not abs(qt * speed - point.total - delivered) <= check:
-            return _invalid(_NO_ROOT)
+            return invalid_point(_NO_ROOT)
         return self._pump_point(point, -delivered, -speed, d if port else None, drop, 0)
 
     def _pump_flow(self, speed: float, d: float, port: bool, p_ex: float,
@@ -283,16 +284,11 @@ class Quadrants:
         dp_i = chamber(delivered)
         point = at(max(dp_i, 0.0))
         if failed or point.status & _INVALID:  # closed on the limit: the point is beyond it
-            return _invalid(beyond[0] or failed or int(point.status & _INVALID))
+            return invalid_point(beyond[0] or failed or int(point.status & _INVALID))
         if not abs(delivered - (qt * speed - point.total)) <= CHECK * abs(delivered) + FLOW_ATOL:
-            return _invalid(beyond[0] or _NO_ROOT)
+            return invalid_point(beyond[0] or _NO_ROOT)
         return self._pump_point(point, -delivered, -speed, d, drop,
                                 _CHANNEL_LIMITED if dp_i < 0.0 else 0)
-
-
-def _invalid(status: int) -> Point:
-    """Return the all-NaN point of an invalid element."""
-    return Point(*(math.nan,) * 12, status)
 
 
 def signed_map(point: Callable[[float, float, float], Point],

@@ -122,19 +122,34 @@ def raise_first(name: str, unit: str, value: FloatArray, bad: npt.NDArray[np.boo
     raise InvalidInputError(msg)
 
 
+CEILINGS = {'m^3/s': 10.0, 'rad/s': 1.0e5, 'Pa': 1.0e10}
+"""
+Magnitudes beyond any displacement motor, by SI unit: BEYOND_LIMIT, never computed.
+
+600 000 l/min, about 950 000 rpm, 100 000 bar. Far above them the arithmetic overflows
+and returns NaN or a wrong 0 that would otherwise carry an ordinary status.
+"""
+
+
 def _screen(name: str, unit: str, value: FloatArray, errors: Errors) -> Status | None:
-    """Flag non-finite and negative elements; None when there are none (the usual case)."""
-    if value.size == 0 or (value.min() >= 0.0 and value.max() < np.inf):
+    """Flag non-finite, negative and absurd elements; None when there are none (the usual case)."""
+    ceiling = CEILINGS.get(unit, np.inf)
+    if value.size == 0 or (value.min() >= 0.0 and value.max() <= ceiling):
         return None
     not_finite = ~np.isfinite(value)
     negative = value < 0.0
+    beyond = np.abs(np.where(not_finite, 0.0, value)) > ceiling
     if errors == 'raise':
         at = (0, value.shape)
         if not_finite.any():
             raise_first(name, unit, value, not_finite, 'not finite', at)
+        if beyond.any():
+            raise_first(name, unit, value, beyond, f'beyond any motor (|{name}| > {ceiling:g})',
+                        at)
         raise_first(name, unit, value, negative, 'negative', at)
     return (not_finite * np.uint8(PointStatus.NOT_FINITE)
-            | negative * np.uint8(PointStatus.NEGATIVE)).astype(np.uint8)
+            | negative * np.uint8(PointStatus.NEGATIVE)
+            | beyond * np.uint8(PointStatus.BEYOND_LIMIT)).astype(np.uint8)
 
 
 def prepare(named: dict[str, tuple[object, str]],
