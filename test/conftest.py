@@ -9,6 +9,8 @@ tests start inherit it.
 
 import os
 
+import pytest
+
 # Discovery never leaves this machine, whatever the calling shell says.
 os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
 
@@ -17,3 +19,14 @@ os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
 # ephemeral port range), and 0 is everyone's default, so use 1..101.
 if not os.environ.get('ROS_DOMAIN_ID'):
     os.environ['ROS_DOMAIN_ID'] = str(1 + os.getpid() % 101)
+
+
+@pytest.fixture()
+def harness():
+    """Give a test its own Context, node and executor, shut down afterwards."""
+    from node_harness import Harness  # imports rclpy: only after the environment above
+    h = Harness()
+    try:
+        yield h
+    finally:
+        h.close()

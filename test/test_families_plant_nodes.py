@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """Every model family in the plant and the nodes, through the same MotorOptions."""
 
-from node_harness import Harness, unique_namespace
+from node_harness import unique_namespace
 import pytest
 from rclpy.parameter import Parameter
 from satmotor_ros.interface import MotorOptions, OptionError
@@ -26,16 +26,6 @@ coefficient_sets:
     coefficients: {k_g: 0.03, a_pv: 0.9, a_nv: 0.2, a_vv: -0.6, p_n: 21 MPa, n_t: 3000 rpm,
                    c_t: 20.0, c_l: 5.0}
 """
-
-
-@pytest.fixture()
-def harness():
-    """Give a test its own Context, node and executor, shut down afterwards."""
-    h = Harness()
-    try:
-        yield h
-    finally:
-        h.close()
 
 
 @pytest.mark.parametrize('family', FAMILY_NAMES)

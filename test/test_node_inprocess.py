@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """The node as a library class: added to the caller's own executor, parameters checked."""
 
-from node_harness import Harness, unique_namespace
+from node_harness import unique_namespace
 import pytest
 from rclpy.parameter import Parameter
 from satmotor_ros.interface import LOSS_COMPONENTS, LOSSES_ARRAY, LOSSES_PREFIX
@@ -9,16 +9,6 @@ from satmotor_ros.model import MotorModel
 from satmotor_ros.model.units import LPM, MPA
 from satmotor_ros.nodes.motor_model import MotorModelNode, PARAMETERS
 from std_msgs.msg import Float64
-
-
-@pytest.fixture()
-def harness():
-    """Give a test its own Context, node and executor, shut down afterwards."""
-    h = Harness()
-    try:
-        yield h
-    finally:
-        h.close()
 
 
 def test_node_joins_a_user_executor_and_predicts(harness):

@@ -14,7 +14,7 @@ import time
 
 from ament_index_python.packages import get_package_prefix
 from builtin_interfaces.msg import Time
-from node_harness import Harness, start_node, stop_node, unique_namespace
+from node_harness import start_node, stop_node, unique_namespace
 import pytest
 from rosgraph_msgs.msg import Clock
 from satmotor_ros.model import MotorModel
@@ -44,16 +44,6 @@ def install(tmp_path_factory):
     env = _sourced_environment(prefix, os.environ)
     return {'env': env, 'prefix': prefix, 'cwd': workspace,
             'config': prefix / 'share' / PACKAGE / 'config' / 'motor_model.yaml'}
-
-
-@pytest.fixture()
-def harness():
-    """Give a test its own Context, node and executor, shut down afterwards."""
-    h = Harness()
-    try:
-        yield h
-    finally:
-        h.close()
 
 
 @pytest.fixture()

@@ -4,7 +4,7 @@
 import os
 import time
 
-from node_harness import Harness, unique_namespace
+from node_harness import unique_namespace
 import pytest
 import rclpy
 from rclpy.parameter import Parameter
@@ -16,16 +16,6 @@ from satmotor_ros.nodes.motor_model import MotorModelNode
 from satmotor_ros.nodes.virtual_motor import VirtualMotorNode
 from sensor_msgs.msg import FluidPressure, JointState
 from std_msgs.msg import Float64
-
-
-@pytest.fixture()
-def harness():
-    """Give a test its own Context, node and executor, shut down afterwards."""
-    h = Harness()
-    try:
-        yield h
-    finally:
-        h.close()
 
 
 @pytest.mark.parametrize(('flow', 'p_in', 'p_out'), [

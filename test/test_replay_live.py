@@ -3,9 +3,8 @@
 
 import csv
 
-from node_harness import Harness, unique_namespace
+from node_harness import unique_namespace
 import numpy as np
-import pytest
 from rclpy.qos import qos_profile_sensor_data
 from satmotor_ros.bags import FLOAT64, FLUID_PRESSURE, JOINT_STATE, OutTopic, write_bag
 from satmotor_ros.cli.main import main
@@ -38,16 +37,6 @@ class Recorder:
         write_bag(path, [OutTopic(name, msgtype, np.array(times, dtype=np.int64), payloads)
                          for name, (msgtype, times, payloads) in self.messages.items()
                          if times])
-
-
-@pytest.fixture()
-def harness():
-    """Give a test its own Context, node and executor, shut down afterwards."""
-    h = Harness()
-    try:
-        yield h
-    finally:
-        h.close()
 
 
 def test_live_run_recorded_and_replayed_gives_identical_predictions(harness, tmp_path):
