@@ -455,6 +455,10 @@ def calibrate(table: BenchTable, liquid: str = 'oil', spec: MotorSpec | None = N
     first = forward.steps[0]
     packaged_error = parts.flow - predict_flow(parts, np.ones(len(parts.components)))
     at = ~forward.outliers
+    if int(at.sum()) < MIN_POINTS:
+        msg = (f'{int((~at).sum())} of {len(at)} points are outliers of every model: check the '
+               'units and the column mapping (e.g. a speed in rpm labelled rad/s)')
+        raise IdentificationError(msg)
     index = np.flatnonzero(at)
     inflation = selector.inflation(parts, forward.final.fit, forward.sigma, index)
     base_inflation = selector.inflation(parts, first.baseline.fit, forward.sigma, index)

@@ -40,6 +40,7 @@ Channels = Mapping[str, float] | None
 _INVALID = int(INVALID)
 _STALLED = int(PointStatus.STALLED)
 _CHANNEL_LIMITED = int(PointStatus.CHANNEL_LIMITED)
+_EXTRAPOLATED = int(PointStatus.EXTRAPOLATED)
 _NO_ROOT = int(PointStatus.NO_ROOT)
 _NOT_CONVERGED = int(PointStatus.NOT_CONVERGED)
 _INF = math.inf
@@ -205,11 +206,16 @@ class Quadrants:
 
     def _pump_point(self, at: Point, flow: float, speed: float, dp: float | None,
                     drop: Callable[[float], float], status: int) -> Point:
-        """Return the pump-mode point of the losses `at` (dp None: dp_i plus the channel drop)."""
+        """
+        Return the pump-mode point of the losses `at` (dp None: dp_i plus the channel drop).
+
+        Always EXTRAPOLATED: the coefficients were measured on a motor, not a pump.
+        """
         dp_i = at.dp_i
         if dp is None:
             dp = dp_i + odd_drop(drop, flow)
-        return Point(flow, speed, dp, dp_i, *at[4:12], (at.status & ~_STALLED) | status)
+        return Point(flow, speed, dp, dp_i, *at[4:12],
+                     (at.status & ~_STALLED) | status | _EXTRAPOLATED)
 
     def _pump_speed(self, delivered: float, d: float, port: bool, p_ex: float,
                     channels: Channels, reverse: bool) -> Point:
