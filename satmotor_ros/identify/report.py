@@ -283,6 +283,28 @@ def _families(cal: Calibration) -> list[str]:
     return lines
 
 
+def _written_effects(summary: dict[str, Any]) -> list[str]:
+    """List the effects as calibration.json and coefficients.yaml write them (SI)."""
+    effects = summary.get('effects') or []
+    if not effects:
+        return []
+    rows = []
+    for e in effects:
+        fitted = e.get('exponents_ci95') or {}
+        shape = ', '.join([f"exponent of {k} {e['exponents'][k]:.4g} [{lo:.4g}, {hi:.4g}]"
+                           for k, (lo, hi) in fitted.items()]
+                          + ([f"threshold {e['threshold']['value']:.5g} "
+                              f"{e['threshold']['unit']}"] if e.get('threshold') else []))
+        rows.append([f"`{e['effect']}`", f"{e['coefficient']:.5g} {e['unit']}",
+                     f"[{e['ci95'][0]:.5g}, {e['ci95'][1]:.5g}]", shape or '-'])
+    return ['The effects as `calibration.json` and `coefficients.yaml` write them, the '
+            'coefficient k in SI. For a fitted form the fit estimates its size (the rows above: '
+            'the extra loss at the largest regressor value) and k follows from the size and the '
+            'exponents, so the interval of k also carries the uncertainty of the exponents and '
+            'can be much wider, even span 0, while the interval of the size does not.', '',
+            _table(rows, ['effect', 'coefficient k', 'ci95', 'fitted shape']), '']
+
+
 def write_report(cal: Calibration, out: Path, summary: dict[str, object]) -> Path:
     """
     Write ``report.md`` and its three PNG plots into `out`.
@@ -325,6 +347,7 @@ def write_report(cal: Calibration, out: Path, summary: dict[str, object]) -> Pat
     rows = [[name, f'{value:.5g}', f'[{lo:.5g}, {hi:.5g}]']
             for name, value, (lo, hi) in zip(cal.final.names, cal.final.values, cal.final.ci95)]
     lines += [_table(rows, ['parameter', 'value', 'ci95']), '']
+    lines += _written_effects(summary)
     lines += [f'`{c.name}` multiplies {c.describes or c.name}.' for c in cal.parts.components]
     lines += [('The other coefficients of Table 1 are not identifiable from Q, n and dp and keep '
                'their packaged values.') if cal.model.family.name == 'sliwinski2017' else
