@@ -1,6 +1,8 @@
 # SPDX-License-Identifier: Apache-2.0
 """Calibration with bad cells: named, handled, the other channels' verdict kept (issue 14)."""
 
+import json
+
 import numpy as np
 import pytest
 
@@ -83,12 +85,15 @@ def test_speed_in_rpm_labelled_rad_per_s_is_warned_about(tmp_path, capsys, leak_
     path = tmp_path / 'bench.csv'
     path.write_text('\n'.join([leak_csv[0].replace('speed [rpm]', 'speed [rad/s]'),
                                *leak_csv[1:]]) + '\n')
-    code, _, err, report = _calibrate(capsys, path)
+    code, out, err, report = _calibrate(capsys, path)
     assert code == 0
     warning = ('implausible data: the volumetric losses Q - q_t n are larger than the flow '
                'itself at 100 of 100 points')
     assert warning in err and 'a speed in rpm labelled [rad/s]?' in err
     assert f'- {warning}' in report
+    summary = json.loads((path.parent / 'out' / 'calibration.json').read_text())
+    assert summary['warnings'][0].startswith(warning)  # the file says so too, not only stderr
+    assert out.startswith('WARNING implausible data')
 
 
 def test_plausible_data_give_no_warning(tmp_path, capsys, leak_csv):
@@ -96,3 +101,4 @@ def test_plausible_data_give_no_warning(tmp_path, capsys, leak_csv):
     path.write_text('\n'.join(leak_csv) + '\n')
     _, _, err, report = _calibrate(capsys, path)
     assert 'warning' not in err and 'implausible' not in report
+    assert 'warnings' not in json.loads((path.parent / 'out' / 'calibration.json').read_text())

@@ -84,7 +84,8 @@ def _calibrate(data: str, out: str, mode: Mode, alpha: float, folds: int,
     target = Path(out)
     effect = summary['effect']
     before, after = summary['error_before']['rmse_lpm'], summary['error_after']['rmse_lpm']
-    line = f'effect: {effect}'
+    line = ('WARNING implausible data (see report.md); ' if summary.get('warnings') else '') + \
+        f'effect: {effect}'
     if effect != 'none':
         line += (f' ({summary["regressor"]}, coefficient {summary["coefficient"]:.4g} '
                  f'{summary["unit"]})')

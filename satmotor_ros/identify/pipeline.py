@@ -169,9 +169,11 @@ class Calibration:
         -------
         dict
             liquid, n_points, effect, regressor, coefficient, ci95, unit,
-            error_before, error_after, effects, outliers, candidates. The
-            top-level effect fields are those of the first effect; with no
-            effect, regressor, coefficient, ci95 and unit are null.
+            error_before, error_after, effects, outliers, candidates,
+            family_comparison, the transient mode's fields, and ``warnings``
+            when the data are implausible. The top-level effect fields are
+            those of the first effect; with no effect, regressor, coefficient,
+            ci95 and unit are null.
 
         """
         effects = self.effect_rows()
@@ -192,7 +194,13 @@ class Calibration:
                  'cv_rmse_lpm': _round(s.cv_rmse / LPM)} for s in ranked],
             'family_comparison': self.family_comparison(),
             **self.mode_fields(),
+            **self.warnings(),
         }
+
+    def warnings(self) -> dict[str, list[str]]:
+        """Return ``{'warnings': [...]}`` when the data are implausible (else nothing)."""
+        found = [note for note in self.table.notes if note.startswith(IMPLAUSIBLE)]
+        return {'warnings': found} if found else {}
 
     def family_comparison(self) -> dict[str, Any]:
         """Return how the family was chosen: the verdict and each family's out-of-sample error."""
