@@ -135,7 +135,7 @@ def take_motor_options(args: dict[str, Any]) -> dict[str, Any]:
 
 
 def quantity(flag: str, text: str, kind: str, default_unit: str, *,
-             positive: bool = False) -> float:
+             positive: bool = False, signed: bool = False) -> float:
     """
     Parse a command-line quantity into SI, naming the flag on error.
 
@@ -151,6 +151,8 @@ def quantity(flag: str, text: str, kind: str, default_unit: str, *,
         Unit when `text` has none, [-]
     positive : bool
         Require a value > 0 rather than >= 0, [-]
+    signed : bool
+        Accept any finite value (a flow or drop of a four-quadrant point), [-]
 
     Returns
     -------
@@ -167,9 +169,9 @@ def quantity(flag: str, text: str, kind: str, default_unit: str, *,
         value = parse_quantity(text, kind, default_unit)
     except UnitError as err:
         raise CliError(f'{flag} {text!r}: {err}') from None
-    if not math.isfinite(value) or value < 0.0 or (positive and value == 0.0):
-        need = '> 0' if positive else '>= 0'
-        raise CliError(f'{flag} {text!r}: must be a finite value {need}')
+    if not math.isfinite(value) or (not signed and value < 0.0) or (positive and value == 0.0):
+        need = '' if signed else ' > 0' if positive else ' >= 0'
+        raise CliError(f'{flag} {text!r}: must be a finite value{need}')
     return value
 
 

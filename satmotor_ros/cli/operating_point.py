@@ -83,12 +83,13 @@ def command(flow: str, dp: str | None, dp_i: str | None, p_ex: str, as_json: boo
     """
     try:
         model = options.build_model()
-        q = quantity('--flow', flow, 'flow', 'l/min')
+        q = quantity('--flow', flow, 'flow', 'l/min', signed=True)
         pex = quantity('--p-ex', p_ex, 'pressure', 'MPa')
         if dp is not None:
-            op = model.speed(q, quantity('--dp', dp, 'pressure', 'MPa'), p_ex=pex)
+            op = model.speed(q, quantity('--dp', dp, 'pressure', 'MPa', signed=True), p_ex=pex)
         elif dp_i is not None:
-            op = model.speed(q, dp_i=quantity('--dp-i', dp_i, 'pressure', 'MPa'), p_ex=pex)
+            op = model.speed(q, dp_i=quantity('--dp-i', dp_i, 'pressure', 'MPa', signed=True),
+                             p_ex=pex)
         else:
             raise CliError('give --dp or --dp-i')
     except (CliError, ModelError) as err:

@@ -340,9 +340,8 @@ def _transient_rows(model: MotorModel, table: BenchTable, options: Options,
     if len(samples.parts) < MIN_POINTS:
         msg = (f'too few rows: {samples.n_samples} of {len(table)} samples are usable, '
                f'{len(samples.parts)} rows of {samples.bin_size} sample steps, need >= '
-               f'{MIN_POINTS}; the model covers forward motor operation (flow > 0, speed >= 0, '
-               'chamber drop between 0 and its limit), and a row needs neighbouring samples '
-               'without a gap')
+               f'{MIN_POINTS}; a sample needs finite readings and a chamber drop within the '
+               "model's limit, and a row needs neighbouring samples without a gap")
         raise IdentificationError(msg)
     if check:
         check_identifiable(samples.parts)
@@ -513,8 +512,10 @@ def _family_and_rows(spec: MotorSpec, liquid: str, table: BenchTable,
         return spec, model, read, choice
     spec = specs[choice.chosen]
     model = MotorModel.from_spec(spec, liquid)
-    again = options if read is None else replace(options, mode=read.mode)
-    return spec, model, read_rows(model, table, again), choice
+    if read is None:
+        return spec, model, read_rows(model, table, options), choice
+    again = read_rows(model, table, replace(options, mode=read.mode))
+    return spec, model, replace(again, reason=read.reason), choice  # why the mode: as decided
 
 
 IMPLAUSIBLE = 'implausible data'
