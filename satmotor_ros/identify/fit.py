@@ -64,6 +64,11 @@ TUKEY = 4.685
 """Tukey's biweight constant in noise standard deviations (95 % efficiency), [-]."""
 
 
+def written(x: float) -> float:
+    """Return `x` to 5 significant digits, as calibration.json writes a fitted number."""
+    return float(f'{float(x):.5g}')
+
+
 def check_identifiable(parts: LossParts) -> None:
     """
     Refuse data that cannot determine the three coefficients.

@@ -17,7 +17,7 @@ import numpy as np
 from satmotor_ros.identify.candidates import build_library, Candidate
 from satmotor_ros.identify.errors import DataError, IdentificationError
 from satmotor_ros.identify.families import compare_families, family_specs, FamilyChoice
-from satmotor_ros.identify.fit import check_identifiable, FitReport, MIN_POINTS
+from satmotor_ros.identify.fit import check_identifiable, FitReport, MIN_POINTS, written
 from satmotor_ros.identify.parts import loss_parts, LossParts, predict_flow
 from satmotor_ros.identify.selection import (CrossValidatedSelector, Errors, Forward, Score,
                                              Selection)
@@ -126,20 +126,20 @@ class Calibration:
             row: dict[str, Any] = {
                 'effect': effect.name if candidate.shape else candidate.effect,
                 'regressor': effect.regressor if candidate.shape else candidate.regressor,
-                'coefficient': _round(value), 'ci95': [_round(v) for v in ci95],
+                'coefficient': written(value), 'ci95': [written(v) for v in ci95],
                 'unit': candidate.unit, 'p_value': float(f'{score.p_value:.3g}'),
                 'error_after': self.errors(score).as_dict()}
             if effect.kind == 'term':
                 row['expression'] = effect.suffix
-                row['exponents'] = {k: _round(effect.option(k)) for k in ('dp', 'n')}
+                row['exponents'] = {k: written(effect.option(k)) for k in ('dp', 'n')}
                 row['exponents_ci95'] = {
-                    s_.name.split()[0]: [_round(v) for v in self.final.ci95[position + 1 + j]]
+                    s_.name.split()[0]: [written(v) for v in self.final.ci95[position + 1 + j]]
                     for j, s_ in enumerate(candidate.shape)}
             if effect.kind == 'threshold':
-                row['threshold'] = {'regressor': 'dp', 'value': _round(effect.reference),
+                row['threshold'] = {'regressor': 'dp', 'value': written(effect.reference),
                                     'unit': 'Pa',
-                                    'ci95': [_round(v) for v in self.final.ci95[position + 1]]}
-                row['exponent'] = _round(effect.option('exponent'))
+                                    'ci95': [written(v) for v in self.final.ci95[position + 1]]}
+                row['exponent'] = written(effect.option('exponent'))
             rows.append(row)
             position += 1 + len(candidate.shape)
         return rows
@@ -154,10 +154,10 @@ class Calibration:
             if self.rows is not None:
                 row['row'] = int(self.rows[i])
             if time is not None:
-                row['time'] = _round(time[i])
-            row.update(flow_lpm=_round(self.parts.flow[i] / LPM),
-                       residual_lpm=_round(residual[i] / LPM),
-                       noise_sd=_round(abs(residual[i]) / self.forward.sigma[i]))
+                row['time'] = written(time[i])
+            row.update(flow_lpm=written(self.parts.flow[i] / LPM),
+                       residual_lpm=written(residual[i] / LPM),
+                       noise_sd=written(abs(residual[i]) / self.forward.sigma[i]))
             out.append(row)
         return out
 
@@ -191,7 +191,7 @@ class Calibration:
             'effects': effects, 'outliers': self.outlier_rows(),
             'candidates': [
                 {'effect': s.effect, 'regressor': s.candidate.regressor if s.candidate else None,
-                 'cv_rmse_lpm': _round(s.cv_rmse / LPM)} for s in ranked],
+                 'cv_rmse_lpm': written(s.cv_rmse / LPM)} for s in ranked],
             'family_comparison': self.family_comparison(),
             **self.mode_fields(),
             **self.warnings(),
@@ -227,7 +227,7 @@ class Calibration:
             return {}
         return {'mode': self.mode, 'mode_reason': self.mode_reason,
                 'n_samples': self.samples.n_samples, 'bin_size': self.samples.bin_size,
-                'variance_inflation': _round(self.inflation),
+                'variance_inflation': written(self.inflation),
                 'dynamics': dynamics_summary(self.final, self.samples)}
 
 
@@ -254,10 +254,6 @@ def _coefficient_interval(report: FitReport, position: int,
     value = coefficient(values)
     half = float(t * np.sqrt(max(float(grad @ cov @ grad), 0.0)))
     return value, (value - half, value + half)
-
-
-def _round(x: float) -> float:
-    return float(f'{float(x):.5g}')
 
 
 def is_series(table: BenchTable) -> bool:

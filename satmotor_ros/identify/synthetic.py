@@ -28,7 +28,7 @@ from satmotor_ros.model import load_motor, MotorModel
 from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.effects import Effect, kind_of, sensor_error, Synthetic, with_effects
 from satmotor_ros.model.revolutions import revolutions
-from satmotor_ros.model.units import LPM, MPA, RPM
+from satmotor_ros.model.units import ATMOSPHERE, LPM, MPA, RPM
 from satmotor_ros.model.viscosity import standard_law
 from scipy.signal import lfilter
 
@@ -530,11 +530,10 @@ def write_bag_of(path: str | Path, table: BenchTable, storage: str = 'mcap',
     from satmotor_ros.bags import (encode_many, FLOAT64, FLUID_PRESSURE, JOINT_STATE,
                                    OutTopic, TEMPERATURE, write_bag)
     t_ns = 1_700_000_000_000_000_000 + np.round(table.channels['time'] * 1e9).astype(np.int64)
-    atm = 101325.0  # FluidPressure is absolute
 
-    def pressure(name: str, p: FloatArray) -> OutTopic:
+    def pressure(name: str, p: FloatArray) -> OutTopic:  # FluidPressure is absolute
         return OutTopic(f'/{CHANNELS[name].topic}', FLUID_PRESSURE, t_ns + 1000,
-                        encode_many(FLUID_PRESSURE, {'fluid_pressure': p + atm}, t_ns))
+                        encode_many(FLUID_PRESSURE, {'fluid_pressure': p + ATMOSPHERE}, t_ns))
 
     topics = [OutTopic(f'/{flow_topic}', FLOAT64, t_ns + 2000,
                        encode_many(FLOAT64, {'data': table.flow})),

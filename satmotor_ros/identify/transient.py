@@ -39,7 +39,7 @@ from typing import Any
 
 import numpy as np
 from satmotor_ros.identify.errors import DataError, IdentificationError
-from satmotor_ros.identify.fit import FitReport
+from satmotor_ros.identify.fit import FitReport, written
 from satmotor_ros.identify.parts import loss_parts, LossParts, NO_EFFECT
 from satmotor_ros.identify.table import BenchTable
 from satmotor_ros.model import MotorModel
@@ -532,8 +532,8 @@ def dynamics_summary(fit: FitReport, samples: Samples) -> list[dict[str, Any]]:
                                  'equation': term.equation, 'meaning': term.meaning}
         if term.name in at:
             lo, hi = (float(v) for v in fit.ci95[at[term.name]])
-            entry.update(coefficient=_sig(fit.values[at[term.name]]),
-                         ci95=[_sig(lo), _sig(hi)], nonzero=bool(lo > 0.0 or hi < 0.0))
+            entry.update(coefficient=written(fit.values[at[term.name]]),
+                         ci95=[written(lo), written(hi)], nonzero=bool(lo > 0.0 or hi < 0.0))
             if term.name != 'line_compliance' and abs(samples.correlation) > LAG_CORRELATION:
                 entry['note'] = (f"the two lags' regressors correlate (r = "
                                  f'{samples.correlation:.4f}): the data determine tau_n - '
@@ -542,10 +542,6 @@ def dynamics_summary(fit: FitReport, samples: Samples) -> list[dict[str, Any]]:
             entry['left_out'] = reasons.get(term.name, 'not fitted')
         out.append(entry)
     return out
-
-
-def _sig(x: float) -> float:
-    return float(f'{float(x):.5g}')
 
 
 def variance_inflation(residual: FloatArray) -> float:
