@@ -8,7 +8,9 @@ channel costs one build). Effects that add a loss to Q_vl (``channel:`` and
 ``term:``) are solved with eq. (36) by a bracketed root search on Python
 floats whose residual is checked like every other solve of the model. Every
 array map with effects is the single-point path applied element by element,
-so the two agree exactly.
+so the two agree exactly. A point that evaluates a calibrated effect outside
+the data it was fitted on is flagged EXTRAPOLATED
+(:func:`~satmotor_ros.model.screening.outside_fitted`).
 """
 
 from __future__ import annotations
@@ -26,7 +28,7 @@ from satmotor_ros.model.errors import ConfigError, InvalidInputError, ModelError
 from satmotor_ros.model.point import invalid_point
 from satmotor_ros.model.results import (COMPONENTS, describe_status, INVALID, LossBreakdown,
                                         OperatingPoints, Point, PointStatus)
-from satmotor_ros.model.screening import CHECK, FLOW_ATOL
+from satmotor_ros.model.screening import CHECK, fitted_bounds, FLOW_ATOL, outside_fitted
 from satmotor_ros.model.solve import solve_increasing_scalar, Tolerance, with_secant_slope
 
 Channels = Mapping[str, float]
@@ -36,6 +38,7 @@ _EXPANSIONS = 60
 _INVALID_FLAGS = int(INVALID)
 _STALLED = int(PointStatus.STALLED)
 _CHANNEL_LIMITED = int(PointStatus.CHANNEL_LIMITED)
+_EXTRAPOLATED = int(PointStatus.EXTRAPOLATED)
 _SCREENED = int(PointStatus.NOT_FINITE | PointStatus.NEGATIVE | PointStatus.BEYOND_LIMIT)
 
 
@@ -63,8 +66,10 @@ class ConditionedModel:
 
     def __init__(self, core: ModelCore) -> None:
         """Sort the effects by what they do and keep the motor without them."""
-        motor = [(kind_of(e), e) for e in core.coefficient_set.effects]
-        motor = [(kind, e) for kind, e in motor if not kind.sensor]
+        every = [(kind_of(e), e) for e in core.coefficient_set.effects]
+        motor = [(kind, e) for kind, e in every if not kind.sensor]
+        self._fitted = tuple((kind.reverse, fitted_bounds(e.fitted_range)) for kind, e in every
+                             if e.fitted_range)  # (only backwards, bounds): empty when none
         self.channels = tuple(sorted({e.channel for _, e in motor if e.channel}))
         self._conditioning = tuple((kind, e) for kind, e in motor if e.channel)
         self._terms = tuple(f for f in (kind.loss(e) for kind, e in motor if not kind.reverse)
@@ -192,6 +197,17 @@ class ConditionedModel:
 
     # -- maps ------------------------------------------------------------------------------
 
+    def _flag_fitted(self, point: Point, channels: Channels | None, reverse: bool) -> Point:
+        """Return `point` flagged EXTRAPOLATED where it reads an effect outside its data."""
+        if point.status & _INVALID_FLAGS:
+            return point
+        values = {**(channels or {}), 'flow': point.flow, 'speed': point.speed,
+                  'dp_i': point.dp_i}
+        if any(outside_fitted(bounds, values) for backwards, bounds in self._fitted
+               if reverse or not backwards):
+            return point._replace(status=point.status | _EXTRAPOLATED)
+        return point
+
     def speed_point(self, flow: float, dp: float, port: bool, p_ex: float,
                     channels: Channels | None, reverse: bool = False) -> Point:
         """
@@ -219,6 +235,11 @@ class ConditionedModel:
             The operating point; Q_vl holds the effects' extra loss.
 
         """
+        point = self._speed(flow, dp, port, p_ex, channels, reverse)
+        return self._flag_fitted(point, channels, reverse) if self._fitted else point
+
+    def _speed(self, flow: float, dp: float, port: bool, p_ex: float,
+               channels: Channels | None, reverse: bool) -> Point:
         model, p_ex, constant, status = self.conditions(channels, p_ex)
         if model is None:
             return invalid_point(status)
@@ -292,6 +313,12 @@ class ConditionedModel:
             The operating point; Q and Q_vl hold the effects' extra loss.
 
         """
+        point = self._absorbency(speed, dp, port, p_ex, flow_guess, channels, reverse)
+        return self._flag_fitted(point, channels, reverse) if self._fitted else point
+
+    def _absorbency(self, speed: float, dp: float, port: bool, p_ex: float,
+                    flow_guess: float | None, channels: Channels | None,
+                    reverse: bool) -> Point:
         model, p_ex, constant, status = self.conditions(channels, p_ex)
         if model is None:
             return invalid_point(status)

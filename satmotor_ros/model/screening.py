@@ -335,3 +335,58 @@ def flag_extrapolated(derived: DerivedCoefficients, speed: FloatArray, dp_i: Flo
                        | (speed < d.speed_min))
         if outside.any():
             status |= outside * np.uint8(PointStatus.EXTRAPOLATED)
+
+
+FITTED_TOLERANCE = 0.05
+"""
+Share of a fitted range's span a calibrated effect may be evaluated beyond before its point is
+EXTRAPOLATED, [-] (of the value itself where the data held one value only).
+"""
+
+Bounds = tuple[tuple[str, float, float], ...]
+"""(quantity, lowest, highest) a calibrated effect may be evaluated at, SI."""
+
+
+def fitted_bounds(fitted_range: Bounds) -> Bounds:
+    """
+    Widen an effect's fitted range by :data:`FITTED_TOLERANCE` on each side.
+
+    Parameters
+    ----------
+    fitted_range : tuple of (str, float, float)
+        (quantity, min, max) of the data the effect was fitted on, SI, [-]
+
+    Returns
+    -------
+    tuple of (str, float, float)
+        The bounds :func:`outside_fitted` holds a point against.
+
+    """
+    out = []
+    for quantity, low, high in fitted_range:
+        slack = FITTED_TOLERANCE * ((high - low) or max(abs(low), abs(high)))
+        out.append((quantity, low - slack, high + slack))
+    return tuple(out)
+
+
+def outside_fitted(bounds: Bounds, values: dict[str, float]) -> bool:
+    """
+    Say whether a point evaluates a calibrated effect outside the data it was fitted on.
+
+    The one check of fitted ranges: the scalar point path and the array maps (which run
+    the point path element by element when the set has effects) both call it.
+
+    Parameters
+    ----------
+    bounds : tuple of (str, float, float)
+        From :func:`fitted_bounds`, [-]
+    values : dict of str to float
+        The point's ``dp_i``, ``speed``, ``flow`` (magnitudes) and channels, SI, [-]
+
+    Returns
+    -------
+    bool
+        True where any quantity lies outside its bounds (or is NaN).
+
+    """
+    return not all(low <= values[quantity] <= high for quantity, low, high in bounds)

@@ -29,6 +29,13 @@ defines ``KIND = MyKind()`` (doc/effects.md). The kinds shipped:
 Sensor effects describe the instruments, not the motor: the model's maps take
 the true flow and return the true speed, and :func:`true_flow` and
 :func:`true_speed` convert readings.
+
+An effect that a calibration fitted carries ``fitted_range``: the least and
+largest value of each quantity its law reads (:meth:`EffectKind.reads`) over
+the data it was fitted on (:func:`measured_range`). The model flags a point
+EXTRAPOLATED where it evaluates the effect outside that range
+(:func:`satmotor_ros.model.screening.outside_fitted`); an effect without one (a
+hand-written file) is never flagged for it.
 """
 
 from __future__ import annotations
@@ -36,10 +43,13 @@ from __future__ import annotations
 from collections.abc import Iterable, Mapping
 from dataclasses import replace
 import importlib
+import math
 import pkgutil
 from typing import Any, TYPE_CHECKING
 
-from satmotor_ros.model._typing import Real
+import numpy as np
+
+from satmotor_ros.model._typing import FloatArray, Real
 from satmotor_ros.model.effects._base import (Candidate, CandidateData, Conditions,
                                               CORE_CHANNELS, DOCUMENTARY, Effect, EffectKind,
                                               KINDS, Modifier, PlantInjection, PlantParameter,
@@ -141,6 +151,10 @@ def kind_of(effect: Effect) -> EffectKind:
     return kind
 
 
+FITTED_RANGE = 'fitted_range'
+"""The YAML key of an effect's fitted range: ``{quantity: [min, max]}``, SI (degC)."""
+
+
 def _known() -> str:
     return ', '.join(f'{k.name}:<name>' if k.suffixed else k.name for k in ranked())
 
@@ -167,7 +181,9 @@ def effect_from_mapping(name: Any, doc: Any, where: str) -> Effect:
     ------
     ConfigError
         Naming the key and the value for an unknown kind, key, regressor or law,
-        a missing key, or a value that is not a finite number.
+        a missing key, a value that is not a finite number, or a ``fitted_range``
+        that does not give [min, max] with min <= max for exactly the quantities
+        the effect reads.
 
     """
     name = str(name)
@@ -180,14 +196,74 @@ def effect_from_mapping(name: Any, doc: Any, where: str) -> Effect:
     if not isinstance(doc, Mapping):
         msg = f'{where} must be a mapping, got {type(doc).__name__}: {doc!r}'
         raise ConfigError(msg)
-    unknown = sorted(set(map(str, doc)) - set(kind.keys) - set(DOCUMENTARY))
+    unknown = sorted(set(map(str, doc)) - set(kind.keys) - set(DOCUMENTARY) - {FITTED_RANGE})
     missing = [k for k in kind.required if k not in doc]
     if unknown or missing:
         what = (f'unknown key(s) {", ".join(unknown)}' if unknown
                 else f'missing key(s) {", ".join(missing)}')
-        msg = f'{where} has {what} (known: {", ".join(kind.keys)})'
+        msg = f'{where} has {what} (known: {", ".join((*kind.keys, FITTED_RANGE))})'
         raise ConfigError(msg)
-    return kind.parse(name, {k: v for k, v in doc.items() if k in kind.keys}, where)
+    effect = kind.parse(name, {k: v for k, v in doc.items() if k in kind.keys}, where)
+    if FITTED_RANGE not in doc:
+        return effect
+    return replace(effect, fitted_range=_fitted_range(doc[FITTED_RANGE], kind.reads(effect),
+                                                      f'{where}.{FITTED_RANGE}'))
+
+
+def _fitted_range(doc: Any, quantities: tuple[str, ...],
+                  where: str) -> tuple[tuple[str, float, float], ...]:
+    """Read ``{quantity: [min, max]}``: exactly the quantities the law reads, min <= max."""
+    if not isinstance(doc, Mapping):
+        msg = f'{where} must be a mapping of quantity to [min, max], got {type(doc).__name__}'
+        raise ConfigError(msg)
+    given = set(map(str, doc))
+    if given != set(quantities):
+        extra, lacking = sorted(given - set(quantities)), sorted(set(quantities) - given)
+        what = (f'unknown quantity {", ".join(extra)}' if extra
+                else f'no range for {", ".join(lacking)}')
+        msg = f'{where} has {what} (the effect reads: {", ".join(quantities) or "nothing"})'
+        raise ConfigError(msg)
+    out = []
+    for quantity in quantities:
+        value = doc[quantity]
+        pair = list(value) if isinstance(value, (list, tuple)) else []
+        numbers = [v for v in pair if not isinstance(v, bool) and isinstance(v, (int, float))
+                   and math.isfinite(v)]
+        if len(pair) != 2 or len(numbers) != 2 or not pair[0] <= pair[1]:
+            msg = (f'{where}.{quantity} = {value!r}: expected [min, max], two finite numbers '
+                   'with min <= max')
+            raise ConfigError(msg)
+        out.append((quantity, float(pair[0]), float(pair[1])))
+    return tuple(out)
+
+
+def measured_range(effect: Effect, data: Mapping[str, FloatArray]) -> Effect:
+    """
+    Return `effect` with the range of the data it was fitted on.
+
+    Parameters
+    ----------
+    effect : Effect
+        A fitted effect, [-]
+    data : mapping of str to ndarray
+        The fitted points: ``dp_i``, ``speed`` and ``flow`` (magnitudes, SI) and the
+        channels by name (gauge Pa, degC, s, rev), [-]
+
+    Returns
+    -------
+    Effect
+        `effect` with ``fitted_range`` over the finite values of every quantity
+        :meth:`EffectKind.reads` names (`effect` itself when one has none).
+
+    """
+    out = []
+    for quantity in kind_of(effect).reads(effect):
+        values = np.asarray(data.get(quantity, ()), dtype=float)
+        values = values[np.isfinite(values)]
+        if not values.size:
+            return effect
+        out.append((quantity, float(values.min()), float(values.max())))
+    return replace(effect, fitted_range=tuple(out))
 
 
 def effect_to_mapping(effect: Effect) -> dict[str, Any]:
@@ -202,11 +278,15 @@ def effect_to_mapping(effect: Effect) -> dict[str, Any]:
     Returns
     -------
     dict
-        The block, plain SI numbers and strings, with the kind's ``evaluation``.
+        The block, plain SI numbers and strings, with its ``fitted_range`` when it has
+        one and the kind's ``evaluation``.
 
     """
     kind = kind_of(effect)
-    return {**kind.to_mapping(effect), 'evaluation': kind.evaluation}
+    block = kind.to_mapping(effect)
+    if effect.fitted_range:
+        block[FITTED_RANGE] = {q: [low, high] for q, low, high in effect.fitted_range}
+    return {**block, 'evaluation': kind.evaluation}
 
 
 def check_effects(effects: Iterable[Effect], where: str,
@@ -395,6 +475,6 @@ SENSOR_KINDS = tuple(k.name for k in ranked() if k.sensor)
 __all__ = ['Candidate', 'CandidateData', 'Conditions', 'Effect', 'EffectKind', 'KINDS',
            'Modifier', 'PlantInjection', 'PlantParameter', 'SENSOR_KINDS', 'SensorError',
            'Shape', 'Synthetic', 'build_candidates', 'check_effects', 'effect_from_mapping',
-           'effect_to_mapping', 'flow_reading', 'kind_of', 'plant_injection', 'ranked',
-           'register', 'sensor_error', 'true_flow', 'true_speed', 'unregister',
-           'with_effects']
+           'effect_to_mapping', 'FITTED_RANGE', 'flow_reading', 'kind_of', 'measured_range',
+           'plant_injection', 'ranked', 'register', 'sensor_error', 'true_flow', 'true_speed',
+           'unregister', 'with_effects']

@@ -67,6 +67,8 @@ class Effect:
     reference_viscosity: float = math.nan  # the viscosity there; NaN the liquid's [m^2/s]
     vogel_c: float = 140.0  # Vogel C [K]
     options: tuple[tuple[str, Any], ...] = ()  # further parameters of a new kind, by name
+    fitted_range: tuple[tuple[str, float, float], ...] = ()  # (quantity, min, max) of the data
+    # it was fitted on, SI, one per quantity of EffectKind.reads; () when not known (no flag)
 
     @property
     def kind(self) -> str:
@@ -363,6 +365,21 @@ class EffectKind:
     def loss(self, effect: Effect) -> Loss | None:
         """Return f(n [rad/s], dp_i [Pa]) -> extra loss in Q_vl [m^3/s], or None."""
         return None
+
+    def reads(self, effect: Effect) -> tuple[str, ...]:
+        """
+        Name the quantities the effect's law reads: the keys of its ``fitted_range``.
+
+        ``dp_i`` [Pa] and ``speed`` [rad/s] (magnitudes) for a loss f(n, dp_i),
+        the instrument's channel (``flow`` [m^3/s] or ``speed``) for a sensor
+        error, the regressor's channel (gauge Pa, degC, s, rev) for a kind that
+        reads one.
+        """
+        if self.sensor:
+            return (self.sensor,)
+        if self.reads_channel:
+            return (effect.regressor,)
+        return ('dp_i', 'speed') if self.loss(effect) is not None else ()
 
     def sensor_error(self, effect: Effect) -> SensorError | None:
         """Return what the effect does to an instrument, or None for a motor effect."""

@@ -134,6 +134,10 @@ class Term(EffectKind):
             return k * abs(dp_i) ** a * abs(n) ** b
         return loss
 
+    def reads(self, effect: Effect) -> tuple[str, ...]:
+        """Read dp_i, n or both, as the exponents say."""
+        return tuple(q for q, p in zip(('dp_i', 'speed'), power_of(effect)) if p)
+
     def candidates(self, data: CandidateData) -> tuple[list[Candidate], list[str]]:
         """Offer dp_i^a, n^b and dp_i^a n^b, k the extra loss at the largest dp_i and n."""
         dp = np.abs(data.parts.dp_i) / max(float(np.max(np.abs(data.parts.dp_i))), 1e-300)

@@ -64,6 +64,10 @@ class Threshold(EffectKind):
             return k * np.maximum(abs(dp_i) - x_c, 0.0) ** e
         return loss
 
+    def reads(self, effect: Effect) -> tuple[str, ...]:
+        """Read the chamber drop only."""
+        return ('dp_i',)
+
     def candidates(self, data: CandidateData) -> tuple[list[Candidate], list[str]]:
         """Offer a threshold within the data, with enough points above it, k >= 0."""
         dp = np.abs(data.parts.dp_i)
