@@ -12,10 +12,14 @@ found, an ``effects:`` block that describes it as data::
         regressor: <channel or expression>
         coefficient: <value>        # SI, in `unit`
         unit: <unit>
+        fitted_range:               # the data it was fitted on, per quantity it reads
+          <quantity>: [<min>, <max>]
         ci95: [<low>, <high>]
         ...                         # what the effect needs to be evaluated
 
-Plain numbers are SI (temperature in degC).
+Plain numbers are SI (temperature in degC). Where the model evaluates an
+effect outside its ``fitted_range`` (by more than 5 % of the span) the point
+is flagged EXTRAPOLATED (doc/effects.md).
 """
 
 from __future__ import annotations
@@ -163,6 +167,10 @@ def write_yaml(cal: Calibration, path: str | Path) -> None:
             f'# Fitted factors on the packaged values: {factors}.\n'
             "# Plain numbers are SI (temperature degC); loss coefficients in the paper's "
             'fitting units.\n')
+    if cal.found:
+        head += ('# fitted_range: least and largest value of each quantity an effect reads '
+                 'over the points it was\n# fitted on (dp_i, speed, flow as magnitudes); '
+                 'outside it the model flags EXTRAPOLATED.\n')
     body = yaml.safe_dump(_document(cal), sort_keys=False, allow_unicode=True,
                           width=99)
     Path(path).write_text(head + body, encoding='utf-8')

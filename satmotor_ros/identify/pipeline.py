@@ -26,7 +26,7 @@ from satmotor_ros.identify.table import BenchTable
 from satmotor_ros.identify.transient import (dynamics_summary, Samples, transient_samples,
                                              TransientOptions)
 from satmotor_ros.model import load_motor, MotorModel, MotorSpec
-from satmotor_ros.model.effects import Effect
+from satmotor_ros.model.effects import Effect, measured_range
 from satmotor_ros.model.revolutions import sampled_revolutions
 from satmotor_ros.model.units import LPM
 from satmotor_ros.model.viscosity import standard_law, ViscosityLaw
@@ -94,8 +94,12 @@ class Calibration:
         return self.found[0] if self.found else None
 
     def effects(self) -> tuple[Effect, ...]:
-        """Return the effects found at their fitted values, in order (for the YAML)."""
-        return tuple(e for _, e in self.forward.final.fit.found())
+        """Return the effects found at their fitted values, in order, with their fitted range."""
+        at = self.inliers
+        data = {**self.table.channels, 'p_out': self.table.p_out, 'dp_i': self.parts.dp_i,
+                'speed': self.parts.speed, 'flow': np.abs(self.parts.flow)}
+        data = {k: np.asarray(v)[at] for k, v in data.items() if np.shape(v) == at.shape}
+        return tuple(measured_range(e, data) for _, e in self.forward.final.fit.found())
 
     @property
     def inliers(self) -> np.ndarray:
@@ -115,7 +119,9 @@ class Calibration:
         -------
         list of dict
             effect, regressor, coefficient, ci95, unit, p_value and error_after (of
-            its step); expression and exponents of a term, threshold of a threshold.
+            its step); expression and exponents of a term; fitted_range (min and max
+            of each quantity the effect reads over the inliers it was fitted on, SI);
+            threshold of a threshold.
 
         """
         rows = []
@@ -135,6 +141,9 @@ class Calibration:
                 row['exponents_ci95'] = {
                     s_.name.split()[0]: [written(v) for v in self.final.ci95[position + 1 + j]]
                     for j, s_ in enumerate(candidate.shape)}
+            if effect.fitted_range:
+                row['fitted_range'] = {q: [written(lo), written(hi)]
+                                       for q, lo, hi in effect.fitted_range}
             if effect.kind == 'threshold':
                 row['threshold'] = {'regressor': 'dp', 'value': written(effect.reference),
                                     'unit': 'Pa',
