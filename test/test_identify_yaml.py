@@ -23,7 +23,7 @@ def test_calibrated_yaml_with_its_effect_reproduces_the_data(tmp_path, liquid, e
     calibrated = CalibratedModel.load(path, liquid)
     assert calibrated.effect == (cal.chosen.effect if cal.chosen else 'none')
     channels = {**table.channels, 'p_out': table.p_out}
-    predicted = calibrated.measured_flow(table.speed, channels, dp=table.dp)
+    predicted, _ = calibrated.measured_flow(table.speed, channels, dp=table.dp)
     packaged = MotorModel.default(liquid).absorbency(table.speed, dp=table.dp).flow
     noise = float(np.sqrt(np.mean(plan.noise_lpm(table.flow, cal.model) ** 2)))
     rmse = float(np.sqrt(np.mean((table.flow - predicted) ** 2))) / LPM

@@ -62,7 +62,9 @@ def _validate(data: str, out: str, mode: Mode, options: MotorOptions, columns: s
         summary = write_validation(result, tmp)
     target = Path(out)
     error = summary['error']
+    outside = summary['n_extrapolated']
+    flagged = f' ({outside} flagged EXTRAPOLATED)' if outside else ''
     return (f'{model.name}, set {options.liquid}, effects: {result.describe_effects()}; '
             f'RMSE of Q_vl {error["rmse_lpm"]:.4g} l/min, mean {error["mean_abs_pct"]:.3g} %, '
-            f'max {error["max_abs_lpm"]:.4g} l/min over {summary["n_points"]} points, nothing '
-            f'refitted; wrote {target}/validation.json, report.md, residuals.png')
+            f'max {error["max_abs_lpm"]:.4g} l/min over {summary["n_points"]} points{flagged}, '
+            f'nothing refitted; wrote {target}/validation.json, report.md, residuals.png')

@@ -18,6 +18,8 @@ import numpy as np
 from satmotor_ros.model import load_motor, MotorModel
 from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.effects import flow_reading
+from satmotor_ros.model.results import OperatingPoints
+from satmotor_ros.model.screening import Status
 
 
 class CalibratedModel:
@@ -56,8 +58,8 @@ class CalibratedModel:
         """
         return cls(MotorModel.from_spec(load_motor(path), liquid))
 
-    def absorbency(self, speed: FloatArray, channels: Mapping[str, FloatArray], *,
-                   dp: FloatArray | None = None, dp_i: FloatArray | None = None) -> FloatArray:
+    def points(self, speed: FloatArray, channels: Mapping[str, FloatArray], *,
+               dp: FloatArray | None = None, dp_i: FloatArray | None = None) -> OperatingPoints:
         """
         Compute the flow the motor absorbs, with the physical effects applied.
 
@@ -75,17 +77,17 @@ class CalibratedModel:
 
         Returns
         -------
-        ndarray
-            Flow (NaN where the model flags the point invalid), [m^3/s]
+        OperatingPoints
+            The points (``errors='mask'``: NaN where the model flags a point invalid).
 
         """
         needed = {name: channels[name] for name in self.model.channels}
         return self.model.absorbency(np.asarray(speed, dtype=float), dp=dp, dp_i=dp_i,
-                                     errors='mask', channels=needed).flow
+                                     errors='mask', channels=needed)
 
     def measured_flow(self, speed: FloatArray, channels: Mapping[str, FloatArray], *,
                       dp: FloatArray | None = None,
-                      dp_i: FloatArray | None = None) -> FloatArray:
+                      dp_i: FloatArray | None = None) -> tuple[FloatArray, Status]:
         """
         Compute what the flowmeter reads at a measured speed, sensor effects included.
 
@@ -106,13 +108,16 @@ class CalibratedModel:
 
         Returns
         -------
-        ndarray
-            Flowmeter reading, [m^3/s]
+        reading : ndarray
+            Flowmeter reading (NaN where the point is invalid), [m^3/s]
+        status : ndarray of uint8
+            The model's PointStatus flags per point (EXTRAPOLATED: outside the
+            validated range or an effect's fitted range), [-]
 
         """
-        flow = self.absorbency(self.model.true_speed(np.asarray(speed, dtype=float)), channels,
-                               dp=dp, dp_i=dp_i)
-        return flow_reading(self.model.effects, flow)
+        at = self.points(self.model.true_speed(np.asarray(speed, dtype=float)), channels,
+                         dp=dp, dp_i=dp_i)
+        return flow_reading(self.model.effects, at.flow), at.status
 
     def describe(self) -> list[dict[str, Any]]:
         """

@@ -10,6 +10,9 @@ model's own, effects and instruments included
 (:class:`~satmotor_ros.identify.effects.CalibratedModel`), at the chamber drop
 the calibration uses. A calibration validated on its own data therefore gives
 its in-sample error. Nothing is fitted, so no cross-validation is needed.
+Points the model flags invalid are left out; points it flags EXTRAPOLATED
+(outside its validated range, or an effect evaluated outside the data it was
+fitted on) are kept and counted.
 """
 
 from __future__ import annotations
@@ -29,6 +32,7 @@ from satmotor_ros.identify.table import BenchTable
 from satmotor_ros.identify.transient import averaged, parts_at, Samples
 from satmotor_ros.model import MotorModel
 from satmotor_ros.model._typing import FloatArray
+from satmotor_ros.model.results import PointStatus
 
 
 @dataclass(frozen=True)
@@ -42,7 +46,8 @@ class Validation:
     residual: FloatArray  # measured minus predicted Q_vl [m^3/s]
     error: Errors  # the residual summarised as calibration.json does
     effects: tuple[dict[str, Any], ...]  # the model's effects as loaded
-    flagged: int = 0  # points (rows) left out because the model flags them invalid [-]
+    invalid: int = 0  # points (rows) left out because the model flags them invalid [-]
+    extrapolated: int = 0  # points (rows) kept that the model flags EXTRAPOLATED [-]
 
     def describe_effects(self) -> str:
         """Return the effects' names, comma-separated, or ``'none'``."""
@@ -55,14 +60,18 @@ class Validation:
         Returns
         -------
         dict
-            n_points and error first, then the liquid, motor, effects, source and
-            n_flagged (points or rows left out where the model flags itself invalid).
+            n_points and error first, then the liquid, motor, effects, source,
+            n_flagged (every point or row the model flags), n_invalid (those left
+            out: the model flags them invalid) and n_extrapolated (those kept but
+            flagged EXTRAPOLATED: outside the validated range or an effect's fitted
+            range).
 
         """
         return {'n_points': len(self.parts), 'error': self.error.as_dict(),
                 'liquid': self.liquid, 'motor': self.model.name,
                 'effects': list(self.effects), 'data': self.table.source,
-                'n_flagged': self.flagged}
+                'n_flagged': self.invalid + self.extrapolated, 'n_invalid': self.invalid,
+                'n_extrapolated': self.extrapolated}
 
 
 def _bare(model: MotorModel) -> MotorModel:
@@ -116,7 +125,7 @@ def validate(table: BenchTable, model: MotorModel, liquid: str, mode: Mode = 'au
                                        'model (no flow the model can give, or a chamber '
                                        'drop out of range)')
     calibrated = CalibratedModel(model)
-    predicted = _predicted(calibrated, points, parts)
+    predicted, extrapolated = _predicted(calibrated, points, parts)
     flagged = ~np.isfinite(predicted)
     if flagged.all():
         msg = f'{points.source}: the model flags every point invalid'
@@ -126,14 +135,26 @@ def validate(table: BenchTable, model: MotorModel, liquid: str, mode: Mode = 'au
         points = points.select(keep, f'left out {int(flagged.sum())} points the model flags '
                                      'invalid (its status is not OK there)')
         parts, _ = loss_parts(_bare(model), points)
-        predicted = predicted[keep]
+        predicted, extrapolated = predicted[keep], extrapolated[keep]
+    points = _note_extrapolated(points, int(extrapolated.sum()), 'points')
     residual = parts.flow - predicted
     return Validation(liquid, model, points, parts, residual, Errors.of(residual, parts.loss),
-                      tuple(calibrated.describe()), int(flagged.sum()))
+                      tuple(calibrated.describe()), int(flagged.sum()), int(extrapolated.sum()))
 
 
-def _predicted(calibrated: CalibratedModel, points: BenchTable, parts: LossParts) -> FloatArray:
-    """Predict the flow reading at the points, in each row's frame (as ``parts.flow``)."""
+def _note_extrapolated(points: BenchTable, count: int, what: str) -> BenchTable:
+    """Add a note on the points (or rows) the model flags EXTRAPOLATED, when there are any."""
+    if not count:
+        return points
+    return replace(points, notes=points.notes + (
+        f'{count} {what} flagged EXTRAPOLATED, kept in the error: outside the range the '
+        "model's coefficients were validated on, or where an effect is evaluated outside the "
+        'data it was fitted on (its fitted_range)',))
+
+
+def _predicted(calibrated: CalibratedModel, points: BenchTable,
+               parts: LossParts) -> tuple[FloatArray, np.ndarray]:
+    """Predict the flow reading in each row's frame (as ``parts.flow``); which are EXTRAPOLATED."""
     channels = {**points.channels, 'p_out': points.p_out}
     model = calibrated.model
     missing = [name for name in model.channels if name not in channels]
@@ -142,8 +163,9 @@ def _predicted(calibrated: CalibratedModel, points: BenchTable, parts: LossParts
                f'{model.name} need')
         raise DataError(msg)
     # the model takes the signed row; the parts hold it where its loss runs forward
-    return parts.sign * calibrated.measured_flow(parts.rotation * parts.speed, channels,
-                                                 dp_i=parts.sign * parts.dp_i)
+    flow, status = calibrated.measured_flow(parts.rotation * parts.speed, channels,
+                                            dp_i=parts.sign * parts.dp_i)
+    return parts.sign * flow, (status & int(PointStatus.EXTRAPOLATED)) != 0
 
 
 def _validate_samples(samples: Samples, model: MotorModel, liquid: str) -> Validation:
@@ -159,10 +181,12 @@ def _validate_samples(samples: Samples, model: MotorModel, liquid: str) -> Valid
     keep = raw.select(samples.usable)
     at_samples, _ = loss_parts(_bare(model), keep)
     calibrated = CalibratedModel(model)
-    predicted = np.full(len(raw), np.nan)
-    predicted[samples.usable] = _predicted(calibrated, keep, at_samples)
+    predicted, extrapolated = np.full(len(raw), np.nan), np.zeros(len(raw))
+    predicted[samples.usable], flags = _predicted(calibrated, keep, at_samples)
+    extrapolated[samples.usable] = flags
     residual = samples.parts.flow - averaged(samples, predicted)
     good = np.isfinite(residual)
+    outside = averaged(samples, extrapolated) > 0.0  # a row with any sample flagged
     if not good.any():
         msg = f'{raw.source}: the model flags every sample invalid'
         raise IdentificationError(msg)
@@ -171,7 +195,8 @@ def _validate_samples(samples: Samples, model: MotorModel, liquid: str) -> Valid
         points = points.select(good, f'left out {int((~good).sum())} rows where the model '
                                      'flags a sample invalid')
         parts = parts_at(parts, good)
-    residual = residual[good]
+    residual, outside = residual[good], outside[good]
+    points = _note_extrapolated(points, int(outside.sum()), 'rows')
     if parts.nuisance:
         x = np.column_stack(list(parts.nuisance.values()))
         residual = residual - x @ np.linalg.lstsq(x, residual, rcond=None)[0]
@@ -179,7 +204,7 @@ def _validate_samples(samples: Samples, model: MotorModel, liquid: str) -> Valid
             'the transient terms (' + ', '.join(parts.nuisance) + ') fitted to the residual: '
             'they describe the bench, not the model',))
     return Validation(liquid, model, points, parts, residual, Errors.of(residual, parts.loss),
-                      tuple(calibrated.describe()), int((~good).sum()))
+                      tuple(calibrated.describe()), int((~good).sum()), int(outside.sum()))
 
 
 __all__ = ['Validation', 'validate']
