@@ -2,11 +2,13 @@
 """
 A motor with no YAML: the SM-0,75/25 in any family, or a family's defaults for a displacement.
 
-The liquids (oil and water sets) and the validated range are the packaged
-SM-0,75/25's. A displacement alone gives a geometrically similar motor: module,
-height and commutation diameter scaled by (q/q_SM)^(1/3), clearances kept; the
-coefficients are the family's documented defaults for that displacement
-(:meth:`~satmotor_ros.model.families.Family.default_coefficients`), to be calibrated.
+The liquids (oil and water sets) are the packaged SM-0,75/25's. A displacement
+alone gives a geometrically similar motor: module, height and commutation
+diameter scaled by (q/q_SM)^(1/3), clearances kept; the coefficients are the
+family's documented defaults for that displacement
+(:meth:`~satmotor_ros.model.families.Family.default_coefficients`), to be
+calibrated; its validated range is the SM-0,75/25's carried over by similarity
+(:func:`similar_range`), so points outside it are flagged EXTRAPOLATED.
 """
 
 from __future__ import annotations
@@ -14,7 +16,7 @@ from __future__ import annotations
 from dataclasses import replace
 import math
 
-from satmotor_ros.model.coefficients import MotorGeometry
+from satmotor_ros.model.coefficients import MotorGeometry, ValidRange
 from satmotor_ros.model.config import load_motor, MotorSpec
 from satmotor_ros.model.errors import ConfigError
 from satmotor_ros.model.families import DEFAULT_FAMILY, family_named
@@ -45,6 +47,34 @@ def similar_geometry(base: MotorGeometry, displacement: float) -> MotorGeometry:
     s = (displacement / base.displacement) ** (1.0 / 3.0)
     return replace(base, displacement=displacement, module=base.module * s,
                    height=base.height * s, commutation_diameter=base.commutation_diameter * s)
+
+
+def similar_range(base: ValidRange, scale: float) -> ValidRange:
+    """
+    Carry a motor's validated range over to a geometrically similar one, lengths times `scale`.
+
+    The pressure drops stay: at one pressure the stresses, the clearance deformation of
+    eq. (2) and the pressure-driven leakage per gap height are those of the measured motor.
+    The speeds scale by 1/`scale`: the velocities in the machine (the teeth's, and the flow
+    in the commutation channels, Q/A ~ scale^3 n / scale^2) are ~ scale n, and the inertia,
+    channel and commutation losses were measured over a span of those velocities. The flow
+    range therefore grows as scale^2 ~ q^(2/3) rather than staying that of the measured motor
+    (which would ask a large motor to crawl at a speed ~ 1/q).
+
+    Parameters
+    ----------
+    base : ValidRange
+        The measured motor's range, [-]
+    scale : float
+        Ratio of the lengths, (q/q_base)^(1/3), [-]
+
+    Returns
+    -------
+    ValidRange
+        The drops of `base`, its speeds divided by `scale`.
+
+    """
+    return replace(base, speed_max=base.speed_max / scale, speed_min=base.speed_min / scale)
 
 
 def default_motor(family: str = DEFAULT_FAMILY, displacement: float | None = None) -> MotorSpec:
@@ -88,5 +118,7 @@ def default_motor(family: str = DEFAULT_FAMILY, displacement: float | None = Non
         name = f'{fam.name} motor of {displacement / CM3_PER_REV:.4g} cm^3/rev{DEFAULTS_NOTE}'
     sets = {key: replace(s, coefficients=fam.default_coefficients(s, displacement), effects=())
             for key, s in packaged.sets.items()}
+    scale = (displacement / packaged.geometry.displacement) ** (1.0 / 3.0)
     return MotorSpec(name, similar_geometry(packaged.geometry, displacement),
-                     packaged.valid_range, sets, f'<{fam.name} defaults>', fam.name)
+                     similar_range(packaged.valid_range, scale), sets, f'<{fam.name} defaults>',
+                     fam.name)
