@@ -177,7 +177,7 @@ def test_the_loader_refuses_a_range_that_is_not_a_mapping():
 
 @pytest.fixture(scope='module')
 def calibration(tmp_path_factory):
-    """Calibrate on case pressures of 0.05-0.3 MPa; write coefficients.yaml and calibration.json."""
+    """Calibrate on case pressures of 0.05-0.3 MPa: coefficients.yaml, calibration.json."""
     tmp = tmp_path_factory.mktemp('fitted')
     injection = Injection.realistic('external_leakage', 1.0, 'water')
     plan = Plan(liquid='water', n_points=60, p_case_mpa=(0.05, 0.3))
