@@ -106,7 +106,7 @@ def test_two_effects_are_found_one_after_the_other(tmp_path, liquid, first, seco
     calibrated = CalibratedModel.load(tmp_path / 'coefficients.yaml', liquid)
     assert len(calibrated.model.effects) == 2
     channels = {**table.channels, 'p_out': table.p_out}
-    predicted = calibrated.measured_flow(table.speed, channels, dp=table.dp)
+    predicted, _ = calibrated.measured_flow(table.speed, channels, dp=table.dp)
     assert np.sqrt(np.mean((table.flow - predicted) ** 2)) / LPM < 1.5 * noise
     report = write_report(cal, tmp_path, summary).read_text()
     assert report.count('`+ ') == 0 and '+ `' in report  # the error after each step
