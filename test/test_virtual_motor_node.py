@@ -229,3 +229,32 @@ def test_clock_mode_and_max_speedup_switch_at_run_time(ros):
     assert len(clock) > published
     assert node.set_parameters([Parameter('max_speedup', value=0.0)])[0].successful
     assert pace(0.5) > 3.0
+
+
+def test_lockstep_takes_one_period_per_flow_command(ros):
+    """clock_mode 'lockstep': time advances one period per answer; unanswered ones wait."""
+    context, executor, probe = ros
+    node = _motor(context, executor, clock_mode='lockstep', lockstep_wait=0.3, paused=True)
+    clock = _collect(probe, Clock, '/clock', 10)
+    command = probe.create_publisher(Float64, f'{NAMESPACE}/flow_command', 10)
+    _spin_until(executor, lambda: command.get_subscription_count() > 0)
+    _spin_until(executor, lambda: False, timeout=0.3)
+    assert node.plant.state.time == 0.0 and not clock  # paused: no step, nothing published
+    assert node.set_parameters([Parameter('paused', value=False)])[0].successful
+    # the start and the first period go out at once; then each period waits for its answer
+    assert _spin_until(executor, lambda: len(clock) == 2)
+    for answered in range(1, 51):
+        command.publish(Float64(data=10.0 * LPM))
+        assert _spin_until(executor, lambda: len(clock) == answered + 2)
+    assert node.plant.state.time == pytest.approx(0.51, abs=1e-12)
+    stamps = [c.clock.sec * 1_000_000_000 + c.clock.nanosec for c in clock]
+    assert stamps == [10_000_000 * k for k in range(52)]  # whole periods, none skipped
+    assert node.unanswered_steps == 0
+    assert node.plant.state.speed > 0.0
+    wall0 = time.monotonic()  # no answer: each period is taken after lockstep_wait
+    assert _spin_until(executor, lambda: len(clock) == 54, timeout=3.0)
+    assert time.monotonic() - wall0 == pytest.approx(0.6, abs=0.25)
+    assert node.unanswered_steps == 2
+    assert node.set_parameters([Parameter('paused', value=True)])[0].successful
+    _spin_until(executor, lambda: False, timeout=0.7)
+    assert len(clock) == 54 and node.plant.state.time == pytest.approx(0.53, abs=1e-12)

@@ -53,7 +53,9 @@ def close_loop(bag: Path, liquid: str, effects: dict[str, Any], out: Path) -> li
 
     """
     lines = ['## Closing the loop', '',
-             f'One more run, {liquid} with the model feed-forward, had a plant with '
+             f'One more run, {liquid} with the model feed-forward on an identification '
+             'cycle (nine speed and load points held 4 s each, 300-1200 rpm by 20-80 N*m, '
+             'the way a bench calibrates), had a plant with '
              f'{_injected(effects)}: an effect the motor model does not know (it is in the '
              'virtual motor only), and sensors with the white noise of a bench (standard '
              f'deviations, SI: {_sensors(effects)}). `satmotor calibrate` then read the bag '

@@ -30,6 +30,7 @@ class RunResult(NamedTuple):
     types: dict[str, str]  # topic -> message type
     wall: float  # wall-clock duration of the run [s]
     sim: float  # simulated duration [s]
+    unanswered: int  # lockstep periods taken with no flow command (0: a repeatable run)
 
 
 def write_run_bag(path: Path, messages: dict[str, list[tuple[int, bytes]]],
@@ -356,12 +357,18 @@ def write_report(out: Path, runs: list[RunResult], cycle: Cycle,
                      'commanded flow, while the plant has a pump lag, line compliance '
                      'and shaft inertia.', '',
                      f'![loss breakdown]({losses})', '']
-    runs_table = ['## Runs', '', '| run | simulated [s] | wall [s] | real-time factor | '
-                  'messages | bag |', '| --- | ---: | ---: | ---: | ---: | --- |']
+    runs_table = ['## Runs', '', 'The virtual motor ran in lockstep: each publish period waited '
+                  "for the controller's flow command, so the runs are repeatable message for "
+                  'message (but for the wall times in `/diagnostics`). A period no command '
+                  'answered in time is counted as unanswered; a run with one is not '
+                  'repeatable.', '',
+                  '| run | simulated [s] | wall [s] | real-time factor | messages | '
+                  'unanswered periods | bag |', '| --- | ---: | ---: | ---: | ---: | ---: | --- |']
     for r in runs:
         count = sum(len(v) for v in r.messages.values())
         runs_table.append(f'| {r.liquid} / {r.feedforward} | {r.sim:.1f} | {r.wall:.1f} | '
-                          f'{r.sim / r.wall:.1f} | {count} | `{r.bag.relative_to(out)}` |')
+                          f'{r.sim / r.wall:.1f} | {count} | {r.unanswered} | '
+                          f'`{r.bag.relative_to(out)}` |')
     path = out / 'report.md'
     text = '\n'.join(lines + table + [''] + sections + runs_table + ['', *closing])
     path.write_text(text.rstrip('\n') + '\n', encoding='utf-8')

@@ -3,8 +3,10 @@
 
 from __future__ import annotations
 
+from collections import Counter
 import os
 from pathlib import Path
+import struct
 import time
 from typing import Any, Callable
 
@@ -15,6 +17,7 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock
+from satmotor_ros.cli._common import CliError
 from satmotor_ros.cli._demo_report import RunResult, write_run_bag
 from satmotor_ros.interface import (CHANNELS, CLOCK, DIAGNOSTIC_ARRAY, FLOAT64, MODEL_OUTPUTS,
                                     TOPIC_TYPES)
@@ -32,6 +35,12 @@ _TYPES = {'std_msgs/msg/Float64': Float64, 'sensor_msgs/msg/FluidPressure': Flui
 
 CONTROL_RATE = 100.0
 """Rate of the controller and of the set-point script, [Hz]."""
+
+LOCKSTEP_WAIT = 2.0
+"""Wall time the virtual motor waits for a flow command before it publishes again, [s]."""
+
+DISCOVERY_TIMEOUT = 10.0
+"""Longest wait for the run's nodes to find each other, [s]."""
 
 _RELIABLE = {CHANNELS['flow'].topic, CHANNELS['torque'].topic,
              *(t for t in TOPIC_TYPES if t.startswith(MODEL_OUTPUTS))}
@@ -60,30 +69,113 @@ class Script(Node):
         self._load.publish(Float64(data=segment.load))
 
 
-class Recorder(Node):
-    """Keep every message of the run as serialised CDR, stamped with simulated time."""
+_STAMPED = frozenset({'sensor_msgs/msg/FluidPressure', 'sensor_msgs/msg/JointState',
+                      'sensor_msgs/msg/Temperature', DIAGNOSTIC_ARRAY, CLOCK})
+"""Types whose serialised form starts with a time (a header's stamp or the clock)."""
 
-    def __init__(self, topics: list[tuple[str, str, bool]], sim_time: Callable[[], float],
-                 **kwargs: Any) -> None:
-        """Subscribe raw to every topic, depth 1000 so that nothing is dropped."""
+_TIME = struct.Struct('<iI')
+
+
+def _leading_time(data: bytes) -> int:
+    """
+    Read the time a little-endian CDR message starts with (after its 4-byte encapsulation).
+
+    Parameters
+    ----------
+    data : bytes
+        A serialised message of one of the :data:`_STAMPED` types, [-]
+
+    Returns
+    -------
+    int
+        The time, [ns]
+
+    """
+    sec, nanosec = _TIME.unpack_from(data, 4)
+    return sec * 1_000_000_000 + nanosec
+
+
+class Recorder(Node):
+    """
+    Keep every message of the run as serialised CDR, stamped with simulated time.
+
+    A message with a header (and ``/clock``) is logged at its own stamp; any other at the
+    last ``/clock`` the recorder took before it, as ``ros2 bag record --use-sim-time`` does.
+    The executor serves a node's subscriptions in the order they were made, one message
+    each per wait, and ``/clock`` is made first: with the plant in lockstep, each message
+    is logged at the period it answers whatever order the executor serves the nodes in.
+    """
+
+    def __init__(self, topics: list[tuple[str, str, bool]], **kwargs: Any) -> None:
+        """Subscribe raw to every topic, ``/clock`` first, depth 1000 so nothing is dropped."""
         super().__init__('demo_recorder', **kwargs)
         self.messages: dict[str, list[tuple[int, bytes]]] = {}
         self.types: dict[str, str] = {}
-        self._now = sim_time
-        for name, msgtype, reliable in topics:
+        self._clock_ns = 0
+        for name, msgtype, reliable in sorted(topics, key=lambda t: t[1] != CLOCK):
             qos = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE if reliable
                              else ReliabilityPolicy.BEST_EFFORT)
             key = name if name.startswith('/') else '/' + name
             store = self.messages.setdefault(key, [])
             self.types[key] = msgtype
-            self.create_subscription(_TYPES[msgtype], name, self._keeper(store), qos, raw=True)
+            keep = (self._clock_keeper(store) if msgtype == CLOCK
+                    else self._keeper(store, msgtype in _STAMPED))
+            self.create_subscription(_TYPES[msgtype], name, keep, qos, raw=True)
 
-    def _keeper(self, store: list[tuple[int, bytes]]) -> Callable[[bytes], None]:
-        now = self._now
-
+    def _clock_keeper(self, store: list[tuple[int, bytes]]) -> Callable[[bytes], None]:
         def keep(data: bytes) -> None:
-            store.append((int(round(now() * 1e9)), data))
+            self._clock_ns = _leading_time(data)
+            store.append((self._clock_ns, data))
         return keep
+
+    def _keeper(self, store: list[tuple[int, bytes]],
+                stamped: bool) -> Callable[[bytes], None]:
+        def keep(data: bytes) -> None:
+            store.append((_leading_time(data) if stamped else self._clock_ns, data))
+        return keep
+
+    def until(self, end_ns: int) -> dict[str, list[tuple[int, bytes]]]:
+        """
+        Give the messages logged at or before a time.
+
+        Parameters
+        ----------
+        end_ns : int
+            Last log time kept, [ns]
+
+        Returns
+        -------
+        dict
+            Topic: list of (log time [ns], CDR bytes).
+
+        """
+        return {topic: [m for m in kept if m[0] <= end_ns]
+                for topic, kept in self.messages.items()}
+
+
+def _wait_connected(executor: SingleThreadedExecutor, nodes: list[Node]) -> None:
+    """
+    Spin until every publisher of the run is matched by every subscription on its topic.
+
+    The virtual motor is paused meanwhile, so the run starts only when no node can miss
+    a message: together with the motor's lockstep, this makes a run repeatable.
+
+    Raises
+    ------
+    CliError
+        If the nodes have not found each other within :data:`DISCOVERY_TIMEOUT`.
+
+    """
+    wanted = Counter(sub.topic_name for node in nodes for sub in node.subscriptions)
+    publishers = [pub for node in nodes for pub in node.publishers]
+    deadline = time.monotonic() + DISCOVERY_TIMEOUT
+    while not all(pub.get_subscription_count() >= wanted[pub.topic_name] for pub in publishers):
+        if time.monotonic() > deadline:
+            missing = sorted({pub.topic_name for pub in publishers
+                              if pub.get_subscription_count() < wanted[pub.topic_name]})
+            raise CliError(f'the demo nodes did not find each other within '
+                           f'{DISCOVERY_TIMEOUT:g} s (unmatched: {", ".join(missing)})')
+        executor.spin_once(timeout_sec=0.01)
 
 
 def run_cycle(liquid: str, feedforward: str, cycle: Cycle, effects: dict[str, Any],
@@ -119,7 +211,8 @@ def run_cycle(liquid: str, feedforward: str, cycle: Cycle, effects: dict[str, An
     nodes: list[Node] = []
     try:
         motor = VirtualMotorNode(context=context, namespace=namespace, parameter_overrides=[
-            Parameter('clock_mode', value='sim'), Parameter('liquid', value=liquid),
+            Parameter('clock_mode', value='lockstep'), Parameter('paused', value=True),
+            Parameter('lockstep_wait', value=LOCKSTEP_WAIT), Parameter('liquid', value=liquid),
             Parameter('publish_rate', value=CONTROL_RATE),
             *(Parameter(k, value=v) for k, v in effects.items())])
         sim = [Parameter('use_sim_time', value=True)]
@@ -131,22 +224,24 @@ def run_cycle(liquid: str, feedforward: str, cycle: Cycle, effects: dict[str, An
         predictor = MotorModelNode(context=context, namespace=namespace, parameter_overrides=[
             *sim, Parameter('liquid', value=liquid)])
         script = Script(cycle, context=context, namespace=namespace, parameter_overrides=sim)
-        recorder = Recorder(list(RECORDED), lambda: motor.plant.state.time, context=context,
-                            namespace=namespace)
+        recorder = Recorder(list(RECORDED), context=context, namespace=namespace)
         nodes = [recorder, script, controller, predictor, motor]
         for node in nodes:
             executor.add_node(node)
+        _wait_connected(executor, nodes)
+        motor.set_parameters([Parameter('paused', value=False)])
         label = f'{liquid}/{"ff" if feedforward == "model" else "pi"}'
         start = time.monotonic()
         plant = motor.plant
-        while plant.state.time < cycle.duration:
+        # two periods past the end: every message that answers the last period is in
+        beyond = cycle.duration + 2.0 / CONTROL_RATE
+        while plant.state.time < beyond:
             executor.spin_once(timeout_sec=0.1)
             if progress is not None:
-                progress.show(label, plant.state.time)
-        for _ in range(50):  # let the last messages in
-            executor.spin_once(timeout_sec=0.0)
+                progress.show(label, min(plant.state.time, cycle.duration))
         wall = time.monotonic() - start
-        sim_seconds = plant.state.time
+        sim_seconds = cycle.duration
+        unanswered = motor.unanswered_steps
     finally:
         executor.shutdown()
         for node in nodes:
@@ -154,6 +249,7 @@ def run_cycle(liquid: str, feedforward: str, cycle: Cycle, effects: dict[str, An
         context.try_shutdown()
     if progress is not None:
         progress.run_done(sim_seconds)
-    write_run_bag(bag, recorder.messages, recorder.types)
-    return RunResult(liquid, feedforward, bag, recorder.messages, recorder.types, wall,
-                     sim_seconds)
+    messages = recorder.until(round(cycle.duration * 1e9))
+    write_run_bag(bag, messages, recorder.types)
+    return RunResult(liquid, feedforward, bag, messages, recorder.types, wall, sim_seconds,
+                     unanswered)

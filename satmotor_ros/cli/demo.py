@@ -22,7 +22,7 @@ from satmotor_ros.cli._common import CliError, fail
 from satmotor_ros.cli._output import output_dir
 from satmotor_ros.model.units import LPM, MPA, RPM
 from satmotor_ros.plant.config import parameter_specs, params_from_flat
-from satmotor_ros.plant.scenario import default_cycle
+from satmotor_ros.plant.scenario import default_cycle, identification_cycle
 
 LIQUIDS = ('water', 'oil')
 FEEDFORWARDS = ('model', 'none')
@@ -159,7 +159,7 @@ def command(liquid: str, duration: str, effect: list[str], out: str, quiet: bool
         from satmotor_ros.cli import _demo_report as report
         from satmotor_ros.cli._demo_ros import run_cycle
         runs = []
-        steps = (len(liquids) * len(FEEDFORWARDS) + (loop is not None)) * cycle.duration
+        steps = (len(liquids) * len(FEEDFORWARDS) + 1.5 * (loop is not None)) * cycle.duration
         progress = None if quiet else Progress(steps)
         with output_dir('--out', out, 'demo', (), force) as out_dir:
             for q in liquids:
@@ -170,13 +170,19 @@ def command(liquid: str, duration: str, effect: list[str], out: str, quiet: bool
             if loop is not None:
                 from satmotor_ros.cli._demo_loop import close_loop
                 bag = out_dir / 'bags' / f'{liquids[0]}_model_loop'
-                run_cycle(liquids[0], 'model', cycle, loop, bag, progress)
+                run_cycle(liquids[0], 'model', identification_cycle().scaled(1.5 * seconds),
+                          loop, bag, progress)
                 section = close_loop(bag, liquids[0], loop, out_dir)
             if progress is not None:
                 progress.done()
             report.write_report(out_dir, runs, cycle, effects, section)
     except (CliError, OSError) as err:
         return fail(err)
+    late = [f'{r.liquid}/{r.feedforward}' for r in runs if r.unanswered]
+    if late:
+        print(f'satmotor demo: warning: the controller missed periods in {", ".join(late)} '
+              '(a busy machine): those runs are not repeatable; see report.md',
+              file=sys.stderr)
     path, bags = Path(out) / 'report.md', Path(out) / 'bags'
     wall = sum(r.wall for r in runs)
     sim = sum(r.sim for r in runs)

@@ -172,21 +172,22 @@ class SpeedControllerNode(Node):
             self._p_out = msg.fluid_pressure
 
     def _control(self) -> None:
+        # every tick publishes: the new command, or the held one when there is no fresh
+        # measurement yet (a plant in lockstep takes each period's command as its answer)
         now = self.get_clock().now()
         last, self._last_time = self._last_time, now
         if last is None or self.speed is None or self._speed_time is None:
+            self._pub.publish(Float64(data=self.command))
             return
         dt = (now - last).nanoseconds * 1e-9
         stale = (now - self._speed_time).nanoseconds * 1e-9 > self.values['measurement_timeout']
-        if dt <= 0.0 or stale:
-            self._diagnose(now, stale)
-            return
-        dp = self._p_in - self._p_out
-        try:
-            self.command = self.law.update(self.setpoint, self.speed,
-                                           dp if math.isfinite(dp) else 0.0, dt)
-        except PlantError as err:  # cannot happen with the checks above; never die on it
-            self._refuse(str(err))
+        if dt > 0.0 and not stale:
+            dp = self._p_in - self._p_out
+            try:
+                self.command = self.law.update(self.setpoint, self.speed,
+                                               dp if math.isfinite(dp) else 0.0, dt)
+            except PlantError as err:  # cannot happen with the checks above; never die on it
+                self._refuse(str(err))
         self._pub.publish(Float64(data=self.command))
         self._diagnose(now, stale)
 

@@ -10,8 +10,13 @@ with sensor-data QoS, and ``/diagnostics``. All physics is in :mod:`satmotor_ros
 
 ``clock_mode`` ``wall`` steps the plant with the wall clock; ``sim`` steps it as fast as
 possible (or ``max_speedup`` times real time) and publishes ``/clock``, so every other
-node runs on ``use_sim_time``. A negative command feeds port B and turns the shaft
-backwards (doc/quadrants.md); a bad command (NaN, beyond ``max_flow_command`` either way)
+node runs on ``use_sim_time``. ``lockstep`` is ``sim`` where each publish period waits
+for a ``flow_command`` that answers it: simulated time advances one period per command,
+so a controller on ``use_sim_time`` runs at its full rate however fast the machine is,
+and a run is repeatable. A period no command answers within ``lockstep_wait`` seconds of
+wall time is taken anyway (counted as ``unanswered_steps`` in the diagnostics). A negative
+command feeds port B and turns the shaft backwards (doc/quadrants.md); a bad command (NaN,
+beyond ``max_flow_command`` either way)
 is refused: the last good one is held, the reason logged and put on ``/diagnostics``.
 """
 
@@ -46,10 +51,16 @@ from satmotor_ros.plant.load import LOAD_KINDS
 from sensor_msgs.msg import FluidPressure, JointState, Temperature
 from std_msgs.msg import Float64
 
+CLOCK_MODES = ('wall', 'sim', 'lockstep')
+"""How the plant's time runs (``clock_mode``)."""
+
 NODE_PARAMETERS: tuple[ParamSpec, ...] = (
     *params.MOTOR_PARAMETERS,
-    ParamSpec('clock_mode', 'wall', "'wall' (real time) or 'sim' (fast, publishes /clock)",
-              choices=('wall', 'sim')),
+    ParamSpec('clock_mode', 'wall', "'wall' (real time), 'sim' (fast, publishes /clock) or "
+              "'lockstep' (sim, one publish period per flow_command)", choices=CLOCK_MODES),
+    ParamSpec('paused', False, 'hold the plant: no step is taken and nothing is published'),
+    ParamSpec('lockstep_wait', 0.5, 'lockstep: wall time after which a period no '
+              'flow_command answers is taken anyway', 's', 0.001, 60.0),
     ParamSpec('max_speedup', 0.0, 'sim mode: at most this many times real time; 0: as fast '
               'as possible', '-', 0.0, 1.0e6),
     ParamSpec('publish_rate', 100.0, 'rate of the sensor topics', 'Hz', 1.0, 1000.0),
@@ -114,7 +125,7 @@ class Setup:
 
         """
         self.values = values
-        for name, allowed in (('clock_mode', ('wall', 'sim')), ('load.kind', tuple(LOAD_KINDS))):
+        for name, allowed in (('clock_mode', CLOCK_MODES), ('load.kind', tuple(LOAD_KINDS))):
             if values[name] not in allowed:
                 msg = f'{name} = {values[name]!r}: use one of {", ".join(allowed)}'
                 raise ValueError(msg)
@@ -153,6 +164,7 @@ class VirtualMotorNode(Node):
         self._command = 0.0
         self._load_torque: float | None = None
         self.rejected = 0
+        self.unanswered_steps = 0  # lockstep periods taken without a flow command
         self.last_rejection = ''
         self._rejected_since_diagnostics = 0
         # The publishers go without rclpy's default QoS-event handlers: each adds two
@@ -180,6 +192,8 @@ class VirtualMotorNode(Node):
         self.create_subscription(Float64, CHANNELS['torque'].topic, self._on_load, 10)
         self._steady = Clock(clock_type=ClockType.STEADY_TIME)
         self._driver: Timer | GuardCondition | None = None
+        self._lockstep_timer: Timer | None = None
+        self._awaiting, self._published_at = False, 0.0
         self._start_stepping()
 
     # -- parameters --------------------------------------------------------------------
@@ -211,7 +225,8 @@ class VirtualMotorNode(Node):
         self.plant.load = setup.load
         self._setup = setup
         if any(setup.values[k] != old.values[k]
-               for k in ('clock_mode', 'max_speedup', 'publish_rate', 'step')):
+               for k in ('clock_mode', 'max_speedup', 'publish_rate', 'step', 'lockstep_wait',
+                         'paused')):
             self._start_stepping()
 
     # -- inputs ------------------------------------------------------------------------
@@ -231,8 +246,9 @@ class VirtualMotorNode(Node):
             problem = f'flow command {value!r} m^3/s is beyond max_flow_command = +-{limit!r}'
         if problem is not None:
             self._refuse(problem)
-            return
-        self._command = value
+        else:
+            self._command = value
+        self._answered()  # a refused command answers the step too: the last good one holds
 
     def _on_load(self, msg: Float64) -> None:
         value = msg.data
@@ -249,14 +265,33 @@ class VirtualMotorNode(Node):
             self.destroy_timer(self._driver)
         elif self._driver is not None:
             self.destroy_guard_condition(self._driver)
+        if self._lockstep_timer is not None:
+            self.destroy_timer(self._lockstep_timer)
+            self._lockstep_timer = None
         values = self._setup.values
         self._steps_per_publish = max(1, round(1.0 / (values['publish_rate']
                                                       * self.plant.params.step)))
         period = self._steps_per_publish * self.plant.params.step
-        self._sim = values['clock_mode'] == 'sim'
+        self._sim = values['clock_mode'] in ('sim', 'lockstep')
+        self._awaiting = False
+        if values['paused']:
+            self._driver = None
+            return
         self._wall_start = time.monotonic() - self.plant.state.time
         self._next_diagnostics = self.plant.state.time
         self._ticks_wall = (time.monotonic(), self.plant.state.time)
+        if values['clock_mode'] == 'lockstep':
+            # the start is published first (nodes on sim time take their clock from it, so
+            # that their timers do not see the first step as a jump), and the first period
+            # runs at once: a controller first acts one period after the start; every later
+            # period waits for the command that answers it
+            self._driver = self.create_guard_condition(self._tick)
+            self._lockstep_timer = self.create_timer(
+                values['lockstep_wait'] / 4, self._step_unanswered, clock=self._steady)
+            self._publish_state()
+            self._awaiting = False
+            self._driver.trigger()
+            return
         if self._sim and values['max_speedup'] == 0.0:
             # as fast as possible: a guard condition the tick re-triggers, so the executor
             # serves every other callback between ticks; a zero-period timer would do the
@@ -267,6 +302,26 @@ class VirtualMotorNode(Node):
         if self._sim:
             period /= values['max_speedup']
         self._driver = self.create_timer(period, self._tick, clock=self._steady)
+
+    def _answered(self) -> None:
+        """Take the next lockstep step: a flow command answered the period."""
+        if self._awaiting and isinstance(self._driver, GuardCondition):
+            self._awaiting = False
+            self._driver.trigger()
+
+    def _step_unanswered(self) -> None:
+        """Lockstep and no command within ``lockstep_wait``: take the step anyway."""
+        if self._awaiting and time.monotonic() - self._published_at >= \
+                self._setup.values['lockstep_wait']:
+            self.unanswered_steps += 1
+            self._answered()
+
+    def _publish_state(self) -> None:
+        self._publish()  # the sensors first, then the clock that makes a controller act on them
+        self._clock_msg.clock = _stamp(self.plant.state.time)
+        self._clock_pub.publish(self._clock_msg)
+        self._awaiting = True
+        self._published_at = time.monotonic()
 
     def _free_tick(self) -> None:
         self._tick()
@@ -286,6 +341,9 @@ class VirtualMotorNode(Node):
         step = plant.step
         for _ in range(steps):
             step(command, load)
+        if self._lockstep_timer is not None:
+            self._publish_state()
+            return
         if self._sim:
             self._clock_msg.clock = _stamp(plant.state.time)
             self._clock_pub.publish(self._clock_msg)
@@ -347,6 +405,7 @@ class VirtualMotorNode(Node):
             'flow_command [m^3/s]': self._command,
             'load_torque [N*m]': 'profile' if self._load_torque is None else self._load_torque,
             'rejected_inputs': self.rejected, 'last_rejection': self.last_rejection,
+            'unanswered_steps': self.unanswered_steps,
             'relief_flow [m^3/s]': flows.relief,
             'model_status': describe_status(plant.model_status),
             'model_rebuilds': plant.rebuilds, 'liquid': plant.model.liquid.name,

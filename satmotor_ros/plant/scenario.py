@@ -101,6 +101,24 @@ def default_cycle() -> Cycle:
     return Cycle(tuple(Segment(d, n * RPM, load) for d, n, load in rows))
 
 
+def identification_cycle() -> Cycle:
+    """
+    Give a bench's identification cycle: 9 steady points, 300-1200 rpm by 20-80 N*m, 36 s.
+
+    Each speed is held while the load steps up, so every point of the grid is a steady
+    window of its own: what a calibration needs to tell the losses apart, where the
+    tracking cycle of :func:`default_cycle` has too few distinct points.
+
+    Returns
+    -------
+    Cycle
+        The cycle.
+
+    """
+    return Cycle(tuple(Segment(4.0, n * RPM, load) for n in (300.0, 750.0, 1200.0)
+                       for load in (20.0, 50.0, 80.0)))
+
+
 class StepMetrics(NamedTuple):
     """Tracking quality after one set-point step."""
 
