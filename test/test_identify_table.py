@@ -54,11 +54,21 @@ def test_table_reads_hydraulic_units(tmp_path):
     ('speed [rpm],flow [l/min],p_in [MPa],p_out [MPa],flow [l/min]\n1,2,3,4,5\n',
      "column 'flow' appears 2 times"),
     ('', 'is empty'),
+    ('speed [rpm] x,flow [l/min],p_in [MPa],p_out [MPa]\n1,2,3,4\n',
+     'column 1 header .*expected "name \\[unit\\]"'),
+    ('[rpm],flow [l/min],p_in [MPa],p_out [MPa]\n1,2,3,4\n', 'column 1 header'),
 ])
 def test_table_errors_are_one_line_naming_the_column(tmp_path, text, match):
     with pytest.raises(DataError, match=match) as info:
         read_csv(_write(tmp_path, text))
     assert '\n' not in str(info.value)
+
+
+def test_table_takes_units_in_parentheses_as_a_log_does(tmp_path):
+    """One header rule for tables and logs: ``flow (l/min)`` is ``flow [l/min]``."""
+    text = 'speed (rpm),flow (l/min),p_in (MPa),p_out [MPa]\n600,20,10,0.5\n'
+    table = read_csv(_write(tmp_path, text))
+    assert table.units['flow'] == 'l/min' and table.flow[0] == pytest.approx(20 / 60000)
 
 
 def test_table_keeps_extra_columns_even_with_units_it_does_not_know(tmp_path):

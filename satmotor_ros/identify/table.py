@@ -6,12 +6,11 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-import re
 
 import numpy as np
 
 from satmotor_ros.identify.errors import DataError
-from satmotor_ros.identify.textfile import read_cells, shorten
+from satmotor_ros.identify.textfile import read_cells, shorten, split_unit
 from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.errors import UnitError
 from satmotor_ros.model.units import (ATMOSPHERE, kinds, pressure_reference, RPM, to_si,
@@ -59,9 +58,6 @@ _EXTRA_UNITS = {('pressure', 'mbar'): 100.0,
                 ('flow', 'm3/s'): 1.0, ('flow', 'm³/s'): 1.0, ('flow', 'l/h'): 1.0e-3 / 3600.0,
                 ('speed', '1/min'): RPM, ('speed', 'min^-1'): RPM, ('time', 'h'): 3600.0}
 """Spellings accepted beyond :mod:`satmotor_ros.model.units` (scale to SI)."""
-
-_HEADER = re.compile(r'^\s*([^\[\]]*?)\s*(?:\[\s*([^\[\]]*?)\s*\])?\s*$')
-
 
 @dataclass(frozen=True)
 class BenchTable:
@@ -210,13 +206,11 @@ def parse_header(header: list[str]) -> list[tuple[str, str]]:
     """
     columns = []
     for i, cell in enumerate(header):
-        match = _HEADER.match(cell)
-        if match is None or not match.group(1):
+        name, unit = split_unit(cell)
+        if not name or '[' in name or ']' in name:
             msg = f'column {i + 1} header {shorten(cell)!r}: expected "name [unit]"'
             raise DataError(msg)
-        name = match.group(1)
-        columns.append((name.lower() if name.lower() in KNOWN_KINDS else name,
-                        match.group(2) or ''))
+        columns.append((name.lower() if name.lower() in KNOWN_KINDS else name, unit))
     names = [name for name, _ in columns]
     for name in names:
         if names.count(name) > 1:
