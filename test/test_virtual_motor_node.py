@@ -234,8 +234,10 @@ def test_clock_mode_and_max_speedup_switch_at_run_time(ros):
 def test_lockstep_takes_one_period_per_flow_command(ros):
     """clock_mode 'lockstep': time advances one period per answer; unanswered ones wait."""
     context, executor, probe = ros
-    node = _motor(context, executor, clock_mode='lockstep', lockstep_wait=0.3, paused=True)
+    node = _motor(context, executor, clock_mode='lockstep', lockstep_wait=0.3, paused=True,
+                  diagnostics_period=0.01)
     clock = _collect(probe, Clock, '/clock', 10)
+    diagnostics = _collect(probe, DiagnosticArray, '/diagnostics', 10)
     command = probe.create_publisher(Float64, f'{NAMESPACE}/flow_command', 10)
     _spin_until(executor, lambda: command.get_subscription_count() > 0)
     _spin_until(executor, lambda: False, timeout=0.3)
@@ -255,6 +257,14 @@ def test_lockstep_takes_one_period_per_flow_command(ros):
     assert _spin_until(executor, lambda: len(clock) == 54, timeout=3.0)
     assert time.monotonic() - wall0 == pytest.approx(0.6, abs=0.25)
     assert node.unanswered_steps == 2
+    assert _spin_until(executor, lambda: any('lockstep' in st.message for d in diagnostics
+                                             for st in d.status))
+    warned = [st.message for d in diagnostics for st in d.status
+              if st.level == DiagnosticStatus.WARN]
+    assert '1 lockstep period(s) taken with no flow_command within lockstep_wait' in warned
+    answered_time = [d for d in diagnostics if d.header.stamp.nanosec <= 510_000_000]
+    assert answered_time and all(st.level == DiagnosticStatus.OK for d in answered_time
+                                 for st in d.status)
     assert node.set_parameters([Parameter('paused', value=True)])[0].successful
     _spin_until(executor, lambda: False, timeout=0.7)
     assert len(clock) == 54 and node.plant.state.time == pytest.approx(0.53, abs=1e-12)

@@ -165,6 +165,7 @@ class VirtualMotorNode(Node):
         self._load_torque: float | None = None
         self.rejected = 0
         self.unanswered_steps = 0  # lockstep periods taken without a flow command
+        self._unanswered_reported = 0
         self.last_rejection = ''
         self._rejected_since_diagnostics = 0
         # The publishers go without rclpy's default QoS-event handlers: each adds two
@@ -393,8 +394,13 @@ class VirtualMotorNode(Node):
             level = 1
             message = f'refused {self._rejected_since_diagnostics} input(s): ' \
                       f'{self.last_rejection}'
+        elif self.unanswered_steps > self._unanswered_reported:
+            level = 1
+            message = f'{self.unanswered_steps - self._unanswered_reported} lockstep ' \
+                      'period(s) taken with no flow_command within lockstep_wait'
         elif flows.relief > 0.0:
             level, message = 1, 'relief valve open'
+        self._unanswered_reported = self.unanswered_steps
         if plant.invalid_points:
             level = 2
             message = f'model refused {plant.invalid_points} point(s): ' \
