@@ -59,6 +59,7 @@ _EXTRA_UNITS = {('pressure', 'mbar'): 100.0,
                 ('speed', '1/min'): RPM, ('speed', 'min^-1'): RPM, ('time', 'h'): 3600.0}
 """Spellings accepted beyond :mod:`satmotor_ros.model.units` (scale to SI)."""
 
+
 @dataclass(frozen=True)
 class BenchTable:
     """
