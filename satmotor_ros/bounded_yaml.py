@@ -25,6 +25,15 @@ class YamlLimitError(ValueError):
     """A YAML file is malformed or exceeds a cap; the message is one line without the document."""
 
 
+def _too_deep() -> YamlLimitError:
+    return YamlLimitError(f'nesting deeper than {YAML_MAX_DEPTH} levels '
+                          '(the cap SATMOTOR_YAML_MAX_DEPTH)')
+
+
+def _too_large() -> YamlLimitError:
+    return YamlLimitError(f'larger than {YAML_MAX_BYTES} bytes (the cap SATMOTOR_YAML_MAX_BYTES)')
+
+
 class _BoundedLoader(yaml.SafeLoader):
     """A safe loader that counts depth and expanded size while it composes."""
 
@@ -36,7 +45,7 @@ class _BoundedLoader(yaml.SafeLoader):
     def compose_node(self, parent: Any, index: Any) -> Any:
         self._depth += 1
         if self._depth > YAML_MAX_DEPTH:
-            raise YamlLimitError(f'nesting deeper than {YAML_MAX_DEPTH} levels')
+            raise _too_deep()
         try:
             node = super().compose_node(parent, index)
         finally:
@@ -46,7 +55,8 @@ class _BoundedLoader(yaml.SafeLoader):
     def compose_document(self) -> Any:
         node = super().compose_document()
         if node is not None and self._expanded(node) > YAML_MAX_NODES:
-            raise YamlLimitError(f'aliases expand to more than {YAML_MAX_NODES} nodes')
+            raise YamlLimitError(f'aliases expand to more than {YAML_MAX_NODES} nodes '
+                                 '(the cap SATMOTOR_YAML_MAX_NODES)')
         return node
 
     def _expanded(self, node: Any) -> int:
@@ -104,7 +114,7 @@ def parse_yaml(text: str) -> Any:
 
     """
     if len(text) > YAML_MAX_BYTES:
-        raise YamlLimitError(f'larger than {YAML_MAX_BYTES} bytes')
+        raise _too_large()
     loader = None
     try:
         loader = _BoundedLoader(text)  # its reader refuses control characters here
@@ -115,7 +125,7 @@ def parse_yaml(text: str) -> Any:
         where = f'line {mark.line + 1}: ' if mark is not None else ''
         raise YamlLimitError(f'not valid YAML ({where}{problem})') from None
     except RecursionError:
-        raise YamlLimitError(f'nesting deeper than {YAML_MAX_DEPTH} levels') from None
+        raise _too_deep() from None
     finally:
         if loader is not None:
             loader.dispose()
@@ -146,7 +156,7 @@ def read_yaml(path: str | Path) -> Any:
     with open(path, 'rb') as file:
         data = file.read(YAML_MAX_BYTES + 1)
     if len(data) > YAML_MAX_BYTES:
-        raise YamlLimitError(f'larger than {YAML_MAX_BYTES} bytes')
+        raise _too_large()
     try:
         text = data.decode('utf-8')
     except UnicodeDecodeError as err:

@@ -5,17 +5,55 @@ The caps on the work a small input may ask for, in one place.
 A hostile or broken file must not take unbounded memory or time: each cap
 below bounds one kind of work, is documented in ``doc/outputs.md`` and can be
 raised through the environment variable named beside it. Hitting a cap is an
-error of one line naming the file and the cap, never a traceback.
+error of one line naming the file and the cap, never a traceback. A variable that
+changes nothing (not a whole number from 1 to 2**63 - 1, or a misspelt name) is
+found here, once, and listed in :data:`BAD_OVERRIDES` for the entry points to say.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+import difflib
 import os
+import re
+
+CAP_MAX = (1 << 63) - 1
+"""Largest value a cap may be given (the 64-bit sizes and counts it is compared with), [-]."""
+
+
+@dataclass(frozen=True)
+class BadOverride:
+    """A SATMOTOR_* variable that was set to change a cap and changes nothing."""
+
+    name: str
+    """The variable, e.g. ``'SATMOTOR_YAML_MAX_BYTES'``, [-]"""
+    text: str
+    """Its value as set, [-]"""
+    reason: str
+    """Why it changes nothing, [-]"""
+    instead: str
+    """What a node does instead of refusing, e.g. ``'the default 1048576 is used'``, [-]"""
+
+    def __str__(self) -> str:
+        """Return the line that names the variable, its value and the reason."""
+        return f'{self.name}={self.text!r}: {self.reason}'
+
+
+_CAPS: dict[str, int] = {}  # each overridable cap's variable and its default
+_bad: list[BadOverride] = []
 
 
 def _cap(name: str, default: int) -> int:
-    text = os.environ.get(name, '').strip()
-    return int(text) if text.isdigit() and int(text) > 0 else default
+    _CAPS[name] = default
+    text = os.environ.get(name, '')
+    if not text.strip():  # unset, or set to nothing as `export NAME=` does: the default
+        return default
+    digits = re.fullmatch(r'\s*([0-9]{1,30})\s*', text)
+    if digits and 1 <= int(digits[1]) <= CAP_MAX:
+        return int(digits[1])
+    _bad.append(BadOverride(name, text, f'a cap is a whole number from 1 to {CAP_MAX}',
+                            f'the default {default} is used'))
+    return default
 
 
 YAML_MAX_BYTES = _cap('SATMOTOR_YAML_MAX_BYTES', 1 << 20)
@@ -49,6 +87,24 @@ PLOT_MAX_PANELS = _cap('SATMOTOR_PLOT_MAX_PANELS', 24)
 """Most panels of a report's residual grid (24: 960 x 1920 pixels), [-]."""
 
 
+def _misspelt() -> list[BadOverride]:
+    """Name each SATMOTOR_*_MAX_* variable that is no cap: a misspelt cap changes nothing."""
+    bad = []
+    for name in sorted(os.environ):
+        if name.startswith('SATMOTOR_') and '_MAX_' in name and name not in _CAPS:
+            near = difflib.get_close_matches(name, _CAPS, n=1, cutoff=0.8)
+            known = f'did you mean {near[0]}?' if near else 'the caps: ' + ', '.join(_CAPS)
+            bad.append(BadOverride(name, os.environ[name], f'no such cap ({known})',
+                                   'it is ignored'))
+    return bad
+
+
+BAD_OVERRIDES = tuple(_bad + _misspelt())
+"""Each SATMOTOR_* cap variable that is set and changes nothing, found once, at import: the
+CLI refuses to run with one (one line), a node logs each as an ERROR and runs on the
+defaults."""
+
+
 def bag_budget(stored_bytes: int) -> int:
     """
     Return how many bytes a bag of `stored_bytes` may decompress to.
@@ -67,6 +123,7 @@ def bag_budget(stored_bytes: int) -> int:
     return min(BAG_MAX_BYTES, max(BAG_FLOOR_BYTES, BAG_MAX_RATIO * stored_bytes))
 
 
-__all__ = ['BAG_FLOOR_BYTES', 'BAG_MAX_BYTES', 'BAG_MAX_RATIO', 'CSV_MAX_COLUMNS',
+__all__ = ['BAD_OVERRIDES', 'BadOverride', 'BAG_FLOOR_BYTES', 'BAG_MAX_BYTES', 'BAG_MAX_RATIO',
+           'CAP_MAX', 'CSV_MAX_COLUMNS',
            'PLOT_MAX_PANELS', 'RATE_MAX_PREDICTIONS', 'YAML_MAX_BYTES',
            'YAML_MAX_DEPTH', 'YAML_MAX_DIGITS', 'YAML_MAX_NODES', 'bag_budget']

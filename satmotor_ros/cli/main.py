@@ -11,6 +11,7 @@ from satmotor_ros import __version__
 from satmotor_ros.cli import (calibrate, characteristics, demo, operating_point, replay,
                               validate)
 from satmotor_ros.cli._common import add_subcommand, CliError, fail, take_motor_options
+from satmotor_ros.limits import BAD_OVERRIDES
 
 SUBCOMMANDS = {'demo': demo, 'operating-point': operating_point,
                'characteristics': characteristics, 'replay': replay, 'calibrate': calibrate,
@@ -51,12 +52,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     Returns
     -------
     int
-        Exit code: 0 on success, 1 on an error the command reports, 2 on bad usage.
+        Exit code: 0 on success, 1 on an error the command reports (also a SATMOTOR_*
+        cap variable that changes nothing), 2 on bad usage.
 
     """
     args = vars(build_parser().parse_args(argv))
     args.pop('subcommand')
     command = args.pop('command')
+    if BAD_OVERRIDES:  # the user meant a cap to change; running on the default would hide that
+        return fail('; '.join(map(str, BAD_OVERRIDES)))
     try:
         args = take_motor_options(args)
     except CliError as err:

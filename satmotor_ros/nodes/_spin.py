@@ -10,6 +10,7 @@ from typing import Protocol
 import rclpy
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
+from satmotor_ros.limits import BAD_OVERRIDES
 
 
 class NodeMain(Protocol):
@@ -58,7 +59,9 @@ def node_main(make_node: Callable[[], Node], name: str) -> NodeMain:
     signal handler shuts the context down, and building the rest of the node then fails:
     that failure is the signal's doing, not an error). Bad start-up parameters (a
     ValueError or OSError from `make_node`) print one line and exit with status 1,
-    without a traceback. The node is destroyed and rclpy shut down in every case.
+    without a traceback. A SATMOTOR_* cap variable that changes nothing is logged as an
+    ERROR and the node runs on the default. The node is destroyed and rclpy shut down in
+    every case.
 
     Parameters
     ----------
@@ -78,6 +81,8 @@ def node_main(make_node: Callable[[], Node], name: str) -> NodeMain:
         try:
             rclpy.init(args=args)
             initialised = True
+            for bad in BAD_OVERRIDES:  # a node runs on: a wrong cap variable never stops it
+                rclpy.logging.get_logger(name).error(f'{bad}; {bad.instead}')
             node = make_node()
             spin(node)
         except (KeyboardInterrupt, ExternalShutdownException):
