@@ -12,7 +12,7 @@ from satmotor_ros.cli._common import add_motor_options
 from satmotor_ros.cli._output import check_target, output_dir, written_by
 from satmotor_ros.identify import calibrate, Options
 from satmotor_ros.identify.output import write_json, write_yaml
-from satmotor_ros.identify.pipeline import IMPLAUSIBLE, Mode, MODES
+from satmotor_ros.identify.pipeline import AT_BOUND, IMPLAUSIBLE, Mode, MODES
 from satmotor_ros.identify.report import write_report
 from satmotor_ros.interface import MotorOptions
 
@@ -74,9 +74,9 @@ def _calibrate(data: str, out: str, mode: Mode, alpha: float, folds: int,
     table = load_data(data, columns)
     cal = calibrate(table, options.liquid, spec, Options(alpha=alpha, n_folds=folds, mode=mode,
                                                          compare_families=not options.family))
-    for note in cal.table.notes:
-        if note.startswith(IMPLAUSIBLE):
-            print(f'warning: {data}: {note}', file=sys.stderr)
+    warnings = cal.warnings().get('warnings', [])
+    for note in warnings:
+        print(f'warning: {data}: {note}', file=sys.stderr)
     with output_dir('--out', out, 'calibrate', inputs, force) as tmp:
         summary = write_json(cal, tmp / 'calibration.json')
         write_yaml(cal, tmp / 'coefficients.yaml')
@@ -84,7 +84,8 @@ def _calibrate(data: str, out: str, mode: Mode, alpha: float, folds: int,
     target = Path(out)
     effect = summary['effect']
     before, after = summary['error_before']['rmse_lpm'], summary['error_after']['rmse_lpm']
-    line = ('WARNING implausible data (see report.md); ' if summary.get('warnings') else '') + \
+    kinds = [k for k in (IMPLAUSIBLE, AT_BOUND) if any(w.startswith(k) for w in warnings)]
+    line = (f'WARNING {" and ".join(kinds)} (see report.md); ' if kinds else '') + \
         f'effect: {effect}'
     if effect != 'none':
         line += (f' ({summary["regressor"]}, coefficient {summary["coefficient"]:.4g} '

@@ -270,7 +270,8 @@ class LossFit:
         Returns
         -------
         LossFit
-            Self, with ``u_``, ``rss_``, ``objective_``, ``n_`` and ``jac_`` set.
+            Self, with ``u_``, ``rss_``, ``objective_``, ``n_``, ``jac_`` and ``active_``
+            (which parameters ended on a bound, see :meth:`pinned`) set.
 
         """
         self._layout(parts)
@@ -305,6 +306,7 @@ class LossFit:
         self.fun_ = np.asarray(best.fun, dtype=float)
         self.bounds_ = (np.array(lower, dtype=float), np.array(upper, dtype=float))
         self.jac_ = np.asarray(best.jac, dtype=float)
+        self.active_ = np.asarray(best.active_mask, dtype=int)  # -1/+1: on a lower/upper bound
         self.n_ = int(index.size)
         self.objective_ = float(np.sum(best.fun[:self.n_] ** 2))
         self.rss_ = float(np.sum((flow - self._predict(parts, best.x)[index]) ** 2))
@@ -367,6 +369,35 @@ class LossFit:
         """Return each effect's candidate with the effect at the fitted values (for the YAML)."""
         self._check_fitted()
         return [(c, c.as_effect(k, *theta)) for c, k, theta in self._effect_values(self.u_)]
+
+    def pinned(self, effects_only: bool = False) -> list[tuple[str, float]]:
+        """
+        Return each parameter the fit left on a bound of its range, and the bound.
+
+        A parameter on a bound is not an estimate: the data ask for a value beyond the
+        range. Its interval (:meth:`report`) and a nested F-test of it assume a best fit
+        inside the range, where the gradient is zero, and mean nothing there. On a bound
+        means within the fit's ``xtol`` of it (relative, at least 1e-6 absolute in the
+        fitted units): scipy's ``active_mask``.
+
+        Parameters
+        ----------
+        effects_only : bool
+            Only the effects' coefficients and shapes, not the components' factors, [-]
+
+        Returns
+        -------
+        list of tuple
+            ``(name, bound)`` per parameter on a bound, in the order of :meth:`report`;
+            the bound in the parameter's unit, [-]
+
+        """
+        self._check_fitted()
+        names, unit, offset = self._names_and_units()
+        first = self.m_ + self.typical_.size if effects_only else 0
+        bound = np.where(self.active_ < 0, *self.bounds_)
+        return [(names[i], float(offset[i] + unit[i] * bound[i]))
+                for i in np.flatnonzero(self.active_) if i >= first]
 
     @property
     def effect_coefficient(self) -> float:

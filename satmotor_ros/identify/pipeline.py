@@ -19,8 +19,8 @@ from satmotor_ros.identify.errors import DataError, IdentificationError
 from satmotor_ros.identify.families import compare_families, family_specs, FamilyChoice
 from satmotor_ros.identify.fit import check_identifiable, FitReport, MIN_POINTS, written
 from satmotor_ros.identify.parts import loss_parts, LossParts, predict_flow
-from satmotor_ros.identify.selection import (CrossValidatedSelector, Errors, Forward, Score,
-                                             Selection)
+from satmotor_ros.identify.selection import (at_bound, CrossValidatedSelector, Errors, Forward,
+                                             Score, Selection)
 from satmotor_ros.identify.steady import extract_steady, looks_like_series, SteadyTolerance
 from satmotor_ros.identify.table import BenchTable
 from satmotor_ros.identify.transient import (dynamics_summary, Samples, transient_samples,
@@ -180,9 +180,9 @@ class Calibration:
             liquid, n_points, effect, regressor, coefficient, ci95, unit,
             error_before, error_after, effects, outliers, candidates,
             family_comparison, the transient mode's fields, and ``warnings``
-            when the data are implausible. The top-level effect fields are
-            those of the first effect; with no effect, regressor, coefficient,
-            ci95 and unit are null.
+            when the data are implausible or a fitted value is on a bound. The
+            top-level effect fields are those of the first effect; with no
+            effect, regressor, coefficient, ci95 and unit are null.
 
         """
         effects = self.effect_rows()
@@ -207,8 +207,25 @@ class Calibration:
         }
 
     def warnings(self) -> dict[str, list[str]]:
-        """Return ``{'warnings': [...]}`` when the data are implausible (else nothing)."""
+        """
+        Return ``{'warnings': [...]}`` when something is wrong with the result (else nothing).
+
+        Returns
+        -------
+        dict
+            The warnings: the data are implausible (beginning :data:`IMPLAUSIBLE`), a
+            candidate that fitted better than the ones chosen from was refused because
+            its fit ended on a bound, or a factor of the final fit ended on a bound (both
+            beginning :data:`AT_BOUND`): a value on a bound is not an estimate.
+
+        """
         found = [note for note in self.table.notes if note.startswith(IMPLAUSIBLE)]
+        found += [f'{AT_BOUND}: step {i}: {at_bound(score)}: the data ask for a value beyond '
+                  'its range, so the fit gives the bound, not an estimate; refused'
+                  for i, step in enumerate(self.forward.steps, 1) for score in step.refused]
+        found += [f'{AT_BOUND}: {name} ends on its bound {bound:.4g} in the final fit: not an '
+                  'estimate, and its interval is not valid; the packaged value is far from '
+                  'what these data ask for' for name, bound in self.forward.final.fit.pinned()]
         return {'warnings': found} if found else {}
 
     def family_comparison(self) -> dict[str, Any]:
@@ -526,6 +543,9 @@ def _family_and_rows(spec: MotorSpec, liquid: str, table: BenchTable,
 IMPLAUSIBLE = 'implausible data'
 """How the note on data no motor can produce begins (the report and stderr give it)."""
 
+AT_BOUND = 'at a bound'
+"""How a warning of a fitted value on a bound of its range begins (not an estimate)."""
+
 
 def implausible(parts: LossParts) -> str | None:
     """
@@ -565,5 +585,5 @@ def _source_rows(table: BenchTable, points: BenchTable) -> np.ndarray | None:
     return np.arange(len(table))
 
 
-__all__ = ['Calibration', 'IdentificationError', 'MODES', 'Mode', 'Options', 'Rows',
+__all__ = ['AT_BOUND', 'Calibration', 'IdentificationError', 'MODES', 'Mode', 'Options', 'Rows',
            'calibrate', 'read_rows', 'steady_points']

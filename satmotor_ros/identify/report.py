@@ -13,8 +13,8 @@ import numpy as np
 
 from satmotor_ros.identify.output import effect_block, fitted_coefficients
 from satmotor_ros.identify.parts import LossParts
-from satmotor_ros.identify.pipeline import Calibration
-from satmotor_ros.identify.selection import Errors
+from satmotor_ros.identify.pipeline import AT_BOUND, Calibration
+from satmotor_ros.identify.selection import at_bound, Errors
 from satmotor_ros.identify.table import BenchTable
 from satmotor_ros.identify.transient import transient_section
 from satmotor_ros.limits import PLOT_MAX_PANELS
@@ -333,6 +333,8 @@ def write_report(cal: Calibration, out: Path, summary: dict[str, object]) -> Pat
     lines = [f'# Calibration of {cal.spec.name} on {cal.liquid}', '',
              f'Data: `{cal.table.source}`, {data}. Mode `{cal.mode}`: {cal.mode_reason}.']
     lines += [f'- {note}' for note in cal.table.notes]
+    lines += [f'- **{note}**' for note in cal.warnings().get('warnings', [])
+              if note.startswith(AT_BOUND)]
     lines += [''] + _families(cal)
     lines += ['## Result', '', f'**Effects: {found}**, found one after the other:', '']
     lines += _steps(cal) + ['']
@@ -344,7 +346,9 @@ def write_report(cal: Calibration, out: Path, summary: dict[str, object]) -> Pat
     lines += ['## Fitted coefficients', '',
               'Factors on the packaged values, then the effects (95 % confidence intervals from '
               'the Jacobian; the fit has a weak prior that each factor is 1 ± 0.3):', '']
-    rows = [[name, f'{value:.5g}', f'[{lo:.5g}, {hi:.5g}]']
+    pinned = dict(cal.forward.final.fit.pinned())
+    rows = [[name, f'{value:.5g}', f'[{lo:.5g}, {hi:.5g}]' if name not in pinned else
+             f'- ({AT_BOUND}: not an estimate)']
             for name, value, (lo, hi) in zip(cal.final.names, cal.final.values, cal.final.ci95)]
     lines += [_table(rows, ['parameter', 'value', 'ci95']), '']
     lines += _written_effects(summary)
@@ -358,13 +362,16 @@ def write_report(cal: Calibration, out: Path, summary: dict[str, object]) -> Pat
     lines += _identifiability(cal) + _outliers(cal, summary)
     lines += ['## Candidates of the first step', '', _table(
         [[f'`{s.label}`', f'{s.cv_rmse / LPM:.4g}', f'{s.p_value:.2g}',
-          f'{s.fit.effect_coefficient:.4g} {s.candidate.unit if s.candidate else ""}']
+          f'{s.fit.effect_coefficient:.4g} {s.candidate.unit if s.candidate else ""}'
+          + (f' ({AT_BOUND}: {at_bound(s)})' if s.fit.pinned(effects_only=True) else '')]
          for s in sel.ranking],
         ['candidate', 'CV error [l/min]', 'p (F-test)', 'coefficient']), '',
         f'No effect: CV error {sel.baseline.cv_rmse / LPM:.4g} l/min (noise-weighted, through '
         f"Huber's loss). An effect is accepted when p < {sel.alpha:g}/{len(sel.ranking)} "
         '(Bonferroni) and it cuts the CV error by more than 5 %; then the loop tests the '
-        'rest on top of it.', '']
+        f'rest on top of it. A candidate marked {AT_BOUND} is never accepted: its fit ended on '
+        'a bound of its range, so its value is the bound, not an estimate, and its p-value '
+        'and interval mean nothing.', '']
     lines += ['Library:', ''] + [f'- {c.description}' for c in cal.candidates]
     if cal.skipped:
         lines += ['', 'Not tested:', ''] + [f'- {why}' for why in cal.skipped]

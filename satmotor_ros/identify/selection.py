@@ -19,6 +19,15 @@ physical effect goes before ``channel:``, ``term:`` and ``threshold:``, and
 before a fitted form that beats it by less than :data:`FORM_TIE` of the error
 removed (a form with free exponents bends towards anything).
 
+A candidate whose fit leaves an effect's parameter on a bound of its range (a
+sensor gain at -0.5, an exponent at its limit) is never accepted: the data ask
+for a value beyond the range, so the fitted value is the bound and not an
+estimate, and both the F-test (whose F distribution assumes the best fit is a
+stationary point inside the range) and the interval from the Jacobian mean
+nothing there. The effect as the model has it does not explain the data;
+the step goes on with the candidates that are estimated, and says which
+candidates it refused when they fitted better than all of those.
+
 Every step weighs the points by a noise model estimated from the residuals
 of the step's best-fitting model (:mod:`.noise`): the F-test and the
 cross-validated error are those of standardised residuals, through Huber's
@@ -136,6 +145,7 @@ class Selection:
     alpha: float  # family-wise significance level [-]
     sigma: FloatArray  # noise model of the step at every point [m^3/s]
     left_out: np.ndarray  # bool: outliers even under the step's best model, not fitted
+    refused: tuple[Score, ...] = ()  # ahead of the candidates chosen from, but on a bound
 
 
 @dataclass(frozen=True)
@@ -338,10 +348,13 @@ class CrossValidatedSelector:
         return variance_inflation((parts.flow[index] - fit.predict(parts, index))
                                   / sigma[index])
 
-    def _passes(self, score: Score, baseline: Score, m: int) -> bool:
+    def _significant(self, score: Score, baseline: Score, m: int) -> bool:
         return (score.p_value < self.alpha / m
                 and score.cv_rmse < (1.0 - self.min_gain) * baseline.cv_rmse
                 and determined(score.fit))
+
+    def _passes(self, score: Score, baseline: Score, m: int) -> bool:
+        return self._significant(score, baseline, m) and not score.fit.pinned(effects_only=True)
 
     def _noise(self, parts: LossParts, found: tuple[Candidate, ...], pool: Sequence[Candidate],
                start: FloatArray | None) -> tuple[FloatArray, np.ndarray, list[LossFit]]:
@@ -394,17 +407,26 @@ class CrossValidatedSelector:
             self._tried[id(c)] = s_.fit.u_[-1 - len(c.shape):]
         ranking = tuple(sorted(scores, key=lambda s: s.cv_rmse))
         m = max(len(pool), 1)
-        done = Selection(baseline, ranking, None, None, '', self.alpha, sigma, left_out)
-        if not ranking:
-            return _with_verdict(done, 'no candidate could be tested')
-        top = ranking[0]
+        estimated = [s for s in ranking if not s.fit.pinned(effects_only=True)]
+        # refused: a candidate ahead of every estimated one, which the tests would have chosen
+        # had its fit not ended on a bound
+        limit = estimated[0].cv_rmse if estimated else np.inf
+        refused = tuple(s for s in ranking if s not in estimated and s.cv_rmse < limit
+                        and self._significant(s, baseline, m))
+        done = Selection(baseline, ranking, None, None, '', self.alpha, sigma, left_out,
+                         refused)
+        if not estimated:
+            return _with_verdict(done, 'no candidate could be tested' if not ranking else
+                                 'none: every candidate ends on a bound of its range'
+                                 + _at_bound(refused))
+        top = estimated[0]
         gain = 1.0 - top.cv_rmse / baseline.cv_rmse if baseline.cv_rmse > 0 else 0.0
         if not self._passes(top, baseline, m):
             return _with_verdict(done, (
                 f'{"none" if not found else "no further effect"}: the best candidate, '
                 f'{top.label}, cuts the cross-validated error by {100 * gain:.1f} % (need > '
                 f'{100 * self.min_gain:.0f} %) with p = {top.p_value:.2g} (need < '
-                f'{self.alpha:g}/{m})'))
+                f'{self.alpha:g}/{m})' + _at_bound(refused)))
         removed = baseline.cv_rmse - top.cv_rmse
         close = [s for s in ranking if self._passes(s, baseline, m) and (
             s.cv_rmse <= (1.0 + self.tie) * top.cv_rmse
@@ -430,7 +452,8 @@ class CrossValidatedSelector:
         if top is not best and priority(top.effect) == 2 and (runner is None
                                                               or runner.effect != top.effect):
             verdict += _tie(best, top, baseline).replace('near tie', 'also near', 1)
-        return Selection(baseline, ranking, best, runner, verdict, self.alpha, sigma, left_out)
+        return Selection(baseline, ranking, best, runner, verdict + _at_bound(refused),
+                         self.alpha, sigma, left_out, refused)
 
     def select(self, parts: LossParts, candidates: Sequence[Candidate]) -> Forward:
         """
@@ -480,7 +503,38 @@ def _guarded(test: np.ndarray, guard: int, n: int) -> np.ndarray:
 
 def _with_verdict(step: Selection, verdict: str) -> Selection:
     return Selection(step.baseline, step.ranking, step.chosen, step.runner_up, verdict,
-                     step.alpha, step.sigma, step.left_out)
+                     step.alpha, step.sigma, step.left_out, step.refused)
+
+
+def at_bound(score: Score) -> str:
+    """
+    Say which of a candidate's parameters ended on a bound of its range.
+
+    Parameters
+    ----------
+    score : Score
+        A candidate whose fit left an effect's parameter on a bound, [-]
+
+    Returns
+    -------
+    str
+        E.g. ``'flow_sensor_gain(flow) at its bound -0.5'`` or ``'term:dp^0.05*n (term:dp^a*n^b
+        dp exponent at its bound 0.05)'``.
+
+    """
+    pinned = score.fit.pinned(effects_only=True)
+    own = [f'at its bound {bound:.4g}' for name, bound in pinned if name == score.added.label]
+    other = [f'{name} at its bound {bound:.4g}' for name, bound in pinned
+             if name != score.added.label]
+    return ' '.join([score.label, *own] + ([f'({", ".join(other)})'] if other else []))
+
+
+def _at_bound(refused: Sequence[Score]) -> str:
+    """Say which candidates were refused because their fit ended on a bound."""
+    if not refused:
+        return ''
+    return ('; refused, not an estimate (the data ask for a value beyond the range): '
+            + '; '.join(at_bound(s) for s in refused))
 
 
 def _tie(best: Score, runner: Score, baseline: Score) -> str:
