@@ -6,6 +6,7 @@ from __future__ import annotations
 from dataclasses import replace
 import json
 from pathlib import Path
+import textwrap
 from types import ModuleType
 from typing import Any
 
@@ -41,6 +42,9 @@ def channel_axes(parts: LossParts, table: BenchTable) -> dict[str, FloatArray]:
     """
     Map ``'label [unit]'`` to speed, dp, flow, p_out and each finite channel at the points.
 
+    Speed, dp and flow are signed as measured (four quadrants, doc/quadrants.md), not the
+    magnitudes the fit works on, so that a residual that depends on the direction shows.
+
     Parameters
     ----------
     parts : LossParts
@@ -54,13 +58,41 @@ def channel_axes(parts: LossParts, table: BenchTable) -> dict[str, FloatArray]:
         Each quantity in the unit of its label.
 
     """
-    out = {'n [rpm]': parts.speed / RPM, 'dp [MPa]': parts.dp / MPA,
-           'flow [l/min]': parts.flow / LPM, 'p_out [MPa]': table.p_out / MPA}
+    out = {'n [rpm]': table.speed / RPM, 'dp [MPa]': table.dp / MPA,
+           'flow [l/min]': table.flow / LPM, 'p_out [MPa]': table.p_out / MPA}
     for name, x in table.channels.items():
         unit, scale = _UNITS.get(name, (table.units.get(name, '') or '-', 1.0))
         if np.all(np.isfinite(x)):
             out[f'{name} [{unit}]'] = x / scale
     return out
+
+
+LABEL_MAX = 44
+"""Most characters of a label on a plot (a CSV column's name can be of any length), [-]."""
+
+
+def short_label(label: str) -> str:
+    """
+    Cut a plot's label to :data:`LABEL_MAX` characters, keeping a ``' [unit]'`` at its end.
+
+    Parameters
+    ----------
+    label : str
+        E.g. ``'a_very_long_channel_name [V]'``, [-]
+
+    Returns
+    -------
+    str
+        The label, or its start, an ellipsis and the unit, [-]
+
+    """
+    if len(label) <= LABEL_MAX:
+        return label
+    name, bracket, unit = label.rpartition(' [')
+    if not bracket or len(unit) > LABEL_MAX // 2:
+        name, unit = label, ''
+    tail = f' [{unit}' if unit else ''
+    return name[:LABEL_MAX - len(tail) - 1] + '…' + tail
 
 
 def plot_residual_grid(axes_data: dict[str, FloatArray], residuals: dict[str, FloatArray],
@@ -87,20 +119,26 @@ def plot_residual_grid(axes_data: dict[str, FloatArray], residuals: dict[str, Fl
     axes_data = dict(list(axes_data.items())[:PLOT_MAX_PANELS])
     cols = 3
     rows = int(np.ceil(len(axes_data) / cols))
-    fig, axes = plt.subplots(rows, cols, figsize=(12, 3.0 * rows), squeeze=False)
+    height = 3.0 * rows  # [inch]
+    fig, axes = plt.subplots(rows, cols, figsize=(12, height), squeeze=False)
     for ax, (label, x) in zip(axes.flat, axes_data.items()):
         for name, residual in residuals.items():
             ax.plot(x, residual / LPM, 'o', ms=3, alpha=0.6, label=name)
         ax.axhline(0.0, color='k', lw=0.8)
-        ax.set_xlabel(label)
+        ax.set_xlabel(short_label(label))
         ax.set_ylabel('residual of Q_vl [l/min]')
         ax.grid(alpha=0.3)
     for ax in list(axes.flat)[len(axes_data):]:
         ax.set_visible(False)
-    axes.flat[0].legend(fontsize=8)
-    fig.suptitle(title)
-    fig.subplots_adjust(left=0.07, right=0.98, bottom=0.5 / rows, top=1 - 0.35 / rows,
-                        hspace=0.45, wspace=0.3)
+    # one legend for the figure, between the title and the panels: a long label (several
+    # effects) inside a panel would cover its points and run past the figure's edge
+    ncol = min(len(residuals), 2)
+    legend_rows = int(np.ceil(len(residuals) / ncol))
+    fig.suptitle(title, y=1 - 0.1 / height, va='top')
+    fig.legend(*axes.flat[0].get_legend_handles_labels(), loc='upper center', ncol=ncol,
+               fontsize=8, frameon=False, bbox_to_anchor=(0.5, 1 - 0.4 / height))
+    fig.subplots_adjust(left=0.07, right=0.98, bottom=0.6 / height,
+                        top=1 - (0.65 + 0.2 * legend_rows) / height, hspace=0.45, wspace=0.3)
     fig.savefig(path, dpi=80, format='png')
     plt.close(fig)
 
@@ -125,6 +163,33 @@ def _plot_residuals(cal: Calibration, path: Path) -> None:
                        'of the volumetric losses against each regressor', path)
 
 
+QUADRANT_MARKERS = {'motor, forward': 'o', 'motor, reverse': 's', 'pump, forward': '^',
+                    'pump, reverse': 'v'}
+"""The marker of each quadrant's points (doc/quadrants.md) in the characteristics plot."""
+
+
+def quadrants(parts: LossParts) -> np.ndarray:
+    """
+    Name the quadrant of each point: motor or pump, forward or reverse (doc/quadrants.md).
+
+    Parameters
+    ----------
+    parts : LossParts
+        The model's components at the points (their frame and rotation), [-]
+
+    Returns
+    -------
+    ndarray of str
+        A key of :data:`QUADRANT_MARKERS` per point; a stalled shaft counts as forward motor.
+
+    """
+    n = len(parts)
+    rotation = np.broadcast_to(np.asarray(parts.rotation, dtype=float), n)
+    sign = np.broadcast_to(np.asarray(parts.sign, dtype=float), n)
+    mode = np.where(rotation * sign < 0.0, 'pump', 'motor')
+    return np.char.add(mode, np.where(rotation < 0.0, ', reverse', ', forward'))
+
+
 def _fitted_model(cal: Calibration) -> MotorModel:
     spec = cal.model.coefficient_set
     coef = replace(fitted_coefficients(cal), external_leakage=0.0)
@@ -142,18 +207,28 @@ def _plot_characteristics(cal: Calibration, path: Path) -> None:
     fitted = _fitted_model(cal)
     dp_i = np.linspace(max(parts.dp_i.min(), 1e3), parts.dp_i.max(), 60)
     colors = plt.rcParams['axes.prop_cycle'].by_key()['color']
+    quadrant = quadrants(parts)
+    signed = set(quadrant) != {'motor, forward'}
     for g in range(4):
         at = group == g
         if not at.any():
             continue
         n = float(np.median(parts.speed[at]))
         c = colors[g % len(colors)]
-        left.plot(parts.dp_i[at] / MPA, parts.loss[at] / LPM, 'o', ms=3, color=c,
-                  label=f'measured, n ~ {n / RPM:.0f} rpm')
+        left.plot([], [], 'o', ms=3, color=c,
+                  label=f'measured, {"|n|" if signed else "n"} ~ {n / RPM:.0f} rpm')
+        for name, marker in QUADRANT_MARKERS.items():
+            here = at & (quadrant == name)
+            left.plot(parts.dp_i[here] / MPA, parts.loss[here] / LPM, marker, ms=3, color=c)
         left.plot(dp_i / MPA, cal.model.breakdown(n, dp_i).total / LPM, '--', color=c, lw=1)
         left.plot(dp_i / MPA, fitted.breakdown(n, dp_i).total / LPM, '-', color=c, lw=1.2)
-    left.set_xlabel('chamber pressure drop dp_i [MPa]')
-    left.set_ylabel('volumetric losses Q_vl = Q - q_t n [l/min]')
+    if signed:  # the model's loss is the same function of |n| and |dp_i| in every quadrant
+        for name, marker in QUADRANT_MARKERS.items():
+            if (quadrant == name).any():
+                left.plot([], [], marker, ms=4, color='0.35', label=name)
+    left.set_xlabel(f'chamber pressure drop {"|dp_i|" if signed else "dp_i"} [MPa]')
+    left.set_ylabel('volumetric losses Q_vl = ' + ('sign(dp) (Q - q_t n)' if signed
+                                                   else 'Q - q_t n') + ' [l/min]')
     left.set_title('dashed: packaged model; solid: fitted (without effect)', fontsize=9)
     left.legend(fontsize=7)
     left.grid(alpha=0.3)
@@ -162,13 +237,13 @@ def _plot_characteristics(cal: Calibration, path: Path) -> None:
     right.plot(measured, before, 'o', ms=3, alpha=0.6, label='before (no effect)')
     if cal.found:
         after = measured - cal.forward.final.cv_error / LPM
-        right.plot(measured, after, 'o', ms=3, alpha=0.6,
-                   label=f'after ({" + ".join(s.label for s in cal.found)})')
+        right.plot(measured, after, 'o', ms=3, alpha=0.6,  # several effects: several lines
+                   label=textwrap.fill(f'after ({" + ".join(s.label for s in cal.found)})', 48))
     lim = [min(measured.min(), before.min()), max(measured.max(), before.max())]
     right.plot(lim, lim, 'k-', lw=0.8)
     right.set_xlabel('measured Q_vl [l/min]')
     right.set_ylabel('predicted Q_vl, out of sample [l/min]')
-    right.legend(fontsize=8)
+    right.legend(fontsize=8, loc='lower right')  # the points run from lower left to upper right
     right.grid(alpha=0.3)
     fig.subplots_adjust(left=0.07, right=0.98, bottom=0.12, top=0.93, wspace=0.22)
     fig.savefig(path, dpi=80)
@@ -179,20 +254,22 @@ def _plot_ranking(cal: Calibration, path: Path) -> None:
     """Plot the candidates' cross-validated errors against the baseline's."""
     plt = pyplot()
     ranking = cal.selection.ranking[:15]
-    fig, ax = plt.subplots(figsize=(8, 0.35 * len(ranking) + 1.5))
-    labels = [s.label for s in ranking][::-1]
+    # constrained layout makes room for the longest label, cut (a CSV column's name may be
+    # long) so that the bars keep most of the width
+    fig, ax = plt.subplots(figsize=(8, 0.35 * len(ranking) + 1.5), layout='constrained')
+    labels = [short_label(s.label) for s in ranking][::-1]
     values = [s.cv_rmse / LPM for s in ranking][::-1]
-    chosen = cal.found[0].label if cal.found else None
-    runner = cal.selection.runner_up.label if cal.selection.runner_up else None
-    colors = ['tab:orange' if lab == chosen else 'tab:olive' if lab == runner else 'tab:blue'
-              for lab in labels]
-    ax.barh(labels, values, color=colors)
-    ax.axvline(cal.selection.baseline.cv_rmse / LPM, color='k', ls='--', label='no effect')
+    chosen = cal.found[0] if cal.found else None
+    runner = cal.selection.runner_up
+    colors = ['tab:orange' if s is chosen else 'tab:olive' if s is runner else
+              'tab:gray' if s.fit.pinned(effects_only=True) else 'tab:blue'
+              for s in ranking][::-1]
+    ax.barh(range(len(labels)), values, color=colors, tick_label=labels)
+    ax.axvline(cal.selection.baseline.cv_rmse / LPM, color='k', ls='--')
     ax.set_xlabel('cross-validated RMSE of Q_vl [l/min]')
-    ax.set_title('Candidate effects (orange: chosen, olive: near tie)', fontsize=10)
-    ax.legend(fontsize=8, loc='lower right')
-    fig.subplots_adjust(left=0.35, right=0.97, bottom=1.0 / (0.35 * len(ranking) + 1.5),
-                        top=1 - 0.4 / (0.35 * len(ranking) + 1.5))
+    grey = ', grey: at a bound' if 'tab:gray' in colors else ''
+    fig.suptitle(f'Candidate effects\n(orange: chosen, olive: near tie{grey}; dashed: no effect)',
+                 fontsize=10)
     fig.savefig(path, dpi=80)
     plt.close(fig)
 
@@ -388,5 +465,5 @@ def write_report(cal: Calibration, out: Path, summary: dict[str, object]) -> Pat
     return path
 
 
-__all__ = ['PLOTS', 'channel_axes', 'grid_note', 'plot_residual_grid', 'pyplot',
-           'write_report']
+__all__ = ['LABEL_MAX', 'PLOTS', 'QUADRANT_MARKERS', 'channel_axes', 'grid_note',
+           'plot_residual_grid', 'pyplot', 'quadrants', 'short_label', 'write_report']
