@@ -8,6 +8,13 @@ its cross-validated error of Q_vl, with the folds and the selector the effect se
 The motor's own family (its file's, or the SM-0,75/25's) is kept unless another one cuts
 that error by more than the selector's ``min_gain``: like an effect, a change of structure
 has to earn its place. A family pinned by the user (``--family``) is not compared.
+
+The two best families are a near tie when the runner-up's out-of-sample error is within
+the noise of the winner's: a one-sided paired test (Diebold and Mariano's) on the
+difference of their squared out-of-sample errors of Q_vl at the same points, its variance
+inflated by the correlation of neighbouring rows of a time series, does not reject at the
+selector's ``alpha`` that the runner-up is as good. The data then do not tell the two
+structures apart, whichever was kept.
 """
 
 from __future__ import annotations
@@ -22,12 +29,14 @@ from satmotor_ros.identify.errors import IdentificationError
 from satmotor_ros.identify.parts import loss_parts, LossParts
 from satmotor_ros.identify.selection import CrossValidatedSelector, Errors
 from satmotor_ros.identify.table import BenchTable
+from satmotor_ros.identify.transient import variance_inflation
 from satmotor_ros.model import MotorModel, MotorSpec
 from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.errors import ModelError
 from satmotor_ros.model.families import FAMILY_NAMES
 from satmotor_ros.model.families.defaults import default_motor
 from satmotor_ros.model.units import LPM
+from scipy import special
 
 
 @dataclass(frozen=True)
@@ -46,6 +55,58 @@ class FamilyScore:
 
 
 @dataclass(frozen=True)
+class NearTie:
+    """The two best families, whose out-of-sample errors differ by less than their noise."""
+
+    winner: str  # the family with the least out-of-sample error
+    runner_up: str  # the next one
+    p_value: float  # one-sided paired test that the runner-up is worse [-]
+    alpha: float  # the level it is not significant at [-]
+
+    @property
+    def note(self) -> str:
+        """Return the sentence the report and calibration.json give."""
+        return (f'near tie: {self.runner_up} is within the noise of {self.winner} (paired test '
+                f'of their squared out-of-sample errors of Q_vl, p = {self.p_value:.2g} >= '
+                f'{self.alpha:g}): the data do not tell the two structures apart')
+
+    def as_dict(self) -> dict[str, Any]:
+        """Return the tie for ``calibration.json``'s ``family_comparison``."""
+        return {'families': [self.winner, self.runner_up],
+                'p_value': float(f'{self.p_value:.3g}'), 'note': self.note}
+
+
+def paired_p_value(better: FloatArray, worse: FloatArray, inflation: float = 1.0) -> float:
+    """
+    Return the one-sided p-value that `worse` errs more than `better` (Diebold-Mariano).
+
+    The statistic is the mean of d = worse^2 - better^2 over its standard error,
+    sqrt(inflation var(d) / N), against Student's t with N - 1 degrees of freedom.
+
+    Parameters
+    ----------
+    better, worse : ndarray
+        Two models' out-of-sample errors at the same points, [m^3/s]
+    inflation : float
+        Variance inflation of d by the correlation of neighbouring points (1 for
+        independent points), [-]
+
+    Returns
+    -------
+    float
+        The p-value; 1 when d is identically 0, 0 when it is a positive constant, [-]
+
+    """
+    d = np.asarray(worse, dtype=float) ** 2 - np.asarray(better, dtype=float) ** 2
+    mean = float(np.mean(d))
+    spread = float(np.std(d, ddof=1)) if d.size > 1 else 0.0
+    if spread == 0.0:
+        return 1.0 if mean <= 0.0 else 0.0
+    t = mean / (spread * math.sqrt(inflation / d.size))
+    return float(special.stdtr(d.size - 1, -t))
+
+
+@dataclass(frozen=True)
 class FamilyChoice:
     """The comparison of the families and the one the calibration continues with."""
 
@@ -53,6 +114,7 @@ class FamilyChoice:
     scores: tuple[FamilyScore, ...]  # best first; empty when pinned
     n_points: int  # points the families were compared on [-]
     verdict: str  # why this family, one sentence
+    tie: NearTie | None = None  # the two best families, when the data do not tell them apart
 
     def as_list(self) -> list[dict[str, Any]]:
         """Return the comparison for ``calibration.json``: one entry per family, best first."""
@@ -180,18 +242,34 @@ def compare_families(points: BenchTable, liquid: str, specs: dict[str, MotorSpec
         msg = f'{points.source}: no model family could be fitted ({own.note})'
         raise IdentificationError(msg)
     n = int(keep.sum())
+    tie = _near_tie(scores, scored, keep, selector())
     if best.family == own.family:
         verdict = f'{own.family} has the least out-of-sample error of the families'
-        return FamilyChoice(own.family, tuple(scores), n, verdict)
+        return FamilyChoice(own.family, tuple(scores), n, verdict, tie)
     if own.error is not None and best.rmse >= (1.0 - min_gain) * own.rmse:
         verdict = (f'{own.family} kept: {best.family} cuts the out-of-sample error by only '
                    f'{100.0 * (1.0 - best.rmse / own.rmse):.1f} % (need > '
                    f'{100.0 * min_gain:.0f} %)')
-        return FamilyChoice(own.family, tuple(scores), n, verdict)
+        return FamilyChoice(own.family, tuple(scores), n, verdict, tie)
     cut = (f'cuts the out-of-sample error of {own.family} by '
            f'{100.0 * (1.0 - best.rmse / own.rmse):.1f} %' if own.error is not None
            else f'fits where {own.family} cannot')
-    return FamilyChoice(best.family, tuple(scores), n, f'{best.family} {cut}')
+    return FamilyChoice(best.family, tuple(scores), n, f'{best.family} {cut}', tie)
 
 
-__all__ = ['FamilyChoice', 'FamilyScore', 'compare_families', 'family_specs']
+def _near_tie(scores: list[FamilyScore], scored: Mapping[str, tuple[LossParts, FloatArray]],
+              keep: np.ndarray, selector: CrossValidatedSelector) -> NearTie | None:
+    """Return the two best families when the runner-up is within the winner's noise."""
+    if len(scores) < 2 or scores[1].error is None:
+        return None
+    winner, runner = (scored[s.family][1][keep] for s in scores[:2])
+    d = runner ** 2 - winner ** 2
+    inflation = variance_inflation(d) if selector.correlated else 1.0
+    p_value = paired_p_value(winner, runner, inflation)
+    if p_value < selector.alpha:
+        return None
+    return NearTie(scores[0].family, scores[1].family, p_value, selector.alpha)
+
+
+__all__ = ['FamilyChoice', 'FamilyScore', 'NearTie', 'compare_families', 'family_specs',
+           'paired_p_value']

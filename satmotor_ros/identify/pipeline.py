@@ -229,12 +229,13 @@ class Calibration:
         return {'warnings': found} if found else {}
 
     def family_comparison(self) -> dict[str, Any]:
-        """Return how the family was chosen: the verdict and each family's out-of-sample error."""
+        """Return how the family was chosen: the verdict, each family's error, any near tie."""
         if self.family is None:
             return {'verdict': f'{self.model.family.name} pinned by the user (--family)',
                     'n_points': None, 'families': []}
         return {'verdict': self.family.verdict, 'n_points': self.family.n_points,
-                'families': self.family.as_list()}
+                'families': self.family.as_list(),
+                'near_tie': self.family.tie.as_dict() if self.family.tie else None}
 
     def mode_fields(self) -> dict[str, Any]:
         """

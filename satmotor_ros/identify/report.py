@@ -345,6 +345,8 @@ def _families(cal: Calibration) -> list[str]:
     """Describe the model family and how it was chosen (the structure before the effect)."""
     comparison = cal.family_comparison()
     lines = ['## Model family', '', f'**{cal.model.family.name}**: {comparison["verdict"]}.', '']
+    if comparison.get('near_tie'):
+        lines += [f'**{comparison["near_tie"]["note"].capitalize()}.**', '']
     if not comparison['families']:
         return lines
     rows = [[f'`{f["family"]}`', ', '.join(f['factors']) or '-',
