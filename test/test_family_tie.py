@@ -4,9 +4,11 @@
 import numpy as np
 import pytest
 
-from satmotor_ros.identify import calibrate
+from satmotor_ros.cli import main
+from satmotor_ros.identify import calibrate, write_csv
 from satmotor_ros.identify.families import paired_p_value
 from satmotor_ros.identify.report import write_report
+from satmotor_ros.model.units import LPM, MPA, RPM
 from test_identify_families import _table_of
 
 
@@ -39,3 +41,12 @@ def test_a_family_clearly_ahead_is_no_tie(family, tmp_path):
     assert cal.model.family.name == family
     assert cal.summary()['family_comparison']['near_tie'] is None
     assert 'near tie' not in write_report(cal, tmp_path, cal.summary()).read_text().lower()
+
+
+def test_the_summary_line_names_the_family_it_ties_with(tmp_path, capsys):
+    table = _table_of('balawender')
+    data = tmp_path / 'points.csv'
+    write_csv(data, {'speed': ('rpm', table.speed / RPM), 'flow': ('l/min', table.flow / LPM),
+                     'p_a': ('MPa', table.p_in / MPA), 'p_b': ('MPa', table.p_out / MPA)})
+    assert main(['calibrate', str(data), '--liquid', 'oil', '--out', str(tmp_path / 'a')]) == 0
+    assert '; family sliwinski2017 (near tie with balawender);' in capsys.readouterr().out

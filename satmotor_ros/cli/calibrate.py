@@ -96,6 +96,10 @@ def _calibrate(data: str, out: str, mode: Mode, alpha: float, folds: int,
     if len(summary['effects']) > 1:
         line += ', then ' + ', '.join(e['effect'] for e in summary['effects'][1:])
     line += f'; family {summary["family"]}'
+    tie = summary['family_comparison'].get('near_tie')
+    if tie:
+        other = next(f for f in tie['families'] if f != summary['family'])
+        line += f' (near tie with {other})'
     if summary['outliers']:
         line += f'; {len(summary["outliers"])} outlier(s) left out'
     rows = f'{summary["n_points"]} points'
