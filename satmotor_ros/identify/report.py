@@ -346,7 +346,8 @@ def _families(cal: Calibration) -> list[str]:
     comparison = cal.family_comparison()
     lines = ['## Model family', '', f'**{cal.model.family.name}**: {comparison["verdict"]}.', '']
     if comparison.get('near_tie'):
-        lines += [f'**{comparison["near_tie"]["note"].capitalize()}.**', '']
+        note = comparison['near_tie']['note']
+        lines += [f'**{note[0].upper()}{note[1:]}.**', '']  # family names keep their case
     if not comparison['families']:
         return lines
     rows = [[f'`{f["family"]}`', ', '.join(f['factors']) or '-',
