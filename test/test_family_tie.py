@@ -5,11 +5,10 @@ import numpy as np
 import pytest
 
 from satmotor_ros.cli import main
-from satmotor_ros.identify import calibrate, write_csv
+from satmotor_ros.identify import calibrate
 from satmotor_ros.identify.families import paired_p_value
 from satmotor_ros.identify.report import write_report
-from satmotor_ros.model.units import LPM, MPA, RPM
-from test_identify_families import _table_of
+from test_identify_families import _points_csv, _table_of
 
 
 def test_the_paired_test_tells_noise_from_a_worse_model():
@@ -45,9 +44,6 @@ def test_a_family_clearly_ahead_is_no_tie(family, tmp_path):
 
 
 def test_the_summary_line_names_the_family_it_ties_with(tmp_path, capsys):
-    table = _table_of('balawender')
-    data = tmp_path / 'points.csv'
-    write_csv(data, {'speed': ('rpm', table.speed / RPM), 'flow': ('l/min', table.flow / LPM),
-                     'p_a': ('MPa', table.p_in / MPA), 'p_b': ('MPa', table.p_out / MPA)})
+    data = _points_csv('balawender', tmp_path / 'points.csv')
     assert main(['calibrate', str(data), '--liquid', 'oil', '--out', str(tmp_path / 'a')]) == 0
     assert '; family sliwinski2017 (near tie with balawender);' in capsys.readouterr().out

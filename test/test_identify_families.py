@@ -27,6 +27,14 @@ def _table_of(family, seed=3, noise_lpm=0.02):
     return BenchTable(speed, flow, dp, np.zeros_like(dp), {}, {}, f'<{family} points>')
 
 
+def _points_csv(family, path):
+    """Write :func:`_table_of` `family` as a bench CSV of ports A and B; return its path."""
+    table = _table_of(family)
+    write_csv(path, {'speed': ('rpm', table.speed / RPM), 'flow': ('l/min', table.flow / LPM),
+                     'p_a': ('MPa', table.p_in / MPA), 'p_b': ('MPa', table.p_out / MPA)})
+    return path
+
+
 def test_calibrate_finds_the_family_that_made_the_data():
     family = 'paszota'
     cal = calibrate(_table_of(family), 'oil')
@@ -77,10 +85,7 @@ def test_a_calibrated_family_writes_a_yaml_of_that_family_that_loads(tmp_path):
 
 
 def test_cli_family_pins_and_displacement_sizes_the_compared_families(tmp_path, capsys):
-    table = _table_of('paszota')
-    data = tmp_path / 'points.csv'
-    write_csv(data, {'speed': ('rpm', table.speed / RPM), 'flow': ('l/min', table.flow / LPM),
-                     'p_a': ('MPa', table.p_in / MPA), 'p_b': ('MPa', table.p_out / MPA)})
+    data = _points_csv('paszota', tmp_path / 'points.csv')
     assert main(['calibrate', str(data), '--liquid', 'oil', '--out', str(tmp_path / 'a')]) == 0
     assert 'family paszota' in capsys.readouterr().out
     result = json.loads((tmp_path / 'a' / 'calibration.json').read_text())
