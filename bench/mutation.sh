@@ -6,8 +6,12 @@
 # Results: `cd /tmp/satmotor_mutation && /tmp/mut/bin/mutmut results`.
 set -eu
 work=/tmp/satmotor_mutation
-[ -x /tmp/mut/bin/mutmut ] || { python3 -m venv /tmp/mut &&
-    /tmp/mut/bin/pip install -q mutmut numpy scipy pyyaml hypothesis pytest matplotlib; }
+[ -x /tmp/mut/bin/mutmut ] || python3 -m venv /tmp/mut
+# the pinned runtime and test requirements (a model test may import the CLI and the bag
+# readers), not ROS, the linters or the type checker
+grep -v '^ros-\|colcon\|ament\|flake8\|pydocstyle\|mypy\|stubs' requirements.txt \
+    > /tmp/mut/requirements.txt
+/tmp/mut/bin/pip install -q mutmut -r /tmp/mut/requirements.txt
 rm -rf "$work" && mkdir -p "$work"
 git archive HEAD | tar -x -C "$work"
 cd "$work"
