@@ -86,6 +86,7 @@ def test_demo_closes_the_loop_on_its_own_recording(tmp_path):
     section = report[report.index('## Closing the loop'):]
     assert '`external_leakage = 2e-11`' in section and 'It named the injected effect.' in section
     assert '](loop/report.md)' in section and '](loop/residuals.png)' in section
+    assert 'Data: `bags/water_model_loop`' in (out / 'loop' / 'report.md').read_text()
     result = json.loads((out / 'loop' / 'calibration.json').read_text())
     first = result['effects'][0]
     assert first['effect'] == 'external_leakage'

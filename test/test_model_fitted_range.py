@@ -267,3 +267,23 @@ def test_a_displacement_motor_flags_the_speeds_its_size_was_never_validated_at()
     assert large.absorbency_point(1400 * RPM, dp_i=10 * MPA).status == EXTRAPOLATED
     assert large.absorbency(np.array([600, 1400]) * RPM, dp_i=10 * MPA).status.tolist() \
         == [0, EXTRAPOLATED]
+
+
+def test_a_reverse_effect_is_ranged_on_the_rows_that_turn_backwards(tmp_path):
+    """Forward rows up to 1500 rpm say nothing of a loss that acts only backwards."""
+    from satmotor_ros.identify import calibrate, read_csv, write_csv
+    from satmotor_ros.identify.synthetic import generate, Injection, Plan, to_columns
+    inject = Injection('reverse_loss', 0.6 * LPM)
+    forward = to_columns(generate(Plan(liquid='oil', n_points=80, speed_rpm=(100, 1500)),
+                                  inject, seed=1))
+    backward = to_columns(generate(Plan(liquid='oil', n_points=60, speed_rpm=(100, 300),
+                                        reverse_share=1.0), inject, seed=2))
+    write_csv(tmp_path / 'rev.csv', {k: (forward[k][0], np.concatenate([forward[k][1],
+                                                                        backward[k][1]]))
+                                     for k in forward})
+    cal = calibrate(read_csv(tmp_path / 'rev.csv'), 'oil')
+    [effect] = [e for e in cal.effects() if e.name == 'reverse_loss']
+    speeds = {q: (lo, hi) for q, lo, hi in effect.fitted_range}['speed']
+    backwards = cal.parts.speed[cal.parts.reverse & cal.inliers]
+    assert speeds == (backwards.min(), backwards.max())
+    assert speeds[1] < 310 * RPM  # not the forward rows' 1500 rpm

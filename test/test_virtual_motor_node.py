@@ -249,22 +249,30 @@ def test_lockstep_takes_one_period_per_flow_command(ros):
         command.publish(Float64(data=10.0 * LPM))
         assert _spin_until(executor, lambda: len(clock) == answered + 2)
     assert node.plant.state.time == pytest.approx(0.51, abs=1e-12)
+    for wait in (0.31, 0.3, 0.31, 0.3):  # a restart takes no period and publishes nothing
+        assert node.set_parameters([Parameter('paused', value=True)])[0].successful
+        assert node.set_parameters([Parameter('paused', value=False),
+                                    Parameter('lockstep_wait', value=wait)])[0].successful
+    _spin_until(executor, lambda: False, timeout=0.1)
+    assert len(clock) == 52 and node.plant.state.time == pytest.approx(0.51, abs=1e-12)
+    command.publish(Float64(data=10.0 * LPM))
+    assert _spin_until(executor, lambda: len(clock) == 53)
     stamps = [c.clock.sec * 1_000_000_000 + c.clock.nanosec for c in clock]
-    assert stamps == [10_000_000 * k for k in range(52)]  # whole periods, none skipped
+    assert stamps == [10_000_000 * k for k in range(53)]  # whole periods, none twice
     assert node.unanswered_steps == 0
     assert node.plant.state.speed > 0.0
     wall0 = time.monotonic()  # no answer: each period is taken after lockstep_wait
-    assert _spin_until(executor, lambda: len(clock) == 54, timeout=3.0)
-    assert time.monotonic() - wall0 == pytest.approx(0.6, abs=0.25)
+    assert _spin_until(executor, lambda: len(clock) == 55, timeout=5.0)
+    assert time.monotonic() - wall0 >= 0.55
     assert node.unanswered_steps == 2
     assert _spin_until(executor, lambda: any('lockstep' in st.message for d in diagnostics
                                              for st in d.status))
     warned = [st.message for d in diagnostics for st in d.status
               if st.level == DiagnosticStatus.WARN]
     assert '1 lockstep period(s) taken with no flow_command within lockstep_wait' in warned
-    answered_time = [d for d in diagnostics if d.header.stamp.nanosec <= 510_000_000]
+    answered_time = [d for d in diagnostics if d.header.stamp.nanosec <= 520_000_000]
     assert answered_time and all(st.level == DiagnosticStatus.OK for d in answered_time
                                  for st in d.status)
     assert node.set_parameters([Parameter('paused', value=True)])[0].successful
     _spin_until(executor, lambda: False, timeout=0.7)
-    assert len(clock) == 54 and node.plant.state.time == pytest.approx(0.53, abs=1e-12)
+    assert len(clock) == 55 and node.plant.state.time == pytest.approx(0.54, abs=1e-12)

@@ -9,6 +9,7 @@ was injected, the effects found one after the other, the error before and after.
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -62,7 +63,8 @@ def close_loop(bag: Path, liquid: str, effects: dict[str, Any], out: Path) -> li
              f'of that run (`{bag.relative_to(out)}`) as any recording, without being told '
              'what was injected.', '']
     try:
-        cal = calibrate(read_bag(bag), liquid)
+        # named as it will be once the demo's output is in place, not by its temporary path
+        cal = calibrate(replace(read_bag(bag), source=f'bags/{bag.name}'), liquid)
     except IdentificationError as err:
         return lines + [f'The calibration refused the recording: {err}', '']
     target = out / LOOP_DIR

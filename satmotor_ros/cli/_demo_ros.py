@@ -206,7 +206,10 @@ def run_cycle(liquid: str, feedforward: str, cycle: Cycle, effects: dict[str, An
     """
     namespace = f'/satmotor_demo_{os.getpid()}/{liquid}_{feedforward}'
     context = Context()
-    context.init()
+    # /clock and /diagnostics are global names: moved into the run's namespace, so that
+    # another demo (or any sim-time system) on the same ROS domain cannot cross this run
+    context.init(args=['--ros-args', '-r', f'/clock:={namespace}/clock',
+                       '-r', f'/diagnostics:={namespace}/diagnostics'])
     executor = SingleThreadedExecutor(context=context)
     nodes: list[Node] = []
     try:

@@ -158,7 +158,8 @@ def command(liquid: str, duration: str, effect: list[str], out: str, quiet: bool
         os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
         from satmotor_ros.cli import _demo_report as report
         from satmotor_ros.cli._demo_ros import run_cycle
-        runs = []
+        runs: list[report.RunResult] = []
+        loop_runs: list[report.RunResult] = []
         steps = (len(liquids) * len(FEEDFORWARDS) + 1.5 * (loop is not None)) * cycle.duration
         progress = None if quiet else Progress(steps)
         with output_dir('--out', out, 'demo', (), force) as out_dir:
@@ -170,22 +171,24 @@ def command(liquid: str, duration: str, effect: list[str], out: str, quiet: bool
             if loop is not None:
                 from satmotor_ros.cli._demo_loop import close_loop
                 bag = out_dir / 'bags' / f'{liquids[0]}_model_loop'
-                run_cycle(liquids[0], 'model', identification_cycle().scaled(1.5 * seconds),
-                          loop, bag, progress)
+                loop_runs.append(run_cycle(liquids[0], 'model',
+                                           identification_cycle().scaled(1.5 * seconds),
+                                           loop, bag, progress))
                 section = close_loop(bag, liquids[0], loop, out_dir)
             if progress is not None:
                 progress.done()
             report.write_report(out_dir, runs, cycle, effects, section)
     except (CliError, OSError) as err:
         return fail(err)
-    late = [f'{r.liquid}/{r.feedforward}' for r in runs if r.unanswered]
+    timed = runs + loop_runs
+    late = [f'{r.liquid}/{r.feedforward}' for r in timed if r.unanswered]
     if late:
         print(f'satmotor demo: warning: the controller missed periods in {", ".join(late)} '
               '(a busy machine): those runs are not repeatable; see report.md',
               file=sys.stderr)
     path, bags = Path(out) / 'report.md', Path(out) / 'bags'
-    wall = sum(r.wall for r in runs)
-    sim = sum(r.sim for r in runs)
+    wall = sum(r.wall for r in timed)
+    sim = sum(r.sim for r in timed)
     loop_note = '' if no_loop else f' and the loop run, calibrated into {Path(out) / "loop"}'
     print(f'satmotor demo: {len(runs)} runs{loop_note}, {sim:.0f} s simulated in {wall:.1f} s '
           f'({sim / wall:.1f}x real time); report: {path}; bags: {bags}')

@@ -26,7 +26,7 @@ from satmotor_ros.identify.table import BenchTable
 from satmotor_ros.identify.transient import (dynamics_summary, Samples, transient_samples,
                                              TransientOptions)
 from satmotor_ros.model import load_motor, MotorModel, MotorSpec
-from satmotor_ros.model.effects import Effect, measured_range
+from satmotor_ros.model.effects import Effect, kind_of, measured_range
 from satmotor_ros.model.revolutions import sampled_revolutions
 from satmotor_ros.model.units import LPM
 from satmotor_ros.model.viscosity import standard_law, ViscosityLaw
@@ -95,11 +95,15 @@ class Calibration:
 
     def effects(self) -> tuple[Effect, ...]:
         """Return the effects found at their fitted values, in order, with their fitted range."""
-        at = self.inliers
         data = {**self.table.channels, 'p_out': self.table.p_out, 'dp_i': self.parts.dp_i,
                 'speed': self.parts.speed, 'flow': np.abs(self.parts.flow)}
-        data = {k: np.asarray(v)[at] for k, v in data.items() if np.shape(v) == at.shape}
-        return tuple(measured_range(e, data) for _, e in self.forward.final.fit.found())
+
+        def fitted_on(effect: Effect) -> Effect:
+            # an effect of the backward direction learns only from the rows that run backwards
+            at = self.inliers & self.parts.reverse if kind_of(effect).reverse else self.inliers
+            return measured_range(effect, {k: np.asarray(v)[at] for k, v in data.items()
+                                           if np.shape(v) == at.shape})
+        return tuple(fitted_on(e) for _, e in self.forward.final.fit.found())
 
     @property
     def inliers(self) -> np.ndarray:

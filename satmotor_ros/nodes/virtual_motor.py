@@ -194,7 +194,8 @@ class VirtualMotorNode(Node):
         self._steady = Clock(clock_type=ClockType.STEADY_TIME)
         self._driver: Timer | GuardCondition | None = None
         self._lockstep_timer: Timer | None = None
-        self._awaiting, self._published_at = False, 0.0
+        # lockstep: the published period waits for its answer; a command came since then
+        self._awaiting, self._answer, self._published_at = False, False, 0.0
         self._start_stepping()
 
     # -- parameters --------------------------------------------------------------------
@@ -249,7 +250,8 @@ class VirtualMotorNode(Node):
             self._refuse(problem)
         else:
             self._command = value
-        self._answered()  # a refused command answers the step too: the last good one holds
+        self._answer = True  # a refused command answers the period too: the last good one holds
+        self._answered()
 
     def _on_load(self, msg: Float64) -> None:
         value = msg.data
@@ -282,16 +284,19 @@ class VirtualMotorNode(Node):
         self._next_diagnostics = self.plant.state.time
         self._ticks_wall = (time.monotonic(), self.plant.state.time)
         if values['clock_mode'] == 'lockstep':
-            # the start is published first (nodes on sim time take their clock from it, so
-            # that their timers do not see the first step as a jump), and the first period
-            # runs at once: a controller first acts one period after the start; every later
-            # period waits for the command that answers it
             self._driver = self.create_guard_condition(self._tick)
             self._lockstep_timer = self.create_timer(
                 values['lockstep_wait'] / 4, self._step_unanswered, clock=self._steady)
-            self._publish_state()
-            self._awaiting = False
-            self._driver.trigger()
+            if self.plant.state.time == 0.0:
+                # the start is published first (nodes on sim time take their clock from it,
+                # so that their timers do not see the first step as a jump), and the first
+                # period runs at once: a controller first acts one period after the start
+                self._publish_state()
+                self._answer = True
+            # a restart (a parameter, pause, another mode before) goes on from the period
+            # last published: taken now if a command answered it, else when one does
+            self._awaiting, self._published_at = True, time.monotonic()
+            self._answered()
             return
         if self._sim and values['max_speedup'] == 0.0:
             # as fast as possible: a guard condition the tick re-triggers, so the executor
@@ -305,8 +310,8 @@ class VirtualMotorNode(Node):
         self._driver = self.create_timer(period, self._tick, clock=self._steady)
 
     def _answered(self) -> None:
-        """Take the next lockstep step: a flow command answered the period."""
-        if self._awaiting and isinstance(self._driver, GuardCondition):
+        """Take the next lockstep step if a flow command answered the published period."""
+        if self._awaiting and self._answer and isinstance(self._driver, GuardCondition):
             self._awaiting = False
             self._driver.trigger()
 
@@ -315,13 +320,14 @@ class VirtualMotorNode(Node):
         if self._awaiting and time.monotonic() - self._published_at >= \
                 self._setup.values['lockstep_wait']:
             self.unanswered_steps += 1
+            self._answer = True
             self._answered()
 
     def _publish_state(self) -> None:
         self._publish()  # the sensors first, then the clock that makes a controller act on them
         self._clock_msg.clock = _stamp(self.plant.state.time)
         self._clock_pub.publish(self._clock_msg)
-        self._awaiting = True
+        self._awaiting, self._answer = True, False
         self._published_at = time.monotonic()
 
     def _free_tick(self) -> None:

@@ -52,8 +52,8 @@ import numpy as np
 from satmotor_ros.model._typing import FloatArray, Real
 from satmotor_ros.model.effects._base import (Candidate, CandidateData, Conditions,
                                               CORE_CHANNELS, DOCUMENTARY, Effect, EffectKind,
-                                              KINDS, Modifier, PlantInjection, PlantParameter,
-                                              SensorError, Shape, Synthetic)
+                                              finite, KINDS, Modifier, PlantInjection,
+                                              PlantParameter, SensorError, Shape, Synthetic)
 from satmotor_ros.model.errors import ConfigError
 
 if TYPE_CHECKING:
@@ -227,13 +227,13 @@ def _fitted_range(doc: Any, quantities: tuple[str, ...],
     for quantity in quantities:
         value = doc[quantity]
         pair = list(value) if isinstance(value, (list, tuple)) else []
-        numbers = [v for v in pair if not isinstance(v, bool) and isinstance(v, (int, float))
-                   and math.isfinite(v)]
-        if len(pair) != 2 or len(numbers) != 2 or not pair[0] <= pair[1]:
+        low, high = (finite(v, f'{where}.{quantity}') for v in pair) if len(pair) == 2 else (
+            math.nan, math.nan)
+        if not low <= high:
             msg = (f'{where}.{quantity} = {value!r}: expected [min, max], two finite numbers '
                    'with min <= max')
             raise ConfigError(msg)
-        out.append((quantity, float(pair[0]), float(pair[1])))
+        out.append((quantity, low, high))
     return tuple(out)
 
 
