@@ -294,8 +294,9 @@ def _bad_cells(si: dict[str, FloatArray], labels: Mapping[str, str],
     An absurd cell (:func:`_absurd`) of a required column drops its row; one of another
     channel is made missing (NaN) in `si`. In a table of operating points, a channel
     missing in a few rows (at most :data:`_MOST_MISSING` of them) drops those rows, so
-    that its effects are tested on the others rather than not at all. Returns the rows to
-    drop and one note per column naming it and the rows.
+    that its effects are tested on the others rather than not at all; missing in more (or
+    in a recording), it is kept and its effects are not tested, which the note says.
+    Returns the rows to drop and one note per column naming it and the rows.
     """
     n = len(si['speed'])
     drop = np.zeros(n, dtype=bool)
@@ -310,13 +311,17 @@ def _bad_cells(si: dict[str, FloatArray], labels: Mapping[str, str],
         else:
             si[name] = values = np.where(absurd, np.nan, values)
         missing = ~np.isfinite(values)
-        if (name not in REQUIRED and not time_series and missing.any()
-                and missing.sum() <= _MOST_MISSING * n):
-            drop |= missing
-            notes.append(f"{BAD_CELLS}: column '{label}': dropped {int(missing.sum())} rows "
-                         f'where it is missing{" or absurd" if largest else ""}{largest} '
-                         f'(data rows {_rows(missing)}), '
-                         'so that its effects are tested on the others')
+        if name not in REQUIRED and missing.any():
+            what = f'missing{" or absurd" if largest else ""}{largest}'
+            if not time_series and missing.sum() <= _MOST_MISSING * n:
+                drop |= missing
+                notes.append(f"{BAD_CELLS}: column '{label}': dropped {int(missing.sum())} "
+                             f'rows where it is {what} (data rows {_rows(missing)}), '
+                             'so that its effects are tested on the others')
+            else:
+                notes.append(f"{BAD_CELLS}: column '{label}': {what} in "
+                             f'{int(missing.sum())} of {n} rows (data rows {_rows(missing)}): '
+                             'too many to drop, so its effects are not tested')
         elif absurd.any():
             action = 'dropped the rows of' if name in REQUIRED else 'ignored'
             notes.append(f"{BAD_CELLS}: column '{label}': {action} {int(absurd.sum())} absurd "
