@@ -26,6 +26,9 @@ from satmotor_ros.cli._common import CliError
 MARKER = '.satmotor-output.json'
 """File in every output directory naming the subcommand that wrote it."""
 
+COMMITTED: list[Path] = []
+"""Each output renamed into place by this process, in order (what an interrupt leaves)."""
+
 
 def _temporary(target: Path) -> Path:
     return target.with_name(f'.{target.name}.partial-{os.getpid()}')
@@ -91,9 +94,11 @@ def _replace(temporary: Path, target: Path) -> None:
         old = target.with_name(f'.{target.name}.old-{os.getpid()}')
         os.replace(target, old)
         os.replace(temporary, target)
+        COMMITTED.append(target)
         shutil.rmtree(old, ignore_errors=True)
     else:
         os.replace(temporary, target)
+        COMMITTED.append(target)
 
 
 @contextmanager

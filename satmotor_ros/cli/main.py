@@ -4,12 +4,16 @@
 from __future__ import annotations
 
 import argparse
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
+import signal
 import sys
+import threading
 
 from satmotor_ros import __version__
 from satmotor_ros.cli import (calibrate, characteristics, demo, operating_point, replay,
                               validate)
+from satmotor_ros.cli import _output
 from satmotor_ros.cli._common import add_subcommand, CliError, fail, take_motor_options
 from satmotor_ros.limits import BAD_OVERRIDES
 
@@ -17,6 +21,39 @@ SUBCOMMANDS = {'demo': demo, 'operating-point': operating_point,
                'characteristics': characteristics, 'replay': replay, 'calibrate': calibrate,
                'validate': validate}
 """Each ``satmotor`` subcommand and the module that defines it, in the order of ``--help``."""
+
+INTERRUPTED = 130
+"""Exit code after SIGINT or SIGTERM (128 + SIGINT, as a shell reports Ctrl-C), [-]."""
+
+
+class _Terminated(KeyboardInterrupt):
+    """SIGTERM, raised as Ctrl-C is so that every output's with-block removes its temporary."""
+
+
+def _terminate(signum: int, frame: object) -> None:
+    raise _Terminated
+
+
+@contextmanager
+def _sigterm_as_interrupt() -> Iterator[None]:
+    if threading.current_thread() is not threading.main_thread():  # only it may set one
+        yield
+        return
+    previous = signal.signal(signal.SIGTERM, _terminate)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+def _interrupted(err: KeyboardInterrupt) -> int:
+    """Say in one line that the run was interrupted and what became of its outputs."""
+    how = 'terminated (SIGTERM)' if isinstance(err, _Terminated) else 'interrupted'
+    done = _output.COMMITTED
+    left = ('; ' + ', '.join(map(str, done)) + ' written before it') if done else ''
+    print(f'satmotor: {how}; outputs not yet written are left as they were{left}',
+          file=sys.stderr)
+    return INTERRUPTED
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -53,9 +90,21 @@ def main(argv: Sequence[str] | None = None) -> int:
     -------
     int
         Exit code: 0 on success, 1 on an error the command reports (also a SATMOTOR_*
-        cap variable that changes nothing), 2 on bad usage.
+        cap variable that changes nothing, or memory running out), 2 on bad usage, 130
+        after SIGINT (Ctrl-C) or SIGTERM (one line; no output is left half-written).
 
     """
+    with _sigterm_as_interrupt():
+        try:
+            return _run(argv)
+        except KeyboardInterrupt as err:
+            return _interrupted(err)
+        except MemoryError:
+            return fail('out of memory; ask for less (fewer points, a lower --rate, a '
+                        'shorter bag)')
+
+
+def _run(argv: Sequence[str] | None) -> int:
     args = vars(build_parser().parse_args(argv))
     args.pop('subcommand')
     command = args.pop('command')

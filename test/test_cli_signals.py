@@ -1,0 +1,59 @@
+# SPDX-License-Identifier: Apache-2.0
+"""SIGINT and SIGTERM mid-write: one line, exit 130, no temporary left, the old output kept."""
+
+import json
+import os
+from pathlib import Path
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _env():
+    return {**os.environ, 'PYTHONPATH': str(ROOT)}
+
+
+@pytest.fixture(scope='module')
+def bag(tmp_path_factory):
+    path = tmp_path_factory.mktemp('signals') / 'bag'
+    subprocess.run([sys.executable, '-m', 'satmotor_ros.identify.synthetic', '--liquid',
+                    'water', '--series', '30000', '--bag', 'mcap', '--seed', '3', '--out',
+                    str(path)], env=_env(), check=True, capture_output=True, timeout=120)
+    return path
+
+
+@pytest.mark.parametrize('signum', [signal.SIGINT, signal.SIGTERM])
+def test_a_signal_while_the_bag_is_written_leaves_the_earlier_output(bag, signum):
+    work = bag.parent / signum.name
+    work.mkdir()
+    earlier = work / 'out'
+    earlier.mkdir()  # an earlier output of replay: its marker, and a file that must stay
+    (earlier / '.satmotor-output.json').write_text(json.dumps({'command': 'replay'}))
+    (earlier / 'keep').write_text('earlier')
+    proc = subprocess.Popen(
+        [sys.executable, '-m', 'satmotor_ros.cli', 'replay', str(bag), '--topic-map',
+         '/flow_measured:=flow_command', '--no-plot', '--out-bag', str(earlier)],
+        env=_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 60
+        while not list(work.glob('.out.partial-*')) and proc.poll() is None \
+                and time.monotonic() < deadline:
+            time.sleep(0.002)
+        assert proc.poll() is None, 'replay finished before its temporary bag appeared'
+        proc.send_signal(signum)
+        out, err = proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    how = 'interrupted' if signum == signal.SIGINT else 'terminated (SIGTERM)'
+    assert proc.returncode == 130
+    assert err == f'satmotor: {how}; outputs not yet written are left as they were\n'
+    assert 'wrote' not in out
+    assert sorted(p.name for p in work.iterdir()) == ['out']
+    assert (earlier / 'keep').read_text() == 'earlier'
