@@ -77,11 +77,15 @@ BAG_MAX_RATIO = _cap('SATMOTOR_BAG_MAX_RATIO', 200)
 BAG_FLOOR_BYTES = 64 << 20
 """Bytes any bag may decompress to, however small it is, [byte]."""
 
-RATE_MAX_PREDICTIONS = _cap('SATMOTOR_RATE_MAX_PREDICTIONS', 20_000_000)
-"""Most predictions ``replay --mode rate`` makes (5.5 h at 1 kHz; about 5 GB of results), [-]."""
+RATE_MAX_PREDICTIONS = _cap('SATMOTOR_RATE_MAX_PREDICTIONS', 4_000_000)
+"""Most predictions ``replay --mode rate`` makes (66 min at 1 kHz; replay peaks at about 2 GB,
+0.5 KB a prediction), [-]."""
 
 CSV_MAX_COLUMNS = _cap('SATMOTOR_CSV_MAX_COLUMNS', 256)
 """Most columns of a CSV or text log read; calibration's work grows with each, [-]."""
+
+CURVE_MAX_POINTS = _cap('SATMOTOR_CURVE_MAX_POINTS', 100_000)
+"""Most points per curve of ``satmotor characteristics --points`` (about 40 MB), [-]."""
 
 PLOT_MAX_PANELS = _cap('SATMOTOR_PLOT_MAX_PANELS', 24)
 """Most panels of a report's residual grid (24: 960 x 1920 pixels), [-]."""
@@ -124,6 +128,6 @@ def bag_budget(stored_bytes: int) -> int:
 
 
 __all__ = ['BAD_OVERRIDES', 'BadOverride', 'BAG_FLOOR_BYTES', 'BAG_MAX_BYTES', 'BAG_MAX_RATIO',
-           'CAP_MAX', 'CSV_MAX_COLUMNS',
+           'CAP_MAX', 'CSV_MAX_COLUMNS', 'CURVE_MAX_POINTS',
            'PLOT_MAX_PANELS', 'RATE_MAX_PREDICTIONS', 'YAML_MAX_BYTES',
            'YAML_MAX_DEPTH', 'YAML_MAX_DIGITS', 'YAML_MAX_NODES', 'bag_budget']

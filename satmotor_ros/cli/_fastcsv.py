@@ -48,9 +48,7 @@ def fixed_point(values: npt.ArrayLike, decimals: int) -> npt.NDArray[np.uint8]:
         decimals = 0
         mag, neg = np.abs(x).astype(np.uint64), x < 0
     else:
-        biggest = float(np.abs(x[valid]).max()) if valid.any() else 0.0
-        while decimals > 0 and biggest * 10.0 ** decimals >= _LIMIT:
-            decimals -= 1
+        decimals = shown_decimals(x, decimals)
         valid &= np.abs(x) * 10.0 ** decimals < _LIMIT
         scaled = np.round(np.where(valid, x, 0.0) * 10.0 ** decimals)
         neg = scaled < 0
@@ -78,6 +76,32 @@ def fixed_point(values: npt.ArrayLike, decimals: int) -> npt.NDArray[np.uint8]:
     out[rows, units - used[rows]] = ord('-')
     out[~valid] = 0
     return out
+
+
+def shown_decimals(values: npt.ArrayLike, decimals: int) -> int:
+    """
+    Return the decimal places :func:`fixed_point` shows for `values`.
+
+    Parameters
+    ----------
+    values : array_like
+        Numbers, [-]
+    decimals : int
+        Decimal places asked for, [-]
+
+    Returns
+    -------
+    int
+        `decimals`, fewer where the largest finite value * 10^decimals would exceed 2^53;
+        formatting a column in pieces with it gives the digits of the whole column.
+
+    """
+    x = np.asarray(values, dtype=np.float64)
+    valid = np.isfinite(x)
+    biggest = float(np.abs(x[valid]).max()) if valid.any() else 0.0
+    while decimals > 0 and biggest * 10.0 ** decimals >= _LIMIT:
+        decimals -= 1
+    return decimals
 
 
 def text(values: Sequence[str]) -> npt.NDArray[np.uint8]:

@@ -71,6 +71,22 @@ def check_target(option: str, target: Path, inputs: Sequence[str | Path], force:
             and not _empty_dir(target):
         raise CliError(f'{option} {str(target)!r} exists and is not an earlier output of '
                        f'satmotor {command}; choose a new path or pass --force to replace it')
+    _probe(option, target)
+
+
+def _probe(option: str, target: Path) -> None:
+    """Refuse a target whose directory takes no file, before any work is done for it."""
+    if not target.parent.is_dir():
+        return  # made when the output is written; an error then is still one line
+    probe = _temporary(target)
+    try:
+        probe.open('x').close()
+    except FileExistsError:
+        return
+    except OSError as err:
+        raise CliError(f'{option} {str(target)!r}: cannot write there ({err.strerror})') \
+            from None
+    probe.unlink(missing_ok=True)
 
 
 def _empty_dir(path: Path) -> bool:

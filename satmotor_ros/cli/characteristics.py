@@ -13,6 +13,7 @@ import numpy as np
 from satmotor_ros.cli._common import add_motor_options, CliError, fail
 from satmotor_ros.cli._output import output_dir
 from satmotor_ros.interface import MotorOptions
+from satmotor_ros.limits import CURVE_MAX_POINTS
 from satmotor_ros.model import ModelError, MotorModel
 from satmotor_ros.model.families import DEFAULT_FAMILY
 from satmotor_ros.model.losses import (displacement_change, displacement_change_empirical,
@@ -52,7 +53,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              'only if this command wrote it')
     parser.add_argument('--force', action='store_true',
                         help='replace an existing --out that this command did not write')
-    parser.add_argument('--points', type=int, default=60, help='points per curve (default 60)')
+    parser.add_argument('--points', type=int, default=60,
+                        help='points per curve (default 60; at most 100000, '
+                             'SATMOTOR_CURVE_MAX_POINTS)')
     add_motor_options(parser)
 
 
@@ -80,6 +83,9 @@ def command(out: str, points: int, options: MotorOptions, force: bool = False) -
     try:
         if points < 2:
             raise CliError(f'--points {points}: need at least 2')
+        if points > CURVE_MAX_POINTS:
+            raise CliError(f'--points {points}: more than {CURVE_MAX_POINTS} points per curve '
+                           '(the cap SATMOTOR_CURVE_MAX_POINTS)')
         model = options.build_model()
         dp_i = np.linspace(0.5 * MPA, model.valid_range.dp_max, points)
         figures = [*constant_flow(model, dp_i), constant_speed(model, dp_i)]

@@ -11,9 +11,8 @@ import sys
 import threading
 
 from satmotor_ros import __version__
-from satmotor_ros.cli import (calibrate, characteristics, demo, operating_point, replay,
-                              validate)
-from satmotor_ros.cli import _output
+from satmotor_ros.cli import (_output, calibrate, characteristics, demo, operating_point,
+                              replay, validate)
 from satmotor_ros.cli._common import add_subcommand, CliError, fail, take_motor_options
 from satmotor_ros.limits import BAD_OVERRIDES
 

@@ -11,6 +11,7 @@ holds the recorded and the predicted topics side by side.
 from __future__ import annotations
 
 import argparse
+from contextlib import ExitStack
 import json
 from pathlib import Path
 import time
@@ -46,6 +47,8 @@ _OUTPUT_COLUMNS = (('dp', 'dp [MPa]', MPA, 9), ('dp_i', 'dp_i [MPa]', MPA, 9),
 
 COMMAND = 'replay'
 _CSV_START = b'log_time [ns],time [s]'
+CSV_CHUNK_ROWS = 65536
+"""Rows formatted at once; the text of a CSV row takes about 1.5 KB while it is built, [-]."""
 
 HELP = "run the motor_model node's prediction over a recorded bag"
 DESCRIPTION = ("Replay a rosbag2 bag (sqlite3 or MCAP) through the motor_model node's "
@@ -136,6 +139,9 @@ def command(bag: str, out: str | None, out_bag: str | None, plot: str | None, no
         for option, (target, ours) in targets.items():
             if target is not None:
                 check_target(option, Path(target), inputs, force, ours, COMMAND)
+        figure = _plot_path(bag, out, plot, no_plot)
+        written = {'--out-bag': out_bag, '--out': out, '--plot': figure}
+        _refuse_clashes({option: Path(p) for option, p in written.items() if p is not None})
         model = options.build_model()
         renames = parse_topic_map(topic_map)
         series = read_series(bag, [TOPICS[name] for name in INPUTS], renames, joint,
@@ -145,27 +151,25 @@ def command(bag: str, out: str | None, out_bag: str | None, plot: str | None, no
         if not batch.valid.any():
             raise CliError(f'{bag}: none of {len(batch)} predictions could be made; the '
                            f'first: {batch.message(0)}')
-        if out_bag is not None:
-            with output_file('--out-bag', out_bag, COMMAND, written_by(COMMAND), inputs,
-                             force) as tmp:
+        measured = series.get(TOPICS['measured_speed'])
+        picture = figure if measured is not None and len(measured) else None
+        with ExitStack() as outputs:  # every output renamed into place only once all are made
+            if out_bag is not None:
+                tmp = outputs.enter_context(output_file('--out-bag', out_bag, COMMAND,
+                                                        written_by(COMMAND), inputs, force))
                 _write_bag(tmp, series, batch, joint)
                 (tmp / MARKER).write_text(json.dumps({'command': COMMAND}) + '\n',
                                           encoding='utf-8')
-    except (BagError, CliError, ModelError) as err:
-        return fail(err)
-    except OSError as err:
-        return fail(CliError(f'{err.filename}: {err.strerror}'))
-    try:
-        if out is not None:
-            with output_file('--out', out, COMMAND, _csv_by_replay, inputs, force) as tmp:
+            if out is not None:
+                tmp = outputs.enter_context(output_file('--out', out, COMMAND, _csv_by_replay,
+                                                        inputs, force))
                 write_csv(tmp, batch)
-        picture = _plot_path(bag, out, plot, no_plot, series)
-        if picture is not None:
-            with output_file('--plot', picture, COMMAND, png_by(COMMAND), inputs,
-                             force) as tmp:
+            if picture is not None:
+                tmp = outputs.enter_context(output_file('--plot', picture, COMMAND,
+                                                        png_by(COMMAND), inputs, force))
                 plot_speed(tmp, batch, f'{Path(bag).name}: {model.liquid.name}, '
                                        f'{model.displacement_law}')
-    except CliError as err:
+    except (BagError, CliError, ModelError) as err:
         return fail(err)
     except OSError as err:
         return fail(CliError(f'{err.filename}: {err.strerror}'))
@@ -174,6 +178,17 @@ def command(bag: str, out: str | None, out_bag: str | None, plot: str | None, no
         if path is not None:
             print(f'wrote {path}')
     return 0
+
+
+def _refuse_clashes(targets: dict[str, Path]) -> None:
+    """Refuse two outputs on one path, or one inside another (an output directory)."""
+    resolved = {option: path.resolve() for option, path in targets.items()}
+    for first, (option, path) in enumerate(resolved.items()):
+        for other, there in list(resolved.items())[first + 1:]:
+            if path == there or path.is_relative_to(there) or there.is_relative_to(path):
+                raise CliError(f'{option} {str(targets[option])!r} and {other} '
+                               f'{str(targets[other])!r} are one path or one holds the other; '
+                               'choose different paths')
 
 
 def _require(bag: str, series: dict[str, Series], renames: dict[str, str]) -> None:
@@ -342,27 +357,31 @@ def write_csv(path: Path, batch: PredictionBatch) -> None:
     """
     snaps = batch.snapshots
     t_ns = snaps.stamp_ns
+    t0 = int(t_ns[0]) if len(t_ns) else 0
     header = _CSV_START.decode('ascii').split(',')
-    fields = [fastcsv.fixed_point(t_ns, 0),
-              fastcsv.fixed_point((t_ns - (t_ns[0] if len(t_ns) else 0)) / 1e9, 9)]
+    numbers = [(t_ns, 0), ((t_ns - t0) / 1e9, 9)]  # each column in SI and its decimals
     for name, title, unit, decimals in _INPUT_COLUMNS:
         values = snaps.values[INPUTS.index(name)]
         if name in REQUIRED or not np.isnan(values).all():  # absent optional inputs: no column
-            fields.append(fastcsv.fixed_point(values / unit, decimals))
+            numbers.append((values / unit, decimals))
             header.append(title)
     for name, title, unit, decimals in _OUTPUT_COLUMNS:
         values = batch.output(name)
         if name != 'residual' or not np.isnan(values).all():
-            fields.append(fastcsv.fixed_point(values / unit, decimals))
+            numbers.append((values / unit, decimals))
             header.append(title)
+    numbers = [(v, d if np.issubdtype(v.dtype, np.integer) else fastcsv.shown_decimals(v, d))
+               for v, d in numbers]
     levels = [Level(k).name for k in range(3)]
-    fields += [fastcsv.text([levels[k] for k in batch.level.tolist()]),
-               fastcsv.text(_status_names(batch)), fastcsv.text(_state_notes(batch))]
+    texts = [[levels[k] for k in batch.level.tolist()], _status_names(batch),
+             _state_notes(batch)]
     header += ['level', 'model_status', 'inputs']
     with path.open('wb') as stream:
         stream.write((','.join(header) + '\n').encode('ascii'))
-        if len(t_ns):
-            stream.write(fastcsv.rows(fields))
+        for start in range(0, len(t_ns), CSV_CHUNK_ROWS):  # bounded memory: rows in pieces
+            part = slice(start, start + CSV_CHUNK_ROWS)
+            stream.write(fastcsv.rows([fastcsv.fixed_point(v[part], d) for v, d in numbers]
+                                      + [fastcsv.text(t[part]) for t in texts]))
 
 
 def _write_bag(path: Path, series: dict[str, Series], batch: PredictionBatch,
@@ -390,10 +409,9 @@ def _write_bag(path: Path, series: dict[str, Series], batch: PredictionBatch,
     write_bag(path, topics)
 
 
-def _plot_path(bag: str, out: str | None, plot: str | None, no_plot: bool,
-               series: dict[str, Series]) -> Path | None:
-    measured = series.get(TOPICS['measured_speed'])
-    if no_plot or measured is None or not len(measured):
+def _plot_path(bag: str, out: str | None, plot: str | None, no_plot: bool) -> Path | None:
+    """Where the plot goes when the bag has a measured speed."""
+    if no_plot:
         return None
     if plot is not None:
         return Path(plot)
