@@ -4,17 +4,20 @@ YAML files read with bounded work: size, nesting, alias expansion, integer digit
 
 Every YAML file the package reads (motor files, column mappings, a bag's
 ``metadata.yaml``) goes through :func:`read_yaml`. A small hostile file must
-not take unbounded memory or time, nor end in a traceback: a file larger than
-``YAML_MAX_BYTES`` (``/dev/zero`` included), nesting deeper than
-``YAML_MAX_DEPTH``, aliases that would expand to more than ``YAML_MAX_NODES``
-nodes (a "billion laughs" bomb), an integer of more than ``YAML_MAX_DIGITS``
-digits and a key given twice are each refused with one line. The document is
+not take unbounded memory or time, nor end in a traceback: a path that is not a
+regular file (a FIFO would block forever, ``/dev/zero`` never end), a file larger
+than ``YAML_MAX_BYTES``, nesting deeper than ``YAML_MAX_DEPTH``, aliases that would
+expand to more than ``YAML_MAX_NODES`` nodes (a "billion laughs" bomb), an integer
+of more than ``YAML_MAX_DIGITS`` digits (hex, octal, binary and sexagesimal ones
+too: their letters count) and a key given twice are each refused with one line. The document is
 never expanded into an error message. The caps live in :mod:`satmotor_ros.limits`.
 """
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
+import stat
 from typing import Any
 
 from satmotor_ros.limits import YAML_MAX_BYTES, YAML_MAX_DEPTH, YAML_MAX_DIGITS, YAML_MAX_NODES
@@ -73,7 +76,9 @@ class _BoundedLoader(yaml.SafeLoader):
         return size
 
     def construct_yaml_int(self, node: Any) -> Any:
-        digits = sum(c.isdigit() for c in str(node.value))
+        # every letter or digit: 0x/0o/0b prefixes and hex digits count too, underscores
+        # and the colons of a sexagesimal 1:30:00 do not; 40 of them stay a finite float
+        digits = sum(c.isalnum() for c in str(node.value))
         if digits > YAML_MAX_DIGITS:
             raise YamlLimitError(f'line {node.start_mark.line + 1}: an integer of {digits} '
                                  f'digits (at most {YAML_MAX_DIGITS})')
@@ -91,6 +96,27 @@ class _BoundedLoader(yaml.SafeLoader):
 
 
 _BoundedLoader.add_constructor('tag:yaml.org,2002:int', _BoundedLoader.construct_yaml_int)
+
+
+def shown(value: Any, limit: int = 40) -> str:
+    """
+    Return the repr of a value read from a file, cut to `limit` characters for an error line.
+
+    Parameters
+    ----------
+    value : Any
+        The value, [-]
+    limit : int
+        Most characters shown, [-]
+
+    Returns
+    -------
+    str
+        ``repr(value)``, or its first characters and how long it is.
+
+    """
+    text = repr(value)
+    return text if len(text) <= limit else f'{text[:limit]}... ({len(text)} characters)'
 
 
 def parse_yaml(text: str) -> Any:
@@ -150,10 +176,14 @@ def read_yaml(path: str | Path) -> Any:
     OSError
         If the file cannot be read.
     YamlLimitError
-        If it is not UTF-8 YAML or exceeds a cap; one line, without the document.
+        If it is not a regular file (a FIFO would block), not UTF-8 YAML or exceeds
+        a cap; one line, without the document.
 
     """
-    with open(path, 'rb') as file:
+    # O_NONBLOCK: opening a FIFO does not wait for a writer, so fstat can refuse it
+    with open(os.open(path, os.O_RDONLY | os.O_NONBLOCK), 'rb') as file:
+        if not stat.S_ISREG(os.fstat(file.fileno()).st_mode):
+            raise YamlLimitError('not a regular file (a FIFO, device or directory)')
         data = file.read(YAML_MAX_BYTES + 1)
     if len(data) > YAML_MAX_BYTES:
         raise _too_large()
@@ -164,4 +194,4 @@ def read_yaml(path: str | Path) -> Any:
     return parse_yaml(text)
 
 
-__all__ = ['YamlLimitError', 'parse_yaml', 'read_yaml']
+__all__ = ['YamlLimitError', 'parse_yaml', 'read_yaml', 'shown']

@@ -20,6 +20,7 @@ import math
 from typing import NamedTuple
 
 from satmotor_ros.model import load_motor, ModelError, MotorModel
+from satmotor_ros.model.coefficients import displacement_problem
 from satmotor_ros.model.config import MotorSpec
 from satmotor_ros.model.families import DEFAULT_FAMILY, FAMILY_NAMES
 from satmotor_ros.model.families.defaults import default_motor
@@ -172,9 +173,10 @@ class MotorOptions:
         """Reject a family, law, displacement or liquid property that cannot be, naming it."""
         if self.family not in ('', *FAMILY_NAMES):
             raise OptionError('family', self.family, f'use one of {", ".join(FAMILY_NAMES)}')
-        if not (math.isfinite(self.displacement) and 0.0 <= self.displacement < 1.0):
+        problem = displacement_problem(self.displacement) if self.displacement != 0.0 else None
+        if problem is not None:
             raise OptionError('displacement', self.displacement,
-                              "must be a finite value > 0 (0: the motor file's)")
+                              f"{problem}; 0: the motor file's")
         if self.displacement and self.motor_file:
             raise OptionError('displacement', self.displacement, 'a motor file has its own: '
                               'give the file or the displacement, not both')

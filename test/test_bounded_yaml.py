@@ -1,13 +1,18 @@
 # SPDX-License-Identifier: Apache-2.0
 """Hostile YAML files end in one line within bounded time and memory (issue 14)."""
 
+import os
 import resource
+import subprocess
+import sys
 import time
 
 import pytest
 
 from satmotor_ros.bags import BagError, open_bag
 from satmotor_ros.bounded_yaml import parse_yaml, read_yaml, YamlLimitError
+from satmotor_ros.identify.columns import load_mapping
+from satmotor_ros.identify.errors import DataError
 from satmotor_ros.interface import MotorOptions
 from satmotor_ros.limits import YAML_MAX_BYTES
 from satmotor_ros.model import ConfigError, load_motor
@@ -28,6 +33,12 @@ HOSTILE = {
     'alias bomb': (_alias_bomb(), 'aliases expand to more than'),
     'deep nesting': ('[' * 20000, 'nesting deeper than'),
     'huge integer': ('geometry:\n  module: ' + '9' * 400 + '\n', 'an integer of 400 digits'),
+    'huge hex integer': ('a1: 0x' + 'f' * 400 + '\n', 'an integer of 402 digits'),
+    'hex beyond int()': ('a1: 0x' + 'f' * 5000 + '\n', 'an integer of 5002 digits'),
+    'huge octal integer': ('a1: 0' + '7' * 400 + '\n', 'an integer of 401 digits'),
+    'huge binary integer': ('a1: -0b' + '1' * 400 + '\n', 'an integer of 402 digits'),
+    'underscored integer': ('a1: 1' + '_9' * 400 + '\n', 'an integer of 401 digits'),
+    'sexagesimal integer': ('a1: 1' + ':59' * 200 + '\n', 'an integer of 401 digits'),
     'duplicate key': ('motor: a\nmotor: b\n', "line 2: key 'motor' is given twice"),
     'not yaml': ('a: [1, 2\n', 'not valid YAML'),
 }
@@ -49,12 +60,63 @@ def test_aliases_that_stay_small_are_read():
     assert doc['use'] == [{'x': 1}, {'x': 1}]
 
 
-def test_endless_file_is_cut_at_the_cap():
-    before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+@pytest.mark.parametrize('text', ['0x' + 'f' * 38, '9' * 40, '-0b' + '1' * 38, '1:30:00'])
+def test_integers_within_the_cap_are_read(text):
+    assert isinstance(parse_yaml(f'a1: {text}\n')['a1'], int)
+
+
+def test_file_larger_than_the_cap_is_refused(tmp_path):
+    path = tmp_path / 'large.yaml'
+    path.write_text('# ' + 'x' * YAML_MAX_BYTES + '\n')
     with pytest.raises(YamlLimitError, match=f'larger than {YAML_MAX_BYTES} bytes'):
+        read_yaml(path)
+
+
+def test_endless_device_is_refused_unread():
+    # a device is not a regular file: refused before reading (formerly cut at the size cap)
+    before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    with pytest.raises(YamlLimitError, match='not a regular file'):
         read_yaml('/dev/zero')
     grown_kib = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before
     assert grown_kib < 64 * 1024
+
+
+def test_fifo_is_refused_at_once_and_never_blocks(tmp_path):
+    fifo = tmp_path / 'fifo.yaml'
+    os.mkfifo(fifo)
+    start = time.perf_counter()
+    with pytest.raises(YamlLimitError, match=r'^not a regular file'):
+        read_yaml(fifo)
+    with pytest.raises(ConfigError, match=r"^motor config '.*fifo.yaml': not a regular file"):
+        MotorOptions(motor_file=str(fifo)).build_model()
+    with pytest.raises(DataError, match=r'fifo.yaml: not a regular file'):
+        load_mapping(str(fifo))
+    assert time.perf_counter() - start < 2.0
+
+
+def test_cli_refuses_a_fifo_and_a_hex_bomb_with_one_line(tmp_path):
+    fifo, bomb = tmp_path / 'fifo.yaml', tmp_path / 'bomb.yaml'
+    os.mkfifo(fifo)
+    hex_a1 = 'a1: 0x' + 'f' * 400 + ' #'
+    bomb.write_text(default_config_path().read_text().replace('a1:', hex_a1, 1))
+    for path, reason in ((fifo, 'not a regular file'), (bomb, 'an integer of 402 digits')):
+        proc = subprocess.run([sys.executable, '-m', 'satmotor_ros.cli', 'operating-point',
+                               '--flow', '30', '--dp-i', '10', '--motor', str(path)],
+                              capture_output=True, text=True, timeout=60)
+        assert proc.returncode == 1 and proc.stderr.count('\n') == 1, proc.stderr
+        assert reason in proc.stderr and 'Traceback' not in proc.stderr, proc.stderr
+
+
+def test_a_long_value_in_a_column_mapping_is_cut_in_the_error(tmp_path):
+    path = tmp_path / 'long.columns.yaml'
+    path.write_text(f'columns:\n  flow: {{column: q, unit: l/min, sign: "{"1" * 480}"}}\n')
+    with pytest.raises(DataError, match=r"sign: '1111.*\.\.\. \(482 characters\): use 1") \
+            as info:
+        load_mapping(str(path))
+    assert len(str(info.value)) < 200
+    path.write_text('columns:\n  flow: {column: q, unit: l/min, sign: 0x' + 'f' * 5000 + '}\n')
+    with pytest.raises(DataError, match='an integer of 5002 digits'):
+        load_mapping(str(path))
 
 
 def test_motor_file_bomb_is_a_config_error_naming_the_file(tmp_path):

@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from satmotor_ros.bounded_yaml import read_yaml, YamlLimitError
+from satmotor_ros.bounded_yaml import read_yaml, shown, YamlLimitError
 from satmotor_ros.identify.errors import DataError
 from satmotor_ros.identify.table import (BenchTable, column_to_si, KNOWN_KINDS,
                                          table_from_columns)
@@ -75,13 +75,14 @@ def _source(doc: Any, where: str, name: str) -> Source:
     if isinstance(doc, (str, int)) and not isinstance(doc, bool):
         doc = {'column': doc}
     if not isinstance(doc, Mapping):
-        raise _fail(where, f'expected a column name or {{column: ..., unit: ...}}, got {doc!r}')
+        raise _fail(where, 'expected a column name or {column: ..., unit: ...}, got '
+                    f'{shown(doc)}')
     unknown = [k for k in doc if k not in _KEYS]
     if unknown:
         raise _fail(where, f'unknown key {unknown[0]!r} (known: {", ".join(_KEYS)})')
     column = doc.get('column')
     if isinstance(column, bool) or not isinstance(column, (str, int)) or column == '':
-        raise _fail(f'{where}.column', f'expected a column name or number, got {column!r}')
+        raise _fail(f'{where}.column', f'expected a column name or number, got {shown(column)}')
     if isinstance(column, int) and column < 1:
         raise _fail(f'{where}.column', f'column numbers start at 1, got {column}')
     unit = str(doc.get('unit', '') or '')
@@ -94,21 +95,21 @@ def _source(doc: Any, where: str, name: str) -> Source:
         except UnitError as err:
             raise _fail(f'{where}.area', str(err)) from None
         if not area > 0.0:
-            raise _fail(f'{where}.area', f'{doc["area"]!r} must be > 0')
+            raise _fail(f'{where}.area', f'{shown(doc["area"])} must be > 0')
     sign = doc.get('sign', 1)
     if sign not in (1, -1) or isinstance(sign, bool):
-        raise _fail(f'{where}.sign', f'{sign!r}: use 1 or -1')
+        raise _fail(f'{where}.sign', f'{shown(sign)}: use 1 or -1')
     if sign == -1 and name not in _SIGNED:
         raise _fail(f'{where}.sign', f'only {", ".join(_SIGNED)} may have their sign turned')
     reference = str(doc.get('reference', '') or '')
     if reference and (reference not in ('gauge', 'absolute') or _kind(name) != 'pressure'):
-        raise _fail(f'{where}.reference', f'{reference!r}: a pressure is gauge or absolute')
+        raise _fail(f'{where}.reference', f'{shown(reference)}: a pressure is gauge or absolute')
     implied = pressure_reference(unit) if unit else None
     if reference and implied and implied != reference:
         raise _fail(f'{where}.reference', f'{reference} contradicts the unit {unit!r}')
     optional = doc.get('optional', False)
     if not isinstance(optional, bool):
-        raise _fail(f'{where}.optional', f'{optional!r}: use true or false')
+        raise _fail(f'{where}.optional', f'{shown(optional)}: use true or false')
     return Source(column, unit, area, float(sign), reference, optional)
 
 
@@ -121,7 +122,7 @@ def _kind(name: str) -> str | None:
 def _section(doc: Mapping[str, Any], key: str, where: str) -> Mapping[str, Any]:
     value = doc.get(key) or {}
     if not isinstance(value, Mapping):
-        raise _fail(f'{where}: {key}', f'expected a mapping, got {value!r}')
+        raise _fail(f'{where}: {key}', f'expected a mapping, got {shown(value)}')
     return value
 
 
@@ -158,9 +159,10 @@ def mapping_from_dict(doc: Any, where: str = '<mapping>') -> ColumnMapping:
             raise _fail(f'{where}: file', f'unknown key {key!r} (known: {", ".join(_FILE)})')
     if layout['separator'] not in ('auto', *SEPARATORS):
         raise _fail(f'{where}: file.separator',
-                    f'{layout["separator"]!r}: use auto, {", ".join(SEPARATORS)}')
+                    f'{shown(layout["separator"])}: use auto, {", ".join(SEPARATORS)}')
     if layout['header'] not in HEADERS:
-        raise _fail(f'{where}: file.header', f'{layout["header"]!r}: use {", ".join(HEADERS)}')
+        raise _fail(f'{where}: file.header',
+                    f'{shown(layout["header"])}: use {", ".join(HEADERS)}')
     columns = _section(doc, 'columns', where)
     for name in columns:
         if name not in FIELDS:
@@ -178,7 +180,7 @@ def mapping_from_dict(doc: Any, where: str = '<mapping>') -> ColumnMapping:
         raise _fail(f'{where}: channels.{clash[0]}', 'is a bench field: put it under columns:')
     others = doc.get('other_columns', 'drop')
     if others not in ('drop', 'keep'):
-        raise _fail(f'{where}: other_columns', f'{others!r}: use drop or keep')
+        raise _fail(f'{where}: other_columns', f'{shown(others)}: use drop or keep')
     return ColumnMapping(fields, channels, str(layout['separator']), str(layout['comment'] or ''),
                          str(layout['header']), others == 'keep', where)
 

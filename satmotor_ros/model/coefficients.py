@@ -40,6 +40,41 @@ def _check(owner: str, name: str, value: float, low: float, high: float,
         raise FieldError(owner, name, f'{value!r} is outside {bracket}{low}, {high})')
 
 
+DISPLACEMENT_RANGE = (0.01 * CM3_PER_REV, 1.0e6 * CM3_PER_REV)
+"""
+Open range of a motor's displacement q_t/(2 pi), [m^3/rad]: 0.01 to 1e6 cm^3/rev.
+
+Wider than any displacement machine built (micro gear pumps have about 0.02 cm^3/rev,
+the largest low-speed radial-piston motors about 250 000 cm^3/rev), narrow enough that
+the scaling of a family's default coefficients (c_t ~ q^(-4/3)) and of the validated
+speeds (~ q^(-1/3)) stays finite: a displacement of 1e-300 m^3/rad overflows them.
+Every displacement (motor file, node parameter, CLI option) is checked here.
+"""
+
+
+def displacement_problem(value: float) -> str | None:
+    """
+    Say why a displacement is not one a motor can have.
+
+    Parameters
+    ----------
+    value : float
+        Displacement q_t/(2 pi), [m^3/rad]
+
+    Returns
+    -------
+    str or None
+        ``'outside (low, high) m^3/rad (...)'``, or None when it is inside
+        :data:`DISPLACEMENT_RANGE`.
+
+    """
+    low, high = DISPLACEMENT_RANGE
+    if isinstance(value, (int, float)) and math.isfinite(value) and low < value < high:
+        return None
+    return (f'outside ({low:.4g}, {high:.4g}) m^3/rad '
+            '(0.01 to 1e6 cm^3/rev, wider than any displacement machine)')
+
+
 LIQUID_RANGES = {'kinematic_viscosity': (1.0e-8, 1.0), 'density': (10.0, 1.0e5),
                  'bulk_modulus': (1.0e5, 1.0e12)}
 """
@@ -84,7 +119,10 @@ class MotorGeometry:
 
     def __post_init__(self) -> None:
         """Reject non-physical dimensions, naming the field."""
-        for name, high in (('displacement', 1.0), ('module', 0.1), ('height', 1.0),
+        problem = displacement_problem(self.displacement)
+        if problem is not None:
+            raise FieldError('geometry', 'displacement', f'{self.displacement!r} is {problem}')
+        for name, high in (('module', 0.1), ('height', 1.0),
                            ('clearance_rotor', 1.0e-3), ('clearance_satellites', 1.0e-3),
                            ('commutation_diameter', 1.0)):
             _check('geometry', name, getattr(self, name), 0.0, high)

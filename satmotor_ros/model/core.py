@@ -10,6 +10,7 @@ wear) build their motors here, so neither needs the other.
 from __future__ import annotations
 
 from satmotor_ros.model.coefficients import CoefficientSet, Liquid, MotorGeometry, ValidRange
+from satmotor_ros.model.errors import ConfigError
 from satmotor_ros.model.families import family_of
 from satmotor_ros.model.point import PointEvaluator
 
@@ -42,6 +43,10 @@ class ModelCore:
         self.geometry, self.coefficient_set = geometry, coefficient_set
         self.valid_range, self.liquid, self.law_name = valid_range, liquid, law
         self.family = family_of(coefficient_set.coefficients)
-        self.eqs = self.family.compose(geometry, coefficient_set, valid_range, liquid, law)
+        try:
+            self.eqs = self.family.compose(geometry, coefficient_set, valid_range, liquid, law)
+        except (OverflowError, ZeroDivisionError) as err:  # a safety net behind the range checks
+            raise ConfigError(f'the {self.family.name} constants of this motor and liquid '
+                              f'cannot be computed ({err})') from None
         self.derived = self.eqs.derived
         self.point = PointEvaluator(self.eqs)

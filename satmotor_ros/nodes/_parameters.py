@@ -23,6 +23,7 @@ from rclpy.exceptions import InvalidParameterTypeException, InvalidParameterValu
 from rclpy.node import Node
 from rclpy.parameter import AllowableParameterValue, Parameter
 from satmotor_ros.interface import DISPLACEMENT_LAWS, MotorOptions
+from satmotor_ros.model.coefficients import DISPLACEMENT_RANGE, displacement_problem
 from satmotor_ros.model.families import FAMILY_NAMES
 
 RosParameter: TypeAlias = Parameter[AllowableParameterValue]
@@ -175,6 +176,13 @@ def values(node: Node, specs: Iterable[ParamSpec]) -> dict[str, Any]:
     return {spec.name: node.get_parameter(spec.name).value for spec in specs}
 
 
+def _displacement_reason(value: float) -> str | None:
+    """Refuse a displacement no motor has (0 keeps meaning the motor file's)."""
+    problem = displacement_problem(value) if value != 0.0 else None
+    return None if problem is None else (f'displacement = {value!r} m^3/rad: {problem}; '
+                                         "0: the motor file's")
+
+
 MOTOR_PARAMETERS = (
     ParamSpec('liquid', MotorOptions.liquid, "coefficient set and its liquid: 'oil' or 'water' "
               'for the packaged SM-0,75/25, or any set of motor_file'),
@@ -192,7 +200,7 @@ MOTOR_PARAMETERS = (
               choices=('', *FAMILY_NAMES)),
     ParamSpec('displacement', MotorOptions.displacement, 'displacement of a motor with no '
               "motor_file (the family's default coefficients, to be calibrated); 0: the "
-              "motor file's", 'm^3/rad', 0.0, 1.0e-2),
+              "motor file's", 'm^3/rad', 0.0, DISPLACEMENT_RANGE[1], check=_displacement_reason),
     ParamSpec('displacement_law', MotorOptions.displacement_law, 'change of displacement: '
               'physical eq. (33) or empirical eq. (39)', choices=DISPLACEMENT_LAWS),
 )

@@ -14,9 +14,8 @@ calibrated; its validated range is the SM-0,75/25's carried over by similarity
 from __future__ import annotations
 
 from dataclasses import replace
-import math
 
-from satmotor_ros.model.coefficients import MotorGeometry, ValidRange
+from satmotor_ros.model.coefficients import displacement_problem, MotorGeometry, ValidRange
 from satmotor_ros.model.config import load_motor, MotorSpec
 from satmotor_ros.model.errors import ConfigError
 from satmotor_ros.model.families import DEFAULT_FAMILY, family_named
@@ -96,7 +95,8 @@ def default_motor(family: str = DEFAULT_FAMILY, displacement: float | None = Non
     Raises
     ------
     ConfigError
-        For an unknown family or a displacement that is not a finite value > 0.
+        For an unknown family or a displacement outside
+        :data:`~satmotor_ros.model.coefficients.DISPLACEMENT_RANGE`.
 
     Examples
     --------
@@ -111,13 +111,16 @@ def default_motor(family: str = DEFAULT_FAMILY, displacement: float | None = Non
         if fam.name == DEFAULT_FAMILY:
             return packaged
         displacement, name = packaged.geometry.displacement, f'{packaged.name} ({fam.name})'
-    elif not (math.isfinite(displacement) and 0.0 < displacement < 1.0):
-        msg = f'displacement = {displacement!r} m^3/rad: expected a finite value > 0'
-        raise ConfigError(msg)
+    elif (problem := displacement_problem(displacement)) is not None:
+        raise ConfigError(f'displacement = {displacement!r} m^3/rad is {problem}')
     else:
         name = f'{fam.name} motor of {displacement / CM3_PER_REV:.4g} cm^3/rev{DEFAULTS_NOTE}'
-    sets = {key: replace(s, coefficients=fam.default_coefficients(s, displacement), effects=())
-            for key, s in packaged.sets.items()}
+    try:
+        sets = {key: replace(s, coefficients=fam.default_coefficients(s, displacement),
+                             effects=()) for key, s in packaged.sets.items()}
+    except (OverflowError, ZeroDivisionError) as err:  # a safety net behind the range check
+        raise ConfigError(f'displacement = {displacement!r} m^3/rad: the default coefficients '
+                          f'of {fam.name} cannot be scaled to it ({err})') from None
     scale = (displacement / packaged.geometry.displacement) ** (1.0 / 3.0)
     return MotorSpec(name, similar_geometry(packaged.geometry, displacement),
                      similar_range(packaged.valid_range, scale), sets, f'<{fam.name} defaults>',
