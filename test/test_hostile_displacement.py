@@ -14,7 +14,7 @@ import pytest
 from satmotor_ros.bounded_yaml import read_yaml
 from satmotor_ros.interface import MotorOptions, OptionError
 from satmotor_ros.model import ConfigError, load_motor, MotorModel
-from satmotor_ros.model.coefficients import DISPLACEMENT_RANGE, displacement_problem
+from satmotor_ros.model.coefficients import displacement_problem, DISPLACEMENT_RANGE
 from satmotor_ros.model.config import default_config_path
 from satmotor_ros.model.core import ModelCore
 from satmotor_ros.model.units import CM3_PER_REV
@@ -48,7 +48,7 @@ def test_a_motor_file_with_a_tiny_displacement_is_refused(tmp_path):
         doc = read_yaml(default_config_path())
         doc['family'], doc['geometry']['displacement'] = family, 1e-300
         path.write_text(yaml.safe_dump(doc))
-        with pytest.raises(ConfigError, match=r"^geometry.displacement = 1e-300 is "
+        with pytest.raises(ConfigError, match=r'^geometry.displacement = 1e-300 is '
                                               r'outside \(1.592e-09'):
             load_motor(path)
         with pytest.raises(ConfigError, match='geometry.displacement = 1e-300'):
@@ -115,8 +115,8 @@ def test_a_node_refuses_a_tiny_displacement_and_a_hostile_motor_file_and_lives(
         node, harness, tmp_path):
     fifo, bomb = tmp_path / 'fifo.yaml', tmp_path / 'bomb.yaml'
     os.mkfifo(fifo)
-    bomb.write_text(default_config_path().read_text().replace('a1:', 'a1: 0x' + 'f' * 400 + ' #',
-                                                                1))
+    hex_a1 = 'a1: 0x' + 'f' * 400 + ' #'
+    bomb.write_text(default_config_path().read_text().replace('a1:', hex_a1, 1))
     proc, name = _start(node, '-p', 'displacement:=1e-300')
     try:
         for path, reason in ((fifo, 'not a regular file'), (bomb, 'an integer of 402 digits')):

@@ -23,7 +23,7 @@ from rclpy.exceptions import InvalidParameterTypeException, InvalidParameterValu
 from rclpy.node import Node
 from rclpy.parameter import AllowableParameterValue, Parameter
 from satmotor_ros.interface import DISPLACEMENT_LAWS, MotorOptions
-from satmotor_ros.model.coefficients import DISPLACEMENT_RANGE, displacement_problem
+from satmotor_ros.model.coefficients import displacement_problem, DISPLACEMENT_RANGE
 from satmotor_ros.model.families import FAMILY_NAMES
 
 RosParameter: TypeAlias = Parameter[AllowableParameterValue]
