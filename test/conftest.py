@@ -8,6 +8,8 @@ tests start inherit it.
 """
 
 import os
+from pathlib import Path
+import sys
 
 import pytest
 
@@ -19,6 +21,36 @@ os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
 # ephemeral port range), and 0 is everyone's default, so use 1..101.
 if not os.environ.get('ROS_DOMAIN_ID'):
     os.environ['ROS_DOMAIN_ID'] = str(1 + os.getpid() % 101)
+
+
+REPOSITORY = Path(__file__).resolve().parents[1]
+_read_outside: list[str] = []
+
+
+def read_beside(path: str, repository: Path) -> bool:
+    """Tell whether opening ``path`` reads a file beside ``repository`` (not inside it)."""
+    path = os.path.abspath(path)
+    beside = path.startswith(str(repository.parent) + os.sep)
+    # A tool probing for a config file that is not there (pydocstyle) reads nothing.
+    return beside and not path.startswith(str(repository) + os.sep) and os.path.exists(path)
+
+
+def _note_reads_beside_the_repository(event, args):
+    # shared/ and any other sibling of the clone is what a user's clone does not have.
+    if event == 'open' and isinstance(args[0], str) and read_beside(args[0], REPOSITORY):
+        _read_outside.append(args[0])
+
+
+sys.addaudithook(_note_reads_beside_the_repository)
+
+
+@pytest.fixture(autouse=True)
+def _self_contained():
+    """Fail a test that opened a file beside the repository (a user's clone has none)."""
+    _read_outside.clear()
+    yield
+    if _read_outside:
+        pytest.fail(f'read outside the repository: {_read_outside[0]}', pytrace=False)
 
 
 @pytest.fixture()

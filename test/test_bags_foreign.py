@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: Apache-2.0
-"""The 24 foreign bags of shared/data/foreign_bags: every one read, or one clear error."""
+"""The 24 foreign bags of test/data/foreign_bags: every one read, or one clear error."""
 
 import numpy as np
 import pytest
@@ -7,7 +7,7 @@ from rosbags.highlevel import AnyReader
 from rosbags.typesys import get_typestore, Stores
 
 from satmotor_ros.bags import BagError, list_topics, open_bag, read_series
-from shared_data import foreign_bag, FOREIGN_BAGS, shared_path
+from vendored_data import data_path, foreign_bag, FOREIGN_BAGS
 
 # Messages in the storage, counted independently of any bag library (the bags' README).
 STORAGE_COUNTS = {
@@ -25,7 +25,7 @@ DISAGREEING = {'v3_cdr_test_type_mismatch': '/test_topic is test_msgs/msg/BasicT
 
 
 def test_the_table_covers_all_24_bags():
-    bags = sorted(p.name for p in shared_path('data', 'foreign_bags').iterdir() if p.is_dir())
+    bags = sorted(p.name for p in data_path('foreign_bags').iterdir() if p.is_dir())
     assert bags == sorted([*STORAGE_COUNTS, *DISAGREEING]) == sorted(FOREIGN_BAGS)
     assert len(bags) == 24
 

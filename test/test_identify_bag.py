@@ -10,7 +10,7 @@ from satmotor_ros.cli import main
 from satmotor_ros.identify import calibrate, DataError
 from satmotor_ros.identify.bag import read_bag
 from satmotor_ros.identify.synthetic import generate_series, Injection, Plan, write_bag_of
-from shared_data import foreign_bag, FOREIGN_BAGS
+from vendored_data import foreign_bag, FOREIGN_BAGS
 
 
 @pytest.fixture(scope='module')

@@ -14,7 +14,7 @@ from satmotor_ros.identify.columns import load_mapping, mapping_from_dict, read_
 from satmotor_ros.model import load_motor
 from satmotor_ros.model.families import FAMILY_NAMES
 from satmotor_ros.model.units import INCH, LPM, MPA, PSI, RPM
-from shared_data import shared_path
+from vendored_data import data_path
 import yaml
 
 MBARI = ('2021.07.26T10.51.44.exp', 'FrictionIDMovesWithBiasCurr.exp')
@@ -22,11 +22,11 @@ DISPLACEMENT = 0.30 * INCH ** 3 / (2.0 * math.pi)  # Parker F11-5 [m^3/rad]
 
 
 def _mbari(name):
-    return read_log(shared_path('data', 'real', 'mbari_pto', name), load_mapping('mbari_pto'))
+    return read_log(data_path('real', 'mbari_pto', name), load_mapping('mbari_pto'))
 
 
 def _raw(name):
-    return np.loadtxt(shared_path('data', 'real', 'mbari_pto', name), comments='#')
+    return np.loadtxt(data_path('real', 'mbari_pto', name), comments='#')
 
 
 @pytest.mark.parametrize(('name', 'rows', 'dropped'), [(MBARI[0], 22001, 49),
@@ -178,7 +178,7 @@ def mbari_calibrations(tmp_path_factory):
     runs = {}
     for name in MBARI:
         out = tmp_path_factory.mktemp('cal') / name
-        log = shared_path('data', 'real', 'mbari_pto', name)
+        log = data_path('real', 'mbari_pto', name)
         errors = io.StringIO()
         with contextlib.redirect_stderr(errors):
             code = main(['calibrate', str(log), '--columns', 'mbari_pto', '--liquid', 'oil',
@@ -205,7 +205,7 @@ def test_calibrate_each_mbari_log_with_the_f11_displacement(mbari_calibrations, 
 def test_validate_one_mbari_logs_calibration_on_the_other(mbari_calibrations, tmp_path, capsys,
                                                           calibrated, data):
     _, out, _ = mbari_calibrations[calibrated]
-    log = shared_path('data', 'real', 'mbari_pto', data)
+    log = data_path('real', 'mbari_pto', data)
     code = main(['validate', str(log), '--columns', 'mbari_pto', '--liquid', 'oil',
                  '--motor', str(out / 'coefficients.yaml'), '--out', str(tmp_path / 'val')])
     assert code == 0, capsys.readouterr().err

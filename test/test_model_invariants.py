@@ -11,7 +11,7 @@ from satmotor_ros.model import INVALID, InvalidInputError, MotorModel, PointStat
 from satmotor_ros.model.losses import channel_pressure_drop
 from satmotor_ros.model.units import LPM, MPA, RPM
 
-DATA = Path(__file__).resolve().parent / 'data'  # copies of shared/model/reference_grid_*.csv
+DATA = Path(__file__).resolve().parent / 'data'  # reference grids (test/data/README.md)
 MODELS = {(liquid, law): MotorModel.default(liquid, law)
           for liquid in ('oil', 'water') for law in ('eq33', 'eq39')}
 RTOL = 1e-9

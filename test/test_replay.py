@@ -10,7 +10,7 @@ from satmotor_ros.bags import (encode_many, FLOAT64, FLUID_PRESSURE, JOINT_STATE
 from satmotor_ros.cli.main import main
 from satmotor_ros.model import MotorModel
 from satmotor_ros.model.units import LPM, MPA, RPM
-from shared_data import foreign_bag, FOREIGN_BAGS
+from vendored_data import foreign_bag, FOREIGN_BAGS
 
 OIL = MotorModel.default('oil')
 

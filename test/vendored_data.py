@@ -1,17 +1,17 @@
 # SPDX-License-Identifier: Apache-2.0
 """
-Where the tests find shared/ (beside the repository): one path, a loud failure without it.
+Where the tests find the real logs and foreign bags vendored under test/data (see its README).
 
-A test that needs shared/ calls :func:`shared_path` inside the test (not at collection), so
-that a missing shared/ fails those tests with one clear line instead of skipping them.
+A test that needs them calls :func:`data_path` inside the test (not at collection), so that a
+missing file fails that test with one clear line instead of skipping it.
 """
 
 from pathlib import Path
 
 import pytest
 
-SHARED = Path(__file__).resolve().parents[2] / 'shared'
-"""The shared/ directory beside the repository (../shared from its root)."""
+DATA = Path(__file__).resolve().parent / 'data'
+"""test/data: vendored copies with their licences and provenance."""
 
 FOREIGN_BAGS = (
     'nometa_filecompressed_split4', 'nometa_msgcompressed_split4', 'nometa_split3_talker',
@@ -23,17 +23,17 @@ FOREIGN_BAGS = (
     'v7_cdr_test_sqlite3', 'v8_services_mcap', 'v8_services_sqlite3', 'v9_actions_mcap',
     'v9_actions_sqlite3',
 )
-"""The 24 bags of shared/data/foreign_bags (its README describes each)."""
+"""The 24 bags of test/data/foreign_bags (its README describes each)."""
 
 
-def shared_path(*parts: str) -> Path:
+def data_path(*parts: str) -> Path:
     """
-    Return a path under shared/, failing the calling test when it is not there.
+    Return a path under test/data, failing the calling test when it is not there.
 
     Parameters
     ----------
     *parts : str
-        Path components below shared/, [-]
+        Path components below test/data, [-]
 
     Returns
     -------
@@ -41,10 +41,9 @@ def shared_path(*parts: str) -> Path:
         The existing path.
 
     """
-    path = SHARED.joinpath(*parts)
+    path = DATA.joinpath(*parts)
     if not path.exists():
-        pytest.fail(f'{path} is missing: this test needs the shared/ directory beside the '
-                    f'repository ({SHARED})', pytrace=False)
+        pytest.fail(f'{path} is missing from the repository', pytrace=False)
     return path
 
 
@@ -60,7 +59,7 @@ def foreign_bag(name: str) -> Path:
     Returns
     -------
     pathlib.Path
-        shared/data/foreign_bags/<name>.
+        test/data/foreign_bags/<name>.
 
     """
-    return shared_path('data', 'foreign_bags', name)
+    return data_path('foreign_bags', name)
