@@ -518,9 +518,11 @@ def dynamics_summary(fit: FitReport, samples: Samples) -> list[dict[str, Any]]:
     list of dict
         Per term of :data:`DYNAMIC_TERMS`: ``term``, ``symbol``, ``regressor``,
         ``equation``, ``meaning``, ``unit``, and either ``coefficient`` and
-        ``ci95`` (SI, in ``unit``) with ``nonzero`` (the interval excludes 0), or
-        ``left_out`` with the reason; a ``note`` on the two lags when their
-        regressors correlate beyond :data:`LAG_CORRELATION`.
+        ``ci95`` (SI, in ``unit``) with ``nonzero`` (the interval excludes 0) and
+        ``physical`` (false for a negative value: a volume over a bulk modulus and a
+        time constant are >= 0, so a negative fit is no estimate and ``impossible``
+        says so), or ``left_out`` with the reason; a ``note`` on the two lags when
+        their regressors correlate beyond :data:`LAG_CORRELATION`.
 
     """
     at = {name.removeprefix('nuisance:'): i for i, name in enumerate(fit.names)}
@@ -532,8 +534,12 @@ def dynamics_summary(fit: FitReport, samples: Samples) -> list[dict[str, Any]]:
                                  'equation': term.equation, 'meaning': term.meaning}
         if term.name in at:
             lo, hi = (float(v) for v in fit.ci95[at[term.name]])
-            entry.update(coefficient=written(fit.values[at[term.name]]),
-                         ci95=[written(lo), written(hi)], nonzero=bool(lo > 0.0 or hi < 0.0))
+            value = float(fit.values[at[term.name]])
+            entry.update(coefficient=written(value), ci95=[written(lo), written(hi)],
+                         nonzero=bool(lo > 0.0 or hi < 0.0), physical=bool(value >= 0.0))
+            if value < 0.0:
+                entry['impossible'] = (f'{term.symbol} < 0 cannot be (it is >= 0): not an '
+                                       'estimate; the term absorbs what the model lacks')
             if term.name != 'line_compliance' and abs(samples.correlation) > LAG_CORRELATION:
                 entry['note'] = (f"the two lags' regressors correlate (r = "
                                  f'{samples.correlation:.4f}): the data determine tau_n - '
@@ -607,7 +613,11 @@ def transient_section(summary: dict[str, Any], inflation: float) -> list[str]:
              f'correlation of neighbouring residuals (variance inflation {inflation:.3g}).', '']
     rows = []
     for d in summary['dynamics']:
-        if 'coefficient' in d:
+        if 'coefficient' in d and 'impossible' in d:
+            lo, hi = d['ci95']
+            value = f'{d["coefficient"]:.4g} **impossible**'
+            interval = f'[{lo:.4g}, {hi:.4g}]: {d["impossible"]}'
+        elif 'coefficient' in d:
             lo, hi = d['ci95']
             value = f'{d["coefficient"]:.4g}'
             interval = f'[{lo:.4g}, {hi:.4g}]' + ('' if d['nonzero'] else ' (includes 0)')
