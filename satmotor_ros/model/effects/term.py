@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 from collections.abc import Mapping
+import math
 import re
 from typing import Any
 
@@ -20,7 +21,10 @@ FORMS = (('dp',), ('n',), ('dp', 'n'))
 BOUNDS = {'dp': (0.05, 4.0), 'n': (0.05, 3.0)}
 """Range of each fitted exponent, [-]."""
 
-_FACTOR = re.compile(r'(dp|n)(?:\^([0-9.]+))?')
+MAX_EXPONENT = 10.0
+"""Largest exponent a ``term:`` id may give (k dp_i^a overflows past it), [-]."""
+
+_FACTOR = re.compile(r'(dp|n)(?:\^([0-9]+(?:\.[0-9]*)?|\.[0-9]+))?')
 
 
 def expression(a: float, b: float) -> str:
@@ -71,11 +75,13 @@ def exponents(suffix: str, where: str) -> tuple[float, float]:
     powers = {'dp': 0.0, 'n': 0.0}
     for factor in suffix.split('*'):
         match = _FACTOR.fullmatch(factor.strip())
-        if match is None or powers[match.group(1)] != 0.0:
-            msg = (f'{where}: term {suffix!r} is not a product of powers of dp and n '
-                   "(e.g. 'dp^0.76', 'dp^2*n', 'n^0.7')")
+        power = float(match.group(2) or 1.0) if match else math.nan
+        if match is None or powers[match.group(1)] != 0.0 or not 0.0 < power <= MAX_EXPONENT:
+            msg = (f'{where}: term {suffix!r} is not a product of powers of dp and n, each '
+                   f"power above 0 and at most {MAX_EXPONENT:g} (e.g. 'dp^0.76', 'dp^2*n', "
+                   "'n^0.7')")
             raise ConfigError(msg)
-        powers[match.group(1)] = float(match.group(2) or 1.0)
+        powers[match.group(1)] = power
     return powers['dp'], powers['n']
 
 
