@@ -36,9 +36,10 @@ $(STAMP): requirements.txt setup.py setup.cfg
 	touch $@
 
 # The main job: virtual motor, controller and model over ROS through a cycle of speed and
-# load steps on water and oil; bags and report.md with plots in out/demo (replaced each run).
+# load steps on water and oil; bags and report.md with plots in out/demo. The demo replaces
+# out/demo only if a demo wrote it (a directory of the user's there stops it, as every
+# command's --out does): no rm -rf here.
 run: $(STAMP)
-	rm -rf out/demo
 	$(VENV)/bin/satmotor demo --out out/demo
 
 test: $(STAMP)

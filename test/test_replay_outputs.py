@@ -75,3 +75,17 @@ def test_memory_and_interrupts_anywhere_are_one_line(capsys, monkeypatch, error,
     assert main(['replay', 'any']) == code
     err = capsys.readouterr().err
     assert err.startswith(line) and err.count('\n') == 1, err
+
+
+def test_the_out_bag_has_ordinary_names_that_its_metadata_names(bag, tmp_path, capsys):
+    """Issue 21: the bag's files are not left under the hidden temporary name."""
+    out = tmp_path / 'predicted'
+    assert main(['replay', str(bag), '--out-bag', str(out), '--no-plot']) == 0
+    visible = sorted(p.name for p in out.iterdir() if not p.name.startswith('.'))
+    assert visible == ['metadata.yaml', 'predicted.mcap'], sorted(out.iterdir())
+    assert 'partial' not in ''.join(p.name for p in out.iterdir())
+    metadata = (out / 'metadata.yaml').read_text(encoding='utf-8')
+    assert '- predicted.mcap' in metadata and 'partial' not in metadata
+    from satmotor_ros.bags import list_topics
+    assert '/motor1/predicted_joint_state' in list_topics(str(out))  # readable by its name
+    assert 'partial' not in ''.join(p.name for p in tmp_path.iterdir())

@@ -112,10 +112,14 @@ def test_installed_virtual_motor_runs_on_sim_time_and_survives_bad_commands(
     assert 'not a finite number' in output
 
 
+@pytest.mark.parametrize('bad', ['liquid:=honey', 'clock_mode:=lunar', 'publish_rate:=0.0'])
 def test_installed_virtual_motor_refuses_bad_start_parameters_in_one_line(
-        sourced_install, tmp_path):
-    """An unknown liquid at start-up: exit 1 and one line naming the value."""
-    process = _start(sourced_install, tmp_path, 'virtual_motor', '-p', 'liquid:=honey')
+        sourced_install, tmp_path, bad):
+    """An unknown liquid or clock mode, a rate out of range at start-up: exit 1, one line."""
+    process = _start(sourced_install, tmp_path, 'virtual_motor', '-p', bad)
     code, output = process.wait(timeout=30.0), process.stdout.read()
     assert code == 1, output
-    assert "'honey'" in output and 'Traceback' not in output
+    name, value = bad.split(':=')
+    lines = [line for line in output.splitlines() if line.startswith('virtual_motor: ')]
+    assert len(lines) == 1 and name in lines[0] and value.strip("'") in lines[0], output
+    assert 'Traceback' not in output

@@ -35,10 +35,12 @@ class OutTopic(NamedTuple):
 class _McapStorage:
     """rosbags' storage-writer interface over the ``mcap`` writer (zstd chunks with CRCs)."""
 
+    stem = ''  # name of the storage file without .mcap; '' for the directory's name
+
     def __init__(self, path: Path, compression: CompressionMode) -> None:  # noqa: ARG002
         from mcap.writer import CompressionType, Writer
 
-        self.path = path / f'{path.name}.mcap'
+        self.path = path / f'{self.stem or path.name}.mcap'
         self.stream = self.path.open('xb')
         self.mcap = Writer(self.stream, compression=CompressionType.ZSTD, enable_crcs=True)
         self.mcap.start(profile='ros2', library='satmotor_ros')
@@ -68,7 +70,8 @@ class _McapStorage:
         self.stream.close()
 
 
-def write_bag(path: str | Path, topics: Sequence[OutTopic], storage: str = 'mcap') -> int:
+def write_bag(path: str | Path, topics: Sequence[OutTopic], storage: str = 'mcap',
+              name: str = '') -> int:
     """
     Write topics into a new bag, every message in log-time order.
 
@@ -80,6 +83,10 @@ def write_bag(path: str | Path, topics: Sequence[OutTopic], storage: str = 'mcap
         What to write; types must be known to the ROS 2 Kilted typestore, [-]
     storage : {'mcap', 'sqlite3'}
         Storage plugin, [-]
+    name : str
+        The bag's final directory name, which names its storage file (``NAME.mcap``) when
+        `path` is a temporary name that is renamed to it once written; '' for `path`'s own
+        name (the only choice for sqlite3), [-]
 
     Returns
     -------
@@ -95,8 +102,11 @@ def write_bag(path: str | Path, topics: Sequence[OutTopic], storage: str = 'mcap
     from rosbags.rosbag2 import StoragePlugin, Writer, WriterError
     from rosbags.typesys import get_typestore, Stores
 
+    class Storage(_McapStorage):
+        stem = name
+
     class McapWriter(Writer):
-        STORAGE_PLUGINS = {**Writer.STORAGE_PLUGINS, StoragePlugin.MCAP: _McapStorage}
+        STORAGE_PLUGINS = {**Writer.STORAGE_PLUGINS, StoragePlugin.MCAP: Storage}
 
     path = Path(path)
     if path.exists():
@@ -104,6 +114,8 @@ def write_bag(path: str | Path, topics: Sequence[OutTopic], storage: str = 'mcap
     plugins = {'mcap': StoragePlugin.MCAP, 'sqlite3': StoragePlugin.SQLITE3}
     if storage not in plugins:
         raise BagError(f'storage {storage!r}: use mcap or sqlite3')
+    if name and storage != 'mcap':
+        raise BagError(f'name {name!r}: only an MCAP bag takes a storage file name')
     typestore = get_typestore(Stores.ROS2_KILTED)
     for topic in topics:
         if topic.msgtype not in typestore.fielddefs:

@@ -157,7 +157,7 @@ def command(bag: str, out: str | None, out_bag: str | None, plot: str | None, no
             if out_bag is not None:
                 tmp = outputs.enter_context(output_file('--out-bag', out_bag, COMMAND,
                                                         written_by(COMMAND), inputs, force))
-                _write_bag(tmp, series, batch, joint)
+                _write_bag(tmp, series, batch, joint, Path(out_bag).name)
                 (tmp / MARKER).write_text(json.dumps({'command': COMMAND}) + '\n',
                                           encoding='utf-8')
             if out is not None:
@@ -385,8 +385,14 @@ def write_csv(path: Path, batch: PredictionBatch) -> None:
 
 
 def _write_bag(path: Path, series: dict[str, Series], batch: PredictionBatch,
-               joint: str) -> None:
-    """Write the recorded inputs and the predictions (what the node publishes) to a bag."""
+               joint: str, name: str) -> None:
+    """
+    Write the recorded inputs and the predictions (what the node publishes) to a bag.
+
+    `path` is the hidden temporary directory renamed to the bag once every output is made;
+    its storage file is named after the bag's final name `name` (``NAME.mcap``), so that
+    ls, globs and clean-up scripts see an ordinary file.
+    """
     flow_topic = series[TOPICS['flow']].topic
     flow = CHANNELS['flow'].topic
     prefix = flow_topic[:-len(flow)] if flow_topic.endswith(flow) else '/'
@@ -406,7 +412,7 @@ def _write_bag(path: Path, series: dict[str, Series], batch: PredictionBatch,
         topics.append(OutTopic(prefix + SPEED_RESIDUAL, FLOAT64,
                                batch.snapshots.stamp_ns[has],
                                encode_many(FLOAT64, {'data': residual[has]})))
-    write_bag(path, topics)
+    write_bag(path, topics, name=name)
 
 
 def _plot_path(bag: str, out: str | None, plot: str | None, no_plot: bool) -> Path | None:

@@ -155,8 +155,10 @@ class VirtualMotorNode(Node):
         """Declare parameters, build the plant, open topics and start stepping."""
         super().__init__(node_name, **kwargs)
         self._specs = {spec.name: spec for spec in all_parameters()}
-        for problem in params.declare(self, self._specs.values()).values():
-            self.get_logger().error(f'parameter {problem}')
+        problems = params.declare(self, self._specs.values())
+        if problems:  # a plant run otherwise than asked is no test: refuse, as a bad set-up is
+            problem = next(iter(problems.values())).partition('; using the default')[0]
+            raise ValueError(f'parameter {problem}')
         self._setup = Setup(self._values())  # an inconsistent set-up raises here
         self.plant = Plant(self._setup.model, self._setup.params, self._setup.load)
         self.add_on_set_parameters_callback(self._validate)

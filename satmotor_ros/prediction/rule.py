@@ -25,6 +25,7 @@ import numpy.typing as npt
 
 from satmotor_ros.interface import CHANNELS, PREDICTION_INPUTS
 from satmotor_ros.limits import RATE_MAX_PREDICTIONS
+from satmotor_ros.model.screening import CEILINGS
 
 INPUTS = PREDICTION_INPUTS
 """The inputs of a prediction, in the order of every per-input tuple and array."""
@@ -64,6 +65,7 @@ class InputState(enum.IntEnum):
     STALE = 2  # older than the timeout
     NOT_FINITE = 3  # NaN or inf
     NEGATIVE = 4  # negative absolute pressure
+    BEYOND_LIMIT = 5  # finite but beyond any motor (model.screening.CEILINGS): a broken message
 
 
 @dataclass(frozen=True)
@@ -108,7 +110,8 @@ class Rule:
 
 _FLOAT_MAX = sys.float_info.max
 # plain ints: an enum member looked up on its class costs a microsecond per message
-_FRESH, _MISSING, _STALE, _NOT_FINITE, _NEGATIVE = (int(s) for s in InputState)
+_FRESH, _MISSING, _STALE, _NOT_FINITE, _NEGATIVE, _BEYOND = (int(s) for s in InputState)
+_CEILINGS = {name: CEILINGS.get(UNITS[name], math.inf) for name in INPUTS}
 
 
 def input_state(name: str, value: Any, age_ns: Any, timeout_ns: int) -> Any:
@@ -129,12 +132,16 @@ def input_state(name: str, value: Any, age_ns: Any, timeout_ns: int) -> Any:
     Returns
     -------
     int or ndarray of int
-        An :class:`InputState`: FRESH, MISSING, STALE, NOT_FINITE or NEGATIVE.
+        An :class:`InputState`: FRESH, MISSING, STALE, NOT_FINITE, NEGATIVE or
+        BEYOND_LIMIT.
 
     """
     # Operators only, so that Python's bools and numpy's bool arrays go through alike:
     # state + condition * (new - state) is `new` where the condition holds, later ones win.
     state = ((value < 0.0) & (name in NON_NEGATIVE)) * _NEGATIVE
+    # a finite value no motor reaches (6.3e8 rad/s) is a broken message: never used, so that
+    # it cannot feed the revolutions counter or any other state that outlives the message
+    state += (abs(value) > _CEILINGS[name]) * (_BEYOND - state)
     state += ((value != value) | (abs(value) > _FLOAT_MAX)) * (_NOT_FINITE - state)
     state += (age_ns > timeout_ns) * (_STALE - state)
     state += (age_ns != age_ns) * (_MISSING - state)  # NaN age: never arrived
@@ -377,4 +384,7 @@ def describe_input(name: str, state: int, value: float, age: float, timeout: flo
         return f'{field} = {value!r} {unit}: not finite'
     if state == InputState.NEGATIVE:
         return f'{field} = {value!r} {unit}: negative'
+    if state == InputState.BEYOND_LIMIT:
+        return (f'{field} = {value!r} {unit}: beyond any motor (limit '
+                f'{_CEILINGS[name]:g} {unit}), ignored')
     return f'{field} = {value!r} {unit}: ok'
