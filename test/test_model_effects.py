@@ -39,7 +39,7 @@ def balance(model, point):
 
 EFFECTS = {
     'external_leakage': ({'external_leakage': {'regressor': 'p_out', 'coefficient': 2e-12}},
-                         {'p_out': 0.8 * MPA}),
+                         {'p_in': 9.0 * MPA, 'p_out': 0.8 * MPA}),
     'viscosity_temperature': ({'viscosity_temperature': {
         'regressor': 'temperature', 'coefficient': 3.7, 'law': 'walther',
         'reference_temperature': 45.0, 'reference_viscosity': 40e-6}}, {'temperature': 60.0}),

@@ -103,7 +103,7 @@ def effect_block(cal: Calibration) -> dict[str, Any]:
         entry = effect_to_mapping(effect)
         entry.update(unit=row['unit'], ci95=row['ci95'], source=score.added.source)
         entry['evaluation'] = entry.pop('evaluation')
-        block[effect.name] = entry
+        block[effect.key] = entry
     return block
 
 

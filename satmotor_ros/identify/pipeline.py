@@ -138,7 +138,7 @@ class Calibration:
                 'regressor': effect.regressor if candidate.shape else candidate.regressor,
                 'coefficient': written(value), 'ci95': [written(v) for v in ci95],
                 'unit': candidate.unit, 'p_value': float(f'{score.p_value:.3g}'),
-                'error_after': self.errors(score).as_dict()}
+                'error_after': self.errors(score).as_dict(), 'direction': effect.direction}
             if effect.kind == 'term':
                 row['expression'] = effect.suffix
                 row['exponents'] = {k: written(effect.option(k)) for k in ('dp', 'n')}
@@ -482,7 +482,7 @@ def calibrate(table: BenchTable, liquid: str = 'oil', spec: MotorSpec | None = N
     if note:
         points = replace(points, notes=points.notes + (note,))
     law = standard_law(model.liquid, liquid)
-    channels = {**points.channels, 'p_out': points.p_out}
+    channels = {**points.channels, 'p_in': points.p_in, 'p_out': points.p_out}
     candidates, skipped = build_library(parts, channels, law)
     selector = _selector(options, points, samples)
     forward = selector.select(parts, candidates)

@@ -115,7 +115,7 @@ class Score:
         if self.candidate is None:
             return 'none'
         if self.candidate.shape:
-            return self.fit.found()[-1][1].name
+            return self.fit.found()[-1][1].key
         return self.candidate.label
 
     @property

@@ -155,7 +155,7 @@ def _note_extrapolated(points: BenchTable, count: int, what: str) -> BenchTable:
 def _predicted(calibrated: CalibratedModel, points: BenchTable,
                parts: LossParts) -> tuple[FloatArray, np.ndarray]:
     """Predict the flow reading in each row's frame (as ``parts.flow``); which are EXTRAPOLATED."""
-    channels = {**points.channels, 'p_out': points.p_out}
+    channels = {**points.channels, 'p_in': points.p_in, 'p_out': points.p_out}
     model = calibrated.model
     missing = [name for name in model.channels if name not in channels]
     if missing:

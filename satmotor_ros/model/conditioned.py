@@ -24,6 +24,7 @@ import numpy as np
 from satmotor_ros.model.coefficients import MotorGeometry
 from satmotor_ros.model.core import ModelCore
 from satmotor_ros.model.effects import Conditions, Effect, kind_of
+from satmotor_ros.model.effects._base import Loss
 from satmotor_ros.model.errors import ConfigError, InvalidInputError, ModelError
 from satmotor_ros.model.point import invalid_point
 from satmotor_ros.model.results import (COMPONENTS, describe_status, INVALID, LossBreakdown,
@@ -68,21 +69,23 @@ class ConditionedModel:
         """Sort the effects by what they do and keep the motor without them."""
         every = [(kind_of(e), e) for e in core.coefficient_set.effects]
         motor = [(kind, e) for kind, e in every if not kind.sensor]
-        self._fitted = tuple((kind.reverse, fitted_bounds(e.fitted_range)) for kind, e in every
-                             if e.fitted_range)  # (only backwards, bounds): empty when none
-        self.channels = tuple(sorted({e.channel for _, e in motor if e.channel}))
+        self._fitted = tuple((kind.reverse, e, fitted_bounds(e.fitted_range))
+                             for kind, e in every if e.fitted_range)  # empty when none
+        self.channels = tuple(sorted({c for kind, e in motor for c in kind.channels(e)}))
         self._conditioning = tuple((kind, e) for kind, e in motor if e.channel)
-        self._terms = tuple(f for f in (kind.loss(e) for kind, e in motor if not kind.reverse)
-                            if f is not None)
-        self._reverse_terms = tuple(f for f in (kind.loss(e) for kind, e in motor
-                                                if kind.reverse) if f is not None)
+        losses = [(kind, e, kind.loss(e)) for kind, e in motor]
+        # the extra losses acting in each frame: (shaft turning backwards, dp < 0)
+        self._terms = {(reverse, negative): tuple(
+            f for kind, e, f in losses
+            if f is not None and (reverse or not kind.reverse) and e.acts(negative))
+            for reverse in (False, True) for negative in (False, True)}
         self._bare = core
         self._variants: dict[tuple[float, float], ModelCore] = {}
 
     # -- conditions ------------------------------------------------------------------------
 
-    def _channel(self, channels: Channels | None, effect: Effect) -> float:
-        name = effect.regressor
+    def _channel(self, channels: Channels | None, effect: Effect, reverse: bool) -> float:
+        name = kind_of(effect).channel_at(effect, reverse)
         if channels is None or name not in channels:
             given = ', '.join(channels) if channels else 'none'
             msg = (f'effect {effect.name} needs the channel {name!r} '
@@ -110,8 +113,8 @@ class ConditionedModel:
             self._variants[key] = model
         return model
 
-    def conditions(self, channels: Channels | None,
-                   p_ex: float) -> tuple[ModelCore | None, float, float, int]:
+    def conditions(self, channels: Channels | None, p_ex: float, reverse: bool = False,
+                   negative: bool = False) -> tuple[ModelCore | None, float, float, int]:
         """
         Return the motor at the channels' values, p_ex, the constant extra loss and a status.
 
@@ -121,6 +124,10 @@ class ConditionedModel:
             Measured channels by name (SI; temperature in degC), [-]
         p_ex : float
             Pressure driving the external leakage when no effect names one, [Pa]
+        reverse : bool
+            Whether the flow (and shaft) runs backwards: it leaves by port A, [-]
+        negative : bool
+            Whether dp = p_a - p_b < 0: only the effects acting there count, [-]
 
         Returns
         -------
@@ -134,12 +141,13 @@ class ConditionedModel:
             When a channel an effect needs is not given.
 
         """
-        values = [self._channel(channels, e) for _, e in self._conditioning]
+        values = [self._channel(channels, e, reverse) for _, e in self._conditioning]
         if any(not math.isfinite(v) for v in values):
             return None, p_ex, 0.0, int(PointStatus.NOT_FINITE)
         now = Conditions(self._bare.liquid.kinematic_viscosity, 0.0, p_ex, 0.0)
         for (kind, effect), x in zip(self._conditioning, values):
-            now = kind.condition(effect, x, now)
+            if effect.acts(negative):
+                now = kind.condition(effect, x, now)
         try:
             model = self._variant(now.viscosity, now.growth)
         except (ConfigError, OverflowError, ValueError):
@@ -168,10 +176,10 @@ class ConditionedModel:
         model = self.conditions(channels, p_ex)[0]
         return model.eqs.channel_drop if model is not None else lambda flow: math.nan
 
-    def _extra(self, speed: float, dp_i: float, constant: float, reverse: bool) -> float:
+    @staticmethod
+    def _extra(speed: float, dp_i: float, constant: float, terms: tuple[Loss, ...]) -> float:
         try:
-            extra = constant + sum(f(speed, dp_i) for f in self._terms)
-            return extra + sum(f(speed, dp_i) for f in self._reverse_terms) if reverse else extra
+            return constant + sum(f(speed, dp_i) for f in terms) if terms else constant
         except OverflowError:
             return math.inf  # flagged BEYOND_LIMIT by _with_extra
 
@@ -197,19 +205,21 @@ class ConditionedModel:
 
     # -- maps ------------------------------------------------------------------------------
 
-    def _flag_fitted(self, point: Point, channels: Channels | None, reverse: bool) -> Point:
+    def _flag_fitted(self, point: Point, channels: Channels | None, reverse: bool,
+                     negative: bool) -> Point:
         """Return `point` flagged EXTRAPOLATED where it reads an effect outside its data."""
         if point.status & _INVALID_FLAGS:
             return point
         values = {**(channels or {}), 'flow': point.flow, 'speed': point.speed,
                   'dp_i': point.dp_i}
-        if any(outside_fitted(bounds, values) for backwards, bounds in self._fitted
-               if reverse or not backwards):
+        if any(outside_fitted(bounds, values) for backwards, effect, bounds in self._fitted
+               if (reverse or not backwards) and effect.acts(negative)):
             return point._replace(status=point.status | _EXTRAPOLATED)
         return point
 
     def speed_point(self, flow: float, dp: float, port: bool, p_ex: float,
-                    channels: Channels | None, reverse: bool = False) -> Point:
+                    channels: Channels | None, reverse: bool = False,
+                    negative: bool = False) -> Point:
         """
         Compute the inverse map n(Q, dp) at one point with the effects.
 
@@ -228,6 +238,9 @@ class ConditionedModel:
         reverse : bool
             Whether the shaft turns backwards (n < 0 before the magnitudes were
             taken): the effects keyed on that direction apply, [-]
+        negative : bool
+            Whether dp < 0 before the magnitudes were taken: the effects acting
+            there apply (:attr:`Effect.direction`), [-]
 
         Returns
         -------
@@ -235,18 +248,18 @@ class ConditionedModel:
             The operating point; Q_vl holds the effects' extra loss.
 
         """
-        point = self._speed(flow, dp, port, p_ex, channels, reverse)
-        return self._flag_fitted(point, channels, reverse) if self._fitted else point
+        point = self._speed(flow, dp, port, p_ex, channels, reverse, negative)
+        return self._flag_fitted(point, channels, reverse, negative) if self._fitted else point
 
     def _speed(self, flow: float, dp: float, port: bool, p_ex: float,
-               channels: Channels | None, reverse: bool) -> Point:
-        model, p_ex, constant, status = self.conditions(channels, p_ex)
+               channels: Channels | None, reverse: bool, negative: bool) -> Point:
+        model, p_ex, constant, status = self.conditions(channels, p_ex, reverse, negative)
         if model is None:
             return invalid_point(status)
         evaluator = model.point
         first = evaluator.speed(flow, dp, port, p_ex)
-        if (not self._terms and constant == 0.0 and not (reverse and self._reverse_terms)
-                or first.status & _SCREENED):
+        terms = self._terms[reverse, negative]
+        if not terms and constant == 0.0 or first.status & _SCREENED:
             return first  # no extra loss; or bad input or beyond the limit, whatever the effect
         dp_i = model.eqs.chamber_drop(dp, flow) if port else dp
         limited = _CHANNEL_LIMITED if dp_i < 0.0 else 0
@@ -254,7 +267,7 @@ class ConditionedModel:
 
         def excess(n: float) -> float:
             at = evaluator.absorbency(n, dp_i, False, p_ex, None)
-            return at.flow + self._extra(n, dp_i, constant, reverse) - flow
+            return at.flow + self._extra(n, dp_i, constant, terms) - flow
 
         lo = model.eqs.law.floor(dp_i)
         f_lo = excess(lo)
@@ -282,11 +295,11 @@ class ConditionedModel:
             status = 0
         point = evaluator.absorbency(speed, dp_i, False, p_ex, None)
         return self._with_extra(model, point, flow, dp if port else None,
-                                self._extra(speed, dp_i, constant, reverse), status | limited)
+                                self._extra(speed, dp_i, constant, terms), status | limited)
 
     def absorbency_point(self, speed: float, dp: float, port: bool, p_ex: float,
                          flow_guess: float | None, channels: Channels | None,
-                         reverse: bool = False) -> Point:
+                         reverse: bool = False, negative: bool = False) -> Point:
         """
         Compute the forward map Q(n, dp) at one point with the effects.
 
@@ -306,6 +319,8 @@ class ConditionedModel:
             Measured channels by name, [-]
         reverse : bool
             Whether the shaft turns backwards: the effects keyed on it apply, [-]
+        negative : bool
+            Whether dp < 0 before the magnitudes were taken, [-]
 
         Returns
         -------
@@ -313,23 +328,23 @@ class ConditionedModel:
             The operating point; Q and Q_vl hold the effects' extra loss.
 
         """
-        point = self._absorbency(speed, dp, port, p_ex, flow_guess, channels, reverse)
-        return self._flag_fitted(point, channels, reverse) if self._fitted else point
+        point = self._absorbency(speed, dp, port, p_ex, flow_guess, channels, reverse, negative)
+        return self._flag_fitted(point, channels, reverse, negative) if self._fitted else point
 
     def _absorbency(self, speed: float, dp: float, port: bool, p_ex: float,
                     flow_guess: float | None, channels: Channels | None,
-                    reverse: bool) -> Point:
-        model, p_ex, constant, status = self.conditions(channels, p_ex)
+                    reverse: bool, negative: bool) -> Point:
+        model, p_ex, constant, status = self.conditions(channels, p_ex, reverse, negative)
         if model is None:
             return invalid_point(status)
         evaluator = model.point
         first = evaluator.absorbency(speed, dp, port, p_ex, flow_guess)
-        if (not self._terms and constant == 0.0 and not (reverse and self._reverse_terms)
-                or first.status & _INVALID_FLAGS):
+        terms = self._terms[reverse, negative]
+        if not terms and constant == 0.0 or first.status & _INVALID_FLAGS:
             return first
         if not port:
             return self._with_extra(model, first, None, None,
-                                    self._extra(speed, dp, constant, reverse),
+                                    self._extra(speed, dp, constant, terms),
                                     first.status & _STALLED)
 
         def chamber(q: float) -> float:
@@ -338,10 +353,10 @@ class ConditionedModel:
         def excess(q: float) -> float:
             dp_i = chamber(q)
             at = evaluator.absorbency(speed, dp_i, False, p_ex, None)
-            return q - at.flow - self._extra(speed, dp_i, constant, reverse)
+            return q - at.flow - self._extra(speed, dp_i, constant, terms)
 
         q0 = first.flow
-        step = abs(self._extra(speed, first.dp_i, constant, reverse)) + abs(q0) * 1e-6 + 1e-12
+        step = abs(self._extra(speed, first.dp_i, constant, terms)) + abs(q0) * 1e-6 + 1e-12
         lo, hi = q0 - step, q0 + step
         f_lo, f_hi = excess(lo), excess(hi)
         for _ in range(_EXPANSIONS):
@@ -363,7 +378,7 @@ class ConditionedModel:
         limited = _CHANNEL_LIMITED if model.eqs.chamber_drop(dp, flow) < 0.0 else 0
         point = evaluator.absorbency(speed, dp_i, False, p_ex, None)
         point = self._with_extra(model, point, None, dp,
-                                 self._extra(speed, dp_i, constant, reverse),
+                                 self._extra(speed, dp_i, constant, terms),
                                  (point.status & _STALLED) | limited)
         return point if point.status & _INVALID_FLAGS else point._replace(flow=flow)
 

@@ -67,16 +67,18 @@ class _Magnitudes:
         self._drop = core.eqs.channel_drop
 
     def speed(self, flow: float, dp: float, port: bool, p_ex: float, channels: Channels,
-              reverse: bool) -> Point:
+              reverse: bool, negative: bool) -> Point:
         if self._conditioned is not None:
-            return self._conditioned.speed_point(flow, dp, port, p_ex, channels, reverse)
+            return self._conditioned.speed_point(flow, dp, port, p_ex, channels, reverse,
+                                                 negative)
         return self._point.speed(flow, dp, port, p_ex)
 
     def absorbency(self, speed: float, dp: float, port: bool, p_ex: float,
-                   flow_guess: float | None, channels: Channels, reverse: bool) -> Point:
+                   flow_guess: float | None, channels: Channels, reverse: bool,
+                   negative: bool) -> Point:
         if self._conditioned is not None:
             return self._conditioned.absorbency_point(speed, dp, port, p_ex, flow_guess,
-                                                      channels, reverse)
+                                                      channels, reverse, negative)
         return self._point.absorbency(speed, dp, port, p_ex, flow_guess)
 
     def channel_drop(self, p_ex: float, channels: Channels) -> Callable[[float], float]:

@@ -57,11 +57,12 @@ class Magnitudes(Protocol):
     qt: float  # theoretical displacement q_t [m^3/rad]
 
     def speed(self, flow: float, dp: float, port: bool, p_ex: float, channels: Channels,
-              reverse: bool) -> Point:
-        """Return n(Q, dp) in motor mode, Q >= 0."""
+              reverse: bool, negative: bool) -> Point:
+        """Return n(Q, dp) in motor mode, Q >= 0 (shaft backwards, dp < 0 before mirroring)."""
 
     def absorbency(self, speed: float, dp: float, port: bool, p_ex: float,
-                   flow_guess: float | None, channels: Channels, reverse: bool) -> Point:
+                   flow_guess: float | None, channels: Channels, reverse: bool,
+                   negative: bool) -> Point:
         """Return Q(n, dp) in motor mode, n >= 0."""
 
     def channel_drop(self, p_ex: float, channels: Channels) -> Callable[[float], float]:
@@ -160,12 +161,12 @@ class Quadrants:
 
         """
         if not (abs(flow) < _INF and abs(dp) < _INF):  # flagged NOT_FINITE at the magnitudes
-            return self.maps.speed(abs(flow), abs(dp), port, p_ex, channels, False)
+            return self.maps.speed(abs(flow), abs(dp), port, p_ex, channels, False, False)
         s = direction(dp, flow)
         q, d = s * flow, s * dp
         if q >= 0.0:  # the flow runs with the pressure: motor mode, turning with s
-            return mirror(self.maps.speed(q, d, port, p_ex, channels, s < 0.0), s)
-        return mirror(self._pump_speed(-q, d, port, p_ex, channels, s > 0.0), s)
+            return mirror(self.maps.speed(q, d, port, p_ex, channels, s < 0.0, s < 0.0), s)
+        return mirror(self._pump_speed(-q, d, port, p_ex, channels, s > 0.0, s < 0.0), s)
 
     def absorbency(self, speed: float, dp: float, port: bool, p_ex: float,
                    flow_guess: float | None, channels: Channels) -> Point:
@@ -194,13 +195,15 @@ class Quadrants:
 
         """
         if not (abs(speed) < _INF and abs(dp) < _INF):
-            return self.maps.absorbency(abs(speed), abs(dp), port, p_ex, None, channels, False)
+            return self.maps.absorbency(abs(speed), abs(dp), port, p_ex, None, channels,
+                                        False, False)
         s = direction(dp, speed)
         n, d = s * speed, s * dp
         guess = None if flow_guess is None else s * flow_guess
         if n >= 0.0:
-            return mirror(self.maps.absorbency(n, d, port, p_ex, guess, channels, s < 0.0), s)
-        return mirror(self._pump_flow(-n, d, port, p_ex, guess, channels, s > 0.0), s)
+            return mirror(self.maps.absorbency(n, d, port, p_ex, guess, channels, s < 0.0,
+                                               s < 0.0), s)
+        return mirror(self._pump_flow(-n, d, port, p_ex, guess, channels, s > 0.0, s < 0.0), s)
 
     # -- pump mode, in the mirrored frame: dp >= 0, the shaft turning backwards ---------------
 
@@ -218,14 +221,15 @@ class Quadrants:
                      (at.status & ~_STALLED) | status | _EXTRAPOLATED)
 
     def _pump_speed(self, delivered: float, d: float, port: bool, p_ex: float,
-                    channels: Channels, reverse: bool) -> Point:
+                    channels: Channels, reverse: bool, negative: bool) -> Point:
         """Solve q_t m - Q_vl(m, dp_i) = `delivered` for m > 0, the point at n = -m."""
         maps, qt = self.maps, self.qt
         drop = maps.channel_drop(p_ex, channels)
         dp_i = d + drop(delivered) if port else d
 
         def at(speed: float) -> Point:
-            return maps.absorbency(speed, dp_i, False, p_ex, None, channels, reverse)
+            return maps.absorbency(speed, dp_i, False, p_ex, None, channels, reverse,
+                                   negative)
 
         stall = at(0.0)
         if stall.status & _INVALID:
@@ -255,13 +259,15 @@ class Quadrants:
         return self._pump_point(point, -delivered, -speed, d if port else None, drop, 0)
 
     def _pump_flow(self, speed: float, d: float, port: bool, p_ex: float,
-                   flow_guess: float | None, channels: Channels, reverse: bool) -> Point:
+                   flow_guess: float | None, channels: Channels, reverse: bool,
+                   negative: bool) -> Point:
         """Return Q = -(q_t m - Q_vl(m, dp_i)) at n = -m, dp_i from eqs. (34)-(35) if `port`."""
         maps, qt = self.maps, self.qt
         drop = maps.channel_drop(p_ex, channels)
 
         def at(dp_i: float) -> Point:
-            return maps.absorbency(speed, dp_i, False, p_ex, None, channels, reverse)
+            return maps.absorbency(speed, dp_i, False, p_ex, None, channels, reverse,
+                                   negative)
 
         first = at(d)
         if first.status & _INVALID:

@@ -520,6 +520,7 @@ class Plant:
     def _channels(self) -> dict[str, float]:
         """Return what a calibrated coefficient set's effects read (gauge Pa, degC, s, rev)."""
         return {'p_case': max(self.case_pressure() - ATMOSPHERE, 0.0),
+                'p_in': max(self._p_in - ATMOSPHERE, 0.0),
                 'p_out': max(self._p_out - ATMOSPHERE, 0.0), 'temperature': self._temp,
                 'time': self._t, 'revolutions': self._revolutions}
 

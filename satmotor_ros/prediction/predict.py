@@ -33,15 +33,15 @@ _NOTED = int(PointStatus.STALLED | PointStatus.CHANNEL_LIMITED | PointStatus.EXT
 _INVALID = int(INVALID)
 _I_CASE = INPUTS.index('p_case')
 _I_SPEED = INPUTS.index('measured_speed')
-_GAUGED = ('p_case', 'p_out')
-_MEASURED = {'p_case': _I_CASE, 'p_out': INPUTS.index('p_out'),
-             'temperature': INPUTS.index('temperature')}
-CHANNELS = ('p_case', 'p_out', 'temperature', 'time', 'revolutions')
+_GAUGED = ('p_case', 'p_in', 'p_out')
+_MEASURED = {'p_case': _I_CASE, 'p_in': INPUTS.index('p_in'),
+             'p_out': INPUTS.index('p_out'), 'temperature': INPUTS.index('temperature')}
+CHANNELS = ('p_case', 'p_in', 'p_out', 'temperature', 'time', 'revolutions')
 """
-Channels a calibrated effect may read (``MotorModel.channels``): case and outlet pressure
-made gauge (absolute - ATMOSPHERE, floored at 0) [Pa], temperature [degC], and the time [s]
-and shaft revolutions [rev] since the first prediction (see :class:`Progress`), as
-``satmotor calibrate`` counts them from the start of a bag.
+Channels a calibrated effect may read (``MotorModel.channels``): case, inlet (port A) and
+outlet (port B) pressure made gauge (absolute - ATMOSPHERE, floored at 0) [Pa], temperature
+[degC], and the time [s] and shaft revolutions [rev] since the first prediction (see
+:class:`Progress`), as ``satmotor calibrate`` counts them from the start of a bag.
 """
 
 # plain ints: an enum member looked up on its class costs a microsecond per message
@@ -425,8 +425,9 @@ def predict(model: MotorModel, snap: Snapshot | SnapshotBatch, timeout: float,
         channels = dict(zip(channels, _masked(usable, list(channels.values()), 0.0)))
     speed, dp_i, status, losses = _model_call(model, flow, dp, p_ex, channels)
     leak = _leakage_channel(model) if channels is not None else None
-    if leak is not None and channels is not None:
-        p_ex = channels[leak]  # the pressure the effect drove eq. (24) with
+    if leak is not None and channels is not None:  # the pressure that drove eq. (24)
+        p_ex = (channels[leak] if leak != 'p_out'
+                else pick(flow < 0.0, channels['p_in'], channels['p_out']))
     status = pick(usable, status, 0)
     level = _worst([level, pick(status & _INVALID, _ERROR, pick(status & _NOTED, _WARN, _OK))])
     residual = pick(states[_I_SPEED] == _FRESH, model.true_speed(values[_I_SPEED]) - speed,

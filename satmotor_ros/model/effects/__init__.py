@@ -51,9 +51,10 @@ import numpy as np
 
 from satmotor_ros.model._typing import FloatArray, Real
 from satmotor_ros.model.effects._base import (Candidate, CandidateData, Conditions,
-                                              CORE_CHANNELS, DOCUMENTARY, Effect, EffectKind,
-                                              finite, KINDS, Modifier, PlantInjection,
-                                              PlantParameter, SensorError, Shape, Synthetic)
+                                              CORE_CHANNELS, DIRECTIONS, DOCUMENTARY, Effect,
+                                              EffectKind, finite, KINDS, Modifier,
+                                              PlantInjection, PlantParameter, SensorError,
+                                              Shape, Synthetic)
 from satmotor_ros.model.errors import ConfigError
 
 if TYPE_CHECKING:
@@ -154,6 +155,10 @@ def kind_of(effect: Effect) -> EffectKind:
 FITTED_RANGE = 'fitted_range'
 """The YAML key of an effect's fitted range: ``{quantity: [min, max]}``, SI (degC)."""
 
+DIRECTION = 'direction'
+"""The YAML key of where an effect acts (:data:`DIRECTIONS`); a one-sided effect's id in the
+``effects:`` block is ``<id>@<direction>`` (:attr:`Effect.key`), so both sides may differ."""
+
 
 def _known() -> str:
     return ', '.join(f'{k.name}:<name>' if k.suffixed else k.name for k in ranked())
@@ -186,9 +191,10 @@ def effect_from_mapping(name: Any, doc: Any, where: str) -> Effect:
         the effect reads.
 
     """
-    name = str(name)
+    key = str(name)
+    name, at, qualifier = key.partition('@')
     kind_name, _, suffix = name.partition(':')
-    where = f'{where}.{name}'
+    where = f'{where}.{key}'
     kind = KINDS.get(kind_name)
     if kind is None or kind.suffixed != bool(suffix):
         msg = f'{where}: unknown effect {name!r} (known: {_known()})'
@@ -196,18 +202,39 @@ def effect_from_mapping(name: Any, doc: Any, where: str) -> Effect:
     if not isinstance(doc, Mapping):
         msg = f'{where} must be a mapping, got {type(doc).__name__}: {doc!r}'
         raise ConfigError(msg)
-    unknown = sorted(set(map(str, doc)) - set(kind.keys) - set(DOCUMENTARY) - {FITTED_RANGE})
+    known = (*kind.keys, *((DIRECTION,) if kind.directional else ()), FITTED_RANGE)
+    unknown = sorted(set(map(str, doc)) - set(known) - set(DOCUMENTARY))
     missing = [k for k in kind.required if k not in doc]
     if unknown or missing:
         what = (f'unknown key(s) {", ".join(unknown)}' if unknown
                 else f'missing key(s) {", ".join(missing)}')
-        msg = f'{where} has {what} (known: {", ".join((*kind.keys, FITTED_RANGE))})'
+        msg = f'{where} has {what} (known: {", ".join(known)})'
         raise ConfigError(msg)
     effect = kind.parse(name, {k: v for k, v in doc.items() if k in kind.keys}, where)
+    direction = _direction(doc.get(DIRECTION, qualifier or 'both'), qualifier if at else None,
+                           kind, where)
+    if direction != 'both':
+        effect = replace(effect, direction=direction)
     if FITTED_RANGE not in doc:
         return effect
     return replace(effect, fitted_range=_fitted_range(doc[FITTED_RANGE], kind.reads(effect),
                                                       f'{where}.{FITTED_RANGE}'))
+
+
+def _direction(value: Any, qualifier: str | None, kind: EffectKind, where: str) -> str:
+    """Read ``direction`` (or the id's ``@<direction>``): one of DIRECTIONS, agreeing."""
+    if not isinstance(value, str) or value not in DIRECTIONS:
+        msg = f'{where}.{DIRECTION} = {value!r}: use {", ".join(DIRECTIONS)}'
+        raise ConfigError(msg)
+    if qualifier is not None and (qualifier != value or qualifier == 'both'):
+        msg = (f'{where}: the id says @{qualifier}, the block says {DIRECTION} = {value!r} '
+               '(write @positive or @negative, as the block)')
+        raise ConfigError(msg)
+    if value != 'both' and not kind.directional:
+        msg = (f'{where}.{DIRECTION} = {value!r}: {kind.name} acts in both directions '
+               '(a one-sided effect is a threshold, term, channel or reverse_loss)')
+        raise ConfigError(msg)
+    return value
 
 
 def _fitted_range(doc: Any, quantities: tuple[str, ...],
@@ -284,6 +311,8 @@ def effect_to_mapping(effect: Effect) -> dict[str, Any]:
     """
     kind = kind_of(effect)
     block = kind.to_mapping(effect)
+    if kind.directional:
+        block[DIRECTION] = effect.direction
     if effect.fitted_range:
         block[FITTED_RANGE] = {q: [low, high] for q, low, high in effect.fitted_range}
     return {**block, 'evaluation': kind.evaluation}
@@ -315,7 +344,7 @@ def check_effects(effects: Iterable[Effect], where: str,
 
     """
     effects = tuple(effects)
-    seen: set[str] = set()
+    seen: set[tuple[str, str]] = set()
     for effect in effects:
         kind = kind_of(effect)
         if family is not None and kind.families is not None and family not in kind.families:
@@ -323,10 +352,11 @@ def check_effects(effects: Iterable[Effect], where: str,
                    f'{" and ".join(sorted(kind.families))} family, not {family}')
             raise ConfigError(msg)
         key = effect.name if kind.suffixed else effect.kind
-        if key in seen:
-            msg = f'{where} has more than one {key} effect'
+        sides = ('positive', 'negative') if effect.direction == 'both' else (effect.direction,)
+        if any((key, side) in seen for side in sides):
+            msg = f'{where} has more than one {key} effect acting where dp is {sides[0]}'
             raise ConfigError(msg)
-        seen.add(key)
+        seen.update((key, side) for side in sides)
     return effects
 
 
@@ -472,7 +502,8 @@ def build_candidates(data: CandidateData) -> tuple[list[Candidate], list[str]]:
 SENSOR_KINDS = tuple(k.name for k in ranked() if k.sensor)
 """Kinds shipped that describe an instrument, not the motor (:attr:`EffectKind.sensor`)."""
 
-__all__ = ['Candidate', 'CandidateData', 'Conditions', 'Effect', 'EffectKind', 'KINDS',
+__all__ = ['Candidate', 'CandidateData', 'Conditions', 'DIRECTION', 'DIRECTIONS', 'Effect',
+           'EffectKind', 'KINDS',
            'Modifier', 'PlantInjection', 'PlantParameter', 'SENSOR_KINDS', 'SensorError',
            'Shape', 'Synthetic', 'build_candidates', 'check_effects', 'effect_from_mapping',
            'effect_to_mapping', 'FITTED_RANGE', 'flow_reading', 'kind_of', 'measured_range',

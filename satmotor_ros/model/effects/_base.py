@@ -45,6 +45,9 @@ KINDS: dict[str, EffectKind] = {}
 """The registry: kind name -> kind, filled by :func:`satmotor_ros.model.effects.register`."""
 
 DOCUMENTARY = ('unit', 'ci95', 'source', 'evaluation')
+
+DIRECTIONS = ('both', 'positive', 'negative')
+"""Where an effect acts: both signs of dp = p_a - p_b, dp >= 0 only or dp < 0 only."""
 """Keys written for the reader of a ``coefficients.yaml``; the model does not use them."""
 
 MIN_SPREAD = 1.0e-3
@@ -69,11 +72,21 @@ class Effect:
     options: tuple[tuple[str, Any], ...] = ()  # further parameters of a new kind, by name
     fitted_range: tuple[tuple[str, float, float], ...] = ()  # (quantity, min, max) of the data
     # it was fitted on, SI, one per quantity of EffectKind.reads; () when not known (no flag)
+    direction: str = 'both'  # sign of dp = p_a - p_b where it acts: 'positive', 'negative'
 
     @property
     def kind(self) -> str:
         """Return the kind, without a ``:<suffix>``."""
         return self.name.split(':', 1)[0]
+
+    @property
+    def key(self) -> str:
+        """Return the id with its direction, ``threshold:dp@negative``: unique in a set."""
+        return self.name if self.direction == 'both' else f'{self.name}@{self.direction}'
+
+    def acts(self, negative: bool) -> bool:
+        """Return whether the effect acts where dp < 0 (`negative`) or dp >= 0."""
+        return self.direction == 'both' or (self.direction == 'negative') == negative
 
     @property
     def suffix(self) -> str:
@@ -152,13 +165,15 @@ class Candidate:
     start: float = 0.0  # initial coefficient of the fit
     make: Callable[..., Effect] | None = None  # (coefficient, *shape) -> the effect (YAML)
     shape: tuple[Shape, ...] = ()  # parameters of the form fitted with the coefficient
+    direction: str = 'both'  # the sign of dp where it acts (DIRECTIONS)
 
     @property
     def label(self) -> str:
         """Return the effect with its regressor, e.g. ``external_leakage(p_case)``."""
+        where = '' if self.direction == 'both' else f'@{self.direction}'
         if ':' in self.effect or self.regressor in ('', '1'):
-            return self.effect
-        return f'{self.effect}({self.regressor})'
+            return self.effect + where
+        return f'{self.effect}({self.regressor}){where}'
 
     @property
     def description(self) -> str:
@@ -168,8 +183,8 @@ class Candidate:
     def as_effect(self, coefficient: float, *shape: float) -> Effect:
         """Return the effect this candidate stands for at a fitted coefficient (and shape)."""
         if self.make is not None:
-            return self.make(coefficient, *shape)
-        return Effect(self.effect, coefficient, self.regressor)
+            return replace(self.make(coefficient, *shape), direction=self.direction)
+        return Effect(self.effect, coefficient, self.regressor, direction=self.direction)
 
 
 class Parts(Protocol):
@@ -190,6 +205,10 @@ class Parts(Protocol):
     @property
     def displacement(self) -> FloatArray:
         """q_t n [m^3/s]."""
+
+    @property
+    def sign(self) -> FloatArray | float:
+        """Sign of dp (the row's frame): -1 where dp < 0 [-]."""
 
     @property
     def clearance(self) -> FloatArray:
@@ -263,6 +282,49 @@ class PlantInjection:
         return replace(self, **{slot: (*getattr(self, slot), item)})
 
 
+def one_sided(candidate: Candidate, negative: np.ndarray, direction: str) -> Candidate:
+    """
+    Return `candidate` acting only where dp < 0 (`direction` 'negative') or dp >= 0.
+
+    Parameters
+    ----------
+    candidate : Candidate
+        A two-sided candidate whose modifier adds a loss, [-]
+    negative : ndarray of bool
+        Rows where dp = p_a - p_b < 0, [-]
+    direction : {'positive', 'negative'}
+        Where it acts, [-]
+
+    Returns
+    -------
+    Candidate
+        The same form with its extra loss zero on the other side.
+
+    """
+    acts = negative if direction == 'negative' else ~negative
+
+    def modify(*args: float) -> Modifier:
+        mod = candidate.modify(*args)
+        return replace(mod, additive=np.where(acts, mod.additive, 0.0))
+    return replace(candidate, modify=modify, direction=direction)
+
+
+def negative_rows(parts: Parts) -> np.ndarray:
+    """Return which rows have dp = p_a - p_b < 0 (their frame's sign is -1)."""
+    return np.broadcast_to(np.asarray(parts.sign, dtype=float) < 0.0, parts.flow.shape)
+
+
+MIN_SIDE = 0.05
+"""Least share of the points (and at least 8) on each side of dp for a one-sided candidate."""
+
+
+def two_sided(parts: Parts) -> bool:
+    """Return whether the data hold both signs of dp, each with enough points to tell them."""
+    negative = negative_rows(parts)
+    least = max(8, int(np.ceil(MIN_SIDE * negative.size)))
+    return bool(min(int(negative.sum()), int((~negative).sum())) >= least)
+
+
 def maker(name: str, regressor: str = '', reference: float = 0.0) -> Callable[[float], Effect]:
     """Return coefficient -> ``Effect(name, coefficient, regressor, reference)``."""
     def make(coefficient: float) -> Effect:
@@ -316,6 +378,7 @@ class EffectKind:
     drifts: bool = False  # it changes the motor itself (a rebuilt model)
     sensor: str = ''  # the channel of an instrument error ('flow', 'speed')
     reverse: bool = False  # its loss() applies only while the shaft turns backwards (n < 0)
+    directional: bool = False  # it may act for one sign of dp only (Effect.direction)
     unit: str = '-'  # unit of the coefficient
     source: str = ''  # the physics or standard the term comes from
     evaluation: str = ''  # what the model does with it (written into the YAML)
@@ -380,6 +443,14 @@ class EffectKind:
         if self.reads_channel:
             return (effect.regressor,)
         return ('dp_i', 'speed') if self.loss(effect) is not None else ()
+
+    def channels(self, effect: Effect) -> tuple[str, ...]:
+        """Name the measured channels the model needs for `effect` (its regressor's, or none)."""
+        return (effect.regressor,) if self.reads_channel else ()
+
+    def channel_at(self, effect: Effect, reverse: bool) -> str:
+        """Name the channel :meth:`condition` reads while the flow runs forward or `reverse`."""
+        return effect.regressor
 
     def sensor_error(self, effect: Effect) -> SensorError | None:
         """Return what the effect does to an instrument, or None for a motor effect."""
@@ -497,4 +568,5 @@ def additive(effect: str, regressor: str, unit: str, source: str, x: FloatArray,
 
 __all__ = ['Candidate', 'CandidateData', 'Conditions', 'Effect', 'EffectKind', 'KINDS',
            'Modifier', 'PlantInjection', 'PlantParameter', 'SensorError', 'Shape', 'Synthetic',
-           'additive', 'finite', 'maker', 'per_unit', 'varies', 'why_not']
+           'additive', 'DIRECTIONS', 'finite', 'maker', 'negative_rows', 'one_sided', 'per_unit',
+           'two_sided', 'varies', 'why_not']

@@ -19,6 +19,7 @@ class Channel(EffectKind):
     name = 'channel'
     suffixed = True
     rank = 70
+    directional = True
     keys = ('regressor', 'coefficient', 'reference')
     required = ('coefficient', 'reference')
     reads_channel = True

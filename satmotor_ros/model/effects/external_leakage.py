@@ -16,6 +16,7 @@ from typing import Any, TYPE_CHECKING
 
 import numpy as np
 
+from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.effects._base import (additive, Candidate, CandidateData, Conditions,
                                               Effect, EffectKind, maker, PlantInjection,
                                               PlantParameter, varies, why_not)
@@ -25,6 +26,21 @@ if TYPE_CHECKING:
     from satmotor_ros.model.coefficients import LossCoefficients
 
 _DRIVERS = {'case': 'p_case', 'outlet': 'p_out'}
+
+OUTFLOW = {False: 'p_out', True: 'p_in'}
+"""The channel of the port the flow leaves by (B, or A while it runs backwards), gauge Pa: the
+``p_out`` regressor names the outflow port, which is port B only while the flow is positive."""
+
+
+def outflow(data: CandidateData) -> FloatArray | None:
+    """Return the outflow port's gauge pressure at the points: p_out, p_in where n < 0."""
+    p_out, p_in = data.channels.get('p_out'), data.channels.get('p_in')
+    backwards = np.asarray(getattr(data.parts, 'rotation', 1.0)) < 0.0
+    if p_out is None or not np.any(backwards):
+        return p_out
+    if p_in is None:
+        return None
+    return np.where(backwards, p_in, p_out)
 
 
 class ExternalLeakage(EffectKind):
@@ -49,6 +65,14 @@ class ExternalLeakage(EffectKind):
         """Return `coef` with eq. (24)'s k_ex set to the effect's coefficient."""
         return replace(coef, external_leakage=effect.coefficient)
 
+    def channels(self, effect: Effect) -> tuple[str, ...]:
+        """Read the case pressure, or both ports: the flow leaves by B, or by A in reverse."""
+        return ('p_in', 'p_out') if effect.regressor == 'p_out' else (effect.regressor,)
+
+    def channel_at(self, effect: Effect, reverse: bool) -> str:
+        """Read the port the flow leaves by: ``p_out`` (B), ``p_in`` (A) while it runs back."""
+        return OUTFLOW[reverse] if effect.regressor == 'p_out' else effect.regressor
+
     def condition(self, effect: Effect, x: float, now: Conditions) -> Conditions:
         """Drive eq. (24) by the channel's gauge pressure `x` [Pa]."""
         return now._replace(p_ex=x)
@@ -57,7 +81,7 @@ class ExternalLeakage(EffectKind):
         """Offer k_ex >= 0 for each driving pressure that was measured and varies."""
         out, skipped = [], []
         for name in self.regressors:
-            p = data.channels.get(name)
+            p = data.channels.get(name) if name != 'p_out' else outflow(data)
             if p is None or not varies(p):
                 skipped.append(f'{self.name}({name}): {why_not(p)}')
                 continue

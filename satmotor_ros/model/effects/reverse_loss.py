@@ -30,6 +30,7 @@ class ReverseLoss(EffectKind):
 
     name = 'reverse_loss'
     rank = 75
+    directional = True
     reverse = True
     unit = 'm^3/(Pa*rad)'
     source = 'direction of rotation: C of eq. (33) differs when n < 0'

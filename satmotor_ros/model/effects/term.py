@@ -102,6 +102,7 @@ class Term(EffectKind):
     name = 'term'
     suffixed = True
     rank = 80
+    directional = True
     keys = ('regressor', 'coefficient', 'exponents')
     unit = 'm^3/s per Pa^a (rad/s)^b'
     source = 'not in eqs. (31)-(33), exponents fitted'

@@ -8,13 +8,18 @@ from typing import Any
 
 import numpy as np
 
-from satmotor_ros.model._typing import Real
+from satmotor_ros.model._typing import FloatArray, Real
 from satmotor_ros.model.effects._base import (Candidate, CandidateData, Effect, EffectKind,
-                                              finite, Loss, Modifier, Shape, Synthetic)
+                                              finite, Loss, Modifier, negative_rows, Shape,
+                                              Synthetic, two_sided)
 from satmotor_ros.model.errors import ConfigError
 
-MIN_ABOVE = 0.15
-"""Least share of the points (and at least 4) above a fitted threshold, [-]."""
+MIN_ABOVE = {'both': (0.15, 4), 'positive': (0.03, 8), 'negative': (0.03, 8)}
+"""Least share of the points, and least number, above a fitted threshold, [-]: a one-sided
+valve opens near the top of its side's range, in a few per cent of a recording."""
+
+STARTS = {'both': (0.3, 0.7), 'positive': (0.5, 0.9), 'negative': (0.5, 0.9)}
+"""Starts of the fitted threshold, as shares of the range it may take, [-]."""
 
 EXPONENTS = (0.5, 3.0)
 """Range of the fitted exponent e, [-]."""
@@ -26,6 +31,7 @@ class Threshold(EffectKind):
     name = 'threshold'
     suffixed = True
     rank = 85
+    directional = True
     keys = ('regressor', 'coefficient', 'reference', 'exponent')
     required = ('coefficient', 'reference')
     unit = 'm^3/s per Pa^e'
@@ -57,7 +63,7 @@ class Threshold(EffectKind):
                 'reference': effect.reference, 'exponent': effect.option('exponent', 1.0)}
 
     def loss(self, effect: Effect) -> Loss | None:
-        """Return k max(0, |dp_i| - x_c)^e."""
+        """Return k max(0, |dp_i| - x_c)^e (where the effect acts: Effect.direction)."""
         k, x_c, e = effect.coefficient, effect.reference, effect.option('exponent', 1.0)
 
         def loss(n: Real, dp_i: Real) -> Real:
@@ -69,26 +75,52 @@ class Threshold(EffectKind):
         return ('dp_i',)
 
     def candidates(self, data: CandidateData) -> tuple[list[Candidate], list[str]]:
-        """Offer a threshold within the data, with enough points above it, k >= 0."""
+        """
+        Offer a threshold within the data, k >= 0: on |dp| and, with both signs, each side.
+
+        A relief, bypass or anti-cavitation valve usually opens for one sign of
+        dp only; the one-sided candidates (``direction`` positive or negative)
+        place the threshold among that side's points.
+        """
         dp = np.abs(data.parts.dp_i)
-        above = max(4, int(np.ceil(MIN_ABOVE * dp.size)))
-        ordered = np.sort(dp)
-        if dp.size < 2 * above:
-            return [], [f'{self.name}:dp: too few points to place a threshold']
+        negative = negative_rows(data.parts)
+        sides = [('both', np.ones(dp.shape, dtype=bool))]
+        if two_sided(data.parts):
+            sides += [('positive', ~negative), ('negative', negative)]
+        out, skipped = [], []
+        for direction, at in sides:
+            candidate = self._candidate(dp, at, direction)
+            if candidate is None:
+                skipped.append(f'{self.name}:dp ({direction}): too few points to place a '
+                               'threshold')
+            else:
+                out.append(candidate)
+        return out, skipped
+
+    def _candidate(self, dp: FloatArray, at: np.ndarray, direction: str) -> Candidate | None:
+        """Return the candidate acting at `at` only, the threshold among those points."""
+        ordered = np.sort(dp[at])
+        share, least = MIN_ABOVE[direction]
+        above = max(least, int(np.ceil(share * ordered.size)))
+        if ordered.size < 2 * above:
+            return None
         low, high = float(ordered[above // 2]), float(ordered[-above])
         top = float(ordered[-1])
+        if not top > high > low:
+            return None
+        acts = at.astype(float)
 
         def modify(k: float, x_c: float, e: float) -> Modifier:
-            return Modifier(additive=k * (np.maximum(dp - x_c, 0.0) / (top - x_c)) ** e)
+            return Modifier(additive=acts * k * (np.maximum(dp - x_c, 0.0) / (top - x_c)) ** e)
 
         def make(k: float, x_c: float, e: float) -> Effect:
             return Effect(f'{self.name}:dp', k / (top - x_c) ** e, 'dp', x_c,
-                          options=(('exponent', e),))
+                          options=(('exponent', e),), direction=direction)
 
-        shape = (Shape('threshold', (0.3, 0.7), (0.0, 1.0), 'Pa', (low, high - low)),
+        shape = (Shape('threshold', STARTS[direction], (0.0, 1.0), 'Pa', (low, high - low)),
                  Shape('exponent', (1.0,), EXPONENTS))
-        return [Candidate(f'{self.name}:dp', 'dp', self.unit, self.source, dp, modify,
-                          1.0e-3 / 60.0, (0.0, np.inf), 0.1e-3 / 60.0, make, shape)], []
+        return Candidate(f'{self.name}:dp', 'dp', self.unit, self.source, dp, modify,
+                         1.0e-3 / 60.0, (0.0, np.inf), 0.1e-3 / 60.0, make, shape, direction)
 
     def scaled(self, name: str, magnitude: float, regressor: str, data: Synthetic) -> Effect:
         """Inject `magnitude` [m^3/s] at the largest drop; ``reference``, ``exponent`` in shape."""
