@@ -12,8 +12,18 @@ from satmotor_ros.cli._common import add_motor_options, CliError, fail, quantity
 from satmotor_ros.interface import MotorOptions
 from satmotor_ros.model import (COMPONENTS, describe_status, ModelError, MotorModel,
                                 OperatingPoints, PointStatus)
+from satmotor_ros.model.errors import UnitError
 from satmotor_ros.model.families import DEFAULT_FAMILY, FAMILIES
-from satmotor_ros.model.units import LPM, MPA, RPM
+from satmotor_ros.model.units import ATMOSPHERE, LPM, MPA, parse_quantity, RPM
+
+ABSOLUTE_UNITS = ('bara', 'psia')
+"""Pressure units that say absolute; a channel's pressure is gauge, one atmosphere less."""
+
+CHANNEL_KINDS = {'p_case': ('pressure', 'MPa'), 'p_out': ('pressure', 'MPa'),
+                 'p_in': ('pressure', 'MPa'), 'temperature': ('temperature', 'degC'),
+                 'time': ('time', 's')}
+"""Kind and default unit of each channel with a unit; any other channel (revolutions, a
+``channel:<name>`` effect's) is a plain number in the unit it was calibrated in."""
 
 
 class PointReport(TypedDict):
@@ -31,6 +41,9 @@ class PointReport(TypedDict):
     speed_rad_s: float
     speed_loss_rpm: float
     losses_lpm: dict[str, float]
+    effects: list[str]
+    effects_lpm: float
+    channels: dict[str, float]
     status: str
     warnings: list[str]
 
@@ -52,13 +65,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                                      "as in the paper's figures")
     parser.add_argument('--p-ex', default='0', help='pressure driving the external leakage, '
                                                     'eq. (24) (default MPa; default 0)')
+    parser.add_argument('--channel', action='append', default=[], dest='channels',
+                        metavar='NAME=VALUE',
+                        help="a channel a calibrated file's effects read, e.g. p_case=0.3MPa "
+                             '(gauge pressure, default MPa; temperature degC; time s; '
+                             'revolutions rev); repeatable')
     parser.add_argument('--json', action='store_true', dest='as_json',
                         help='print one JSON object')
     add_motor_options(parser)
 
 
-def command(flow: str, dp: str | None, dp_i: str | None, p_ex: str, as_json: bool,
-            options: MotorOptions) -> int:
+def command(flow: str, dp: str | None, dp_i: str | None, p_ex: str, channels: list[str],
+            as_json: bool, options: MotorOptions) -> int:
     """
     Print the operating point.
 
@@ -70,6 +88,8 @@ def command(flow: str, dp: str | None, dp_i: str | None, p_ex: str, as_json: boo
         Port or chamber pressure drop as typed (exactly one), [MPa by default]
     p_ex : str
         Pressure driving the external leakage as typed, [MPa by default]
+    channels : list of str
+        ``NAME=VALUE`` for each channel the motor file's effects read, as typed, [-]
     as_json : bool
         Print JSON instead of a table, [-]
     options : MotorOptions
@@ -85,19 +105,81 @@ def command(flow: str, dp: str | None, dp_i: str | None, p_ex: str, as_json: boo
         model = options.build_model()
         q = quantity('--flow', flow, 'flow', 'l/min', signed=True)
         pex = quantity('--p-ex', p_ex, 'pressure', 'MPa')
+        given = read_channels(channels, model.channels)
         if dp is not None:
-            op = model.speed(q, quantity('--dp', dp, 'pressure', 'MPa', signed=True), p_ex=pex)
+            op = model.speed(q, quantity('--dp', dp, 'pressure', 'MPa', signed=True), p_ex=pex,
+                             channels=given or None)
         elif dp_i is not None:
             op = model.speed(q, dp_i=quantity('--dp-i', dp_i, 'pressure', 'MPa', signed=True),
-                             p_ex=pex)
+                             p_ex=pex, channels=given or None)
         else:
             raise CliError('give --dp or --dp-i')
     except (CliError, ModelError) as err:
         return fail(err)
-    result = _result(model, op)
+    result = _result(model, op, given)
     print(json.dumps(_json_safe(result), indent=2, allow_nan=False) if as_json
           else _table(result))
     return 0
+
+
+def read_channels(texts: list[str], needed: tuple[str, ...]) -> dict[str, float]:
+    """
+    Read ``--channel NAME=VALUE`` options: exactly the channels the model's effects read.
+
+    Parameters
+    ----------
+    texts : list of str
+        Each option as typed, e.g. ``'p_case=0.3MPa'``, [-]
+    needed : tuple of str
+        The channels the model reads (``MotorModel.channels``), [-]
+
+    Returns
+    -------
+    dict of str to float
+        Each channel in the model's units: gauge pressure [Pa] (an absolute unit, ``bara``
+        or ``psia``, less one atmosphere), temperature [degC], time [s], others as given.
+
+    Raises
+    ------
+    CliError
+        One line naming the option: malformed, repeated, not read by the model, missing.
+
+    """
+    values: dict[str, float] = {}
+    for text in texts:
+        name, sep, value = (part.strip() for part in text.partition('='))
+        if not sep or not name or not value:
+            raise CliError(f'--channel {text!r}: use NAME=VALUE, e.g. p_case=0.3MPa')
+        if name not in needed:
+            reads = ', '.join(needed) or 'no channel'
+            raise CliError(f"--channel {text!r}: the motor file's effects read {reads}, "
+                           f'not {name!r}')
+        if name in values:
+            raise CliError(f'--channel {text!r}: {name} is given twice')
+        values[name] = _channel_value(text, name, value)
+    missing = [name for name in needed if name not in values]
+    if missing:
+        raise CliError(f"--channel: the motor file's effects read {', '.join(missing)}; "
+                       f'give --channel {missing[0]}=VALUE')
+    return values
+
+
+def _channel_value(text: str, name: str, value: str) -> float:
+    kind = CHANNEL_KINDS.get(name)
+    try:
+        if kind is None:
+            number = float(value)
+        else:
+            number = parse_quantity(value, *kind)
+            if kind[0] == 'pressure' and number < 0.0:
+                raise CliError(f'--channel {text!r}: a pressure must be >= 0')
+            if kind[0] == 'pressure' and value.rstrip().endswith(ABSOLUTE_UNITS):
+                number = max(0.0, number - ATMOSPHERE)  # bara, psia: the effects read gauge
+    except (UnitError, ValueError) as err:
+        raise CliError(f'--channel {text!r}: {err}') from None
+    if not math.isfinite(number):
+        raise CliError(f'--channel {text!r}: must be a finite value')
+    return number
 
 
 def _json_safe(value: Any) -> Any:
@@ -109,8 +191,9 @@ def _json_safe(value: Any) -> Any:
     return value
 
 
-def _result(model: MotorModel, op: OperatingPoints) -> PointReport:
+def _result(model: MotorModel, op: OperatingPoints, channels: dict[str, float]) -> PointReport:
     status = int(op.status)
+    losses = {name: float(getattr(op.losses, name)) / LPM for name in COMPONENTS}
     return {
         'motor': model.name,
         'family': model.family.name,
@@ -123,7 +206,12 @@ def _result(model: MotorModel, op: OperatingPoints) -> PointReport:
         'speed_rpm': float(op.speed) / RPM,
         'speed_rad_s': float(op.speed),
         'speed_loss_rpm': float(op.speed_loss) / RPM,
-        'losses_lpm': {name: float(getattr(op.losses, name)) / LPM for name in COMPONENTS},
+        'losses_lpm': losses,
+        # what the file's effects add to Q_vl beyond the family's components (eq. 31's sum)
+        'effects': [effect.name for effect in model.effects],
+        'effects_lpm': losses['total'] - sum(v for k, v in losses.items() if k != 'total')
+        if model.effects else 0.0,
+        'channels': channels,
         'status': describe_status(status),
         'warnings': _warnings(status),
     }
@@ -153,8 +241,10 @@ def _table(r: PointReport) -> str:
         '  volumetric losses [l/min]',
     ]
     labels = FAMILIES[r['family']].components  # the components the family has
-    lines += [f'    {labels[name]:38s} {value:10.4f}'
-              for name, value in r['losses_lpm'].items() if name in labels]
+    rows = [(labels[name], value) for name, value in r['losses_lpm'].items() if name in labels]
+    if r['effects']:
+        rows.insert(-1, (f'+ effects ({", ".join(r["effects"])})', r['effects_lpm']))
+    lines += [f'    {label:38s} {value:10.4f}' for label, value in rows]
     lines.append(f'  status: {r["status"]}')
     lines += [f'  warning: {note}' for note in r['warnings']]
     return '\n'.join(lines)

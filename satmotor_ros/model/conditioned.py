@@ -422,7 +422,7 @@ def points_to_array(points: list[Point], shape: tuple[int, ...], geometry: Motor
         values = ', '.join(f'{n} = {float(x.reshape(-1)[i])!r}' for n, x in zip(names, inputs))
         msg = f'element {i} ({values}) is invalid: {describe_status(int(status.reshape(-1)[i]))}'
         raise InvalidInputError(msg)
-    columns = [np.ascontiguousarray(table[..., j]) for j in range(12)]
+    columns = [np.array(table[..., j]) for j in range(12)]  # a copy of `shape`, 0-d kept
     for column in (*columns, status):
         column.setflags(write=False)
     losses = LossBreakdown(**dict(zip(COMPONENTS, columns[4:])))
