@@ -20,6 +20,8 @@ import json
 import os
 from pathlib import Path
 import shutil
+import signal
+import threading
 
 from satmotor_ros.cli._common import CliError
 
@@ -28,6 +30,9 @@ MARKER = '.satmotor-output.json'
 
 COMMITTED: list[Path] = []
 """Each output renamed into place by this process, in order (what an interrupt leaves)."""
+
+
+_HELD = {signal.SIGINT, signal.SIGTERM}
 
 
 def _temporary(target: Path) -> Path:
@@ -104,17 +109,92 @@ def written_by(command: str) -> Callable[[Path], bool]:
     return ours
 
 
-def _replace(temporary: Path, target: Path) -> None:
-    """Move `temporary` onto `target`; an old target is removed only once the new one is in."""
-    if target.is_dir() and not target.is_symlink():
-        old = target.with_name(f'.{target.name}.old-{os.getpid()}')
-        os.replace(target, old)
-        os.replace(temporary, target)
+def _commit(temporary: Path, target: Path, option: str, command: str, force: bool,
+            ours: Callable[[Path], bool]) -> None:
+    """
+    Move `temporary` onto `target`, checking again what is there now, never over the check.
+
+    Whatever holds `target` at this moment is first renamed aside under a name of this
+    process (atomic), so the check of it is the check of what is replaced. What is not ours
+    is put back and the run refused; the new output is installed with no-replace semantics
+    (a directory is never renamed over a non-empty one, a file is linked), so a target made
+    after the check is never replaced either.
+    """
+    refused = (f'{option} {str(target)!r} was made during the run and is not an earlier '
+               f'output of satmotor {command}; it is left as it was; choose a new path or pass '
+               '--force to replace it')
+    blocked = _block_interrupts()
+    try:
+        aside = target.with_name(f'.{target.name}.old-{os.getpid()}-{os.urandom(4).hex()}')
+        old: Path | None = aside
+        try:
+            os.rename(target, aside)
+        except FileNotFoundError:
+            old = None
+        if old is not None and not (force or ours(old) or _empty_dir(old)):
+            _put_back(old, target, refused)
+            raise CliError(refused)
+        try:
+            _install(temporary, target)
+        except OSError:
+            if old is not None:
+                _put_back(old, target, refused)
+            raise CliError(refused) from None
         COMMITTED.append(target)
+        if old is not None:
+            _remove(old)
+    finally:
+        _unblock_interrupts(blocked)
+
+
+def _install(temporary: Path, target: Path) -> None:
+    """Rename `temporary` to `target` only if nothing (or an empty directory) is there."""
+    if temporary.is_dir():
+        os.rename(temporary, target)  # fails on a file and on a non-empty directory
+        return
+    try:
+        os.link(temporary, target)  # fails on anything there, unlike rename
+    except FileExistsError:
+        raise
+    except OSError:  # a file system without hard links
+        if target.exists() or target.is_symlink():
+            raise FileExistsError(target) from None
+        os.rename(temporary, target)
+        return
+    os.unlink(temporary)
+
+
+def _put_back(old: Path, target: Path, refused: str) -> None:
+    """Return what was renamed aside to `target`; if something took the name, say where."""
+    try:
+        if old.is_dir() and not old.is_symlink():
+            os.rename(old, target)
+        else:
+            os.link(old, target, follow_symlinks=False)
+            os.unlink(old)
+    except OSError:
+        raise CliError(f'{refused}; what was there before is now {str(old)!r}') from None
+
+
+def _remove(old: Path) -> None:
+    """Remove a replaced output: a link itself, never what it points to."""
+    if old.is_dir() and not old.is_symlink():
         shutil.rmtree(old, ignore_errors=True)
     else:
-        os.replace(temporary, target)
-        COMMITTED.append(target)
+        old.unlink(missing_ok=True)
+
+
+def _block_interrupts() -> bool:
+    """Hold SIGINT and SIGTERM while an output is being swapped (delivered right after)."""
+    if threading.current_thread() is not threading.main_thread():
+        return False
+    signal.pthread_sigmask(signal.SIG_BLOCK, _HELD)
+    return True
+
+
+def _unblock_interrupts(blocked: bool) -> None:
+    if blocked:
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, _HELD)
 
 
 @contextmanager
@@ -157,7 +237,7 @@ def output_dir(option: str, out: str | Path, command: str, inputs: Sequence[str 
         yield temporary
         (temporary / MARKER).write_text(json.dumps({'command': command}) + '\n',
                                         encoding='utf-8')
-        _replace(temporary, target)
+        _commit(temporary, target, option, command, force, written_by(command))
     except BaseException:
         shutil.rmtree(temporary, ignore_errors=True)
         raise
@@ -201,9 +281,9 @@ def output_file(option: str, out: str | Path, command: str, ours: Callable[[Path
     temporary = _temporary(target)
     try:
         yield temporary
-        _replace(temporary, target)
+        _commit(temporary, target, option, command, force, ours)
     except BaseException:
-        if temporary.is_dir():
+        if temporary.is_dir() and not temporary.is_symlink():
             shutil.rmtree(temporary, ignore_errors=True)
         else:
             temporary.unlink(missing_ok=True)
