@@ -14,6 +14,8 @@ package_name = 'satmotor_ros'
 # mapped onto config/ (package_dir), so importlib.resources.files('satmotor_ros.config')
 # finds them.
 config_files = sorted(glob(os.path.join('config', '*.yaml')))
+# The XML launch files go to share/<pkg>/launch, where `ros2 launch satmotor_ros X` finds them.
+launch_files = sorted(glob(os.path.join('launch', '*.launch.xml')))
 
 setup(
     name=package_name,
@@ -33,6 +35,7 @@ setup(
         ('share/ament_index/resource_index/packages', ['resource/' + package_name]),
         ('share/' + package_name, ['package.xml']),
         ('share/' + package_name + '/config', config_files),
+        ('share/' + package_name + '/launch', launch_files),
     ],
     python_requires='>=3.10',
     # Every third-party module satmotor_ros imports (test_package_build checks the list against

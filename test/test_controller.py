@@ -99,3 +99,28 @@ def test_step_metrics_on_a_known_first_order_response():
     assert m.overshoot == 0.0
     assert m.iae == pytest.approx(1.0, rel=1e-2)
     assert m.steady_state_error == pytest.approx(0.0, abs=1e-6)
+
+
+@pytest.mark.parametrize('feedforward', ['model', 'none'])
+def test_a_negative_setpoint_drives_the_motor_backwards_as_a_positive_one_forwards(feedforward):
+    """Signed set-points: the reverse steps are tracked as the forward ones, mirrored."""
+    steps = (Segment(2.0, 600.0 * RPM, 0.0), Segment(2.0, -600.0 * RPM, 0.0),
+             Segment(2.0, -1000.0 * RPM, 0.0), Segment(2.0, 300.0 * RPM, 0.0))
+    run = run_closed_loop(MODELS['oil'], Cycle(steps), ControllerParams(feedforward=feedforward))
+    for m in step_metrics(run.time, run.setpoint, run.speed, run.load):
+        assert abs(m.steady_state_error) < 0.005 * abs(m.target), m
+    asked = np.concatenate(([0.0], run.setpoint[:-1]))  # a command reaches the plant 1 late
+    backwards = run.setpoint < 0.0
+    assert np.all(run.flow_command[asked < 0.0] <= 0.0)  # the mirrored range [-flow_max, 0]
+    assert np.all(run.flow_command[asked > 0.0] >= 0.0)
+    end = run.time >= 5.5
+    assert np.all(run.speed[end & backwards] < -0.99 * 1000.0 * RPM)
+
+
+def test_the_flow_range_mirrors_for_a_negative_setpoint():
+    law = SpeedController(ControllerParams(flow_min=1.0 * LPM, flow_max=40.0 * LPM),
+                          MODELS['water'])
+    assert law.flow_range(10.0) == (1.0 * LPM, 40.0 * LPM)
+    assert law.flow_range(-10.0) == (-40.0 * LPM, -1.0 * LPM)
+    command = law.update(-3000.0 * RPM, 0.0, 0.0, 0.01)  # far out of reach: saturated
+    assert command == -40.0 * LPM and law.saturated

@@ -63,19 +63,36 @@ def test_controller_brings_the_virtual_motor_to_the_setpoint_and_follows_the_top
     assert motor.plant.state.speed == pytest.approx(900.0 * RPM, rel=0.01)
 
 
+def test_a_negative_setpoint_drives_the_virtual_motor_backwards(loop):
+    """-600 rpm on speed_setpoint: the motor reverses and holds it within 1 %, then forward."""
+    executor, motor, controller, probe = loop
+    assert _spin_until(executor, lambda: motor.plant.state.time > 2.0)
+    setpoint = probe.create_publisher(Float64, 'speed_setpoint', 10)
+    setpoint.publish(Float64(data=-600.0 * RPM))
+    assert _spin_until(executor, lambda: controller.setpoint == -600.0 * RPM)
+    start = motor.plant.state.time
+    assert _spin_until(executor, lambda: motor.plant.state.time > start + 4.0)
+    assert motor.plant.state.speed == pytest.approx(-600.0 * RPM, rel=0.01)
+    assert controller.command < 0.0 and controller.rejected == 0
+    setpoint.publish(Float64(data=300.0 * RPM))
+    start = motor.plant.state.time
+    assert _spin_until(executor, lambda: motor.plant.state.time > start + 4.0)
+    assert motor.plant.state.speed == pytest.approx(300.0 * RPM, rel=0.01)
+
+
 def test_controller_refuses_bad_setpoints_and_parameters(loop):
-    """Set-points NaN and -5 are refused and reported; a bad feed-forward is refused."""
+    """Set-points NaN and beyond 3000 rpm either way are refused and reported."""
     executor, motor, controller, probe = loop
     diagnostics = []
     probe.create_subscription(DiagnosticArray, '/diagnostics', diagnostics.append, 10)
     setpoint = probe.create_publisher(Float64, 'speed_setpoint', 10)
     assert _spin_until(executor, lambda: motor.plant.state.time > 1.0)
-    for bad in (math.nan, -5.0):
+    for bad in (math.nan, -4000.0 * RPM):
         setpoint.publish(Float64(data=bad))
     assert _spin_until(executor, lambda: controller.rejected >= 2)
     assert controller.setpoint == 600.0 * RPM
     assert _spin_until(executor, lambda: any(
-        s.level == DiagnosticStatus.WARN and 'set-point' in s.message
+        s.level == DiagnosticStatus.WARN and 'speed_setpoint.data = ' in s.message
         for d in diagnostics for s in d.status if 'speed loop' in s.name))
     (result,) = controller.set_parameters([Parameter('feedforward', value='psychic')])
     assert not result.successful and 'feedforward' in result.reason

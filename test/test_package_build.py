@@ -307,6 +307,9 @@ def test_colcon_build_installs_index_marker_manifest_and_config(colcon_build):
     assert source_yaml, 'config/ holds no *.yaml'
     share_yaml = sorted(p.name for p in (prefix / 'share' / PACKAGE / 'config').glob('*.yaml'))
     assert share_yaml == source_yaml
+    launch = sorted(p.name for p in (REPO_ROOT / 'launch').glob('*.launch.xml'))
+    assert launch, 'launch/ holds no *.launch.xml'
+    assert sorted(p.name for p in (prefix / 'share' / PACKAGE / 'launch').iterdir()) == launch
     site = f'lib/python{sys.version_info.major}.{sys.version_info.minor}/site-packages'
     package_data = prefix / site / PACKAGE / 'config'
     assert sorted(p.name for p in package_data.glob('*.yaml')) == source_yaml
@@ -526,6 +529,17 @@ def test_clean_venv_has_the_wheel_and_no_ros(clean_venv, tmp_path):
     check = _run([clean_venv['bin'] / 'python', '-m', 'pip', 'check'], clean_venv['env'],
                  tmp_path)
     assert check.returncode == 0, check.stdout + check.stderr
+
+
+@pytest.mark.parametrize('argv', [['motor_model'], ['virtual_motor'], ['speed_controller'],
+                                  ['satmotor', 'demo', '--quiet', '--out', 'demo']])
+def test_wheel_alone_says_in_one_line_that_a_node_needs_ros(clean_venv, tmp_path, argv):
+    """Issue 21: a node or the demo without ROS 2 is one line naming what to install."""
+    proc = _run([clean_venv['bin'] / argv[0], *argv[1:]], clean_venv['env'], tmp_path)
+    assert proc.returncode == 1, proc.stdout + proc.stderr
+    assert proc.stderr.count('\n') == 1 and 'pip install ros-kilted-rclpy' in proc.stderr, \
+        proc.stderr
+    assert not (tmp_path / 'demo').exists()
 
 
 def test_wheel_alone_runs_satmotor_calibrate(clean_venv, tmp_path):

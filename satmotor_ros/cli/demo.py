@@ -23,6 +23,7 @@ from satmotor_ros.cli._output import output_dir
 from satmotor_ros.model.units import LPM, MPA, RPM
 from satmotor_ros.plant.config import parameter_specs, params_from_flat
 from satmotor_ros.plant.scenario import default_cycle, identification_cycle
+from satmotor_ros.ros_runtime import MISSING_ROS, ros_problem
 
 LIQUIDS = ('water', 'oil')
 FEEDFORWARDS = ('model', 'none')
@@ -156,6 +157,9 @@ def command(liquid: str, duration: str, effect: list[str], out: str, quiet: bool
         liquids = LIQUIDS if liquid == 'both' else (liquid,)
         cycle = default_cycle().scaled(seconds)
         os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
+        problem = ros_problem()
+        if problem is not None:
+            raise CliError(f'demo {MISSING_ROS} (cannot import {problem})')
         from satmotor_ros.cli import _demo_report as report
         from satmotor_ros.cli._demo_ros import run_cycle
         runs: list[report.RunResult] = []

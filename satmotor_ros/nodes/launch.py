@@ -5,15 +5,19 @@ The nodes' console scripts (what ``ros2 run satmotor_ros NODE`` starts).
 A node module imports rclpy and numpy, which takes a good part of a second. A
 Ctrl-C in that window would end in a KeyboardInterrupt traceback; here it ends
 the start-up quietly with status 130, as a shell reports an interrupted program.
+Without ROS 2 (a pip install alone) a node ends in one line naming what it needs.
 """
 
 from __future__ import annotations
 
 import importlib
 
+from satmotor_ros.ros_runtime import require_ros
+
 
 def _launch(module: str) -> None:
     try:
+        require_ros(module)
         main = importlib.import_module(f'satmotor_ros.nodes.{module}').main
     except KeyboardInterrupt:
         raise SystemExit(130) from None

@@ -4,7 +4,7 @@ The ``speed_controller`` node: an example drive controller, speed loop on comman
 
 Reads ``joint_states`` (measured speed), ``inlet_pressure`` and ``outlet_pressure`` (for the
 model-based feed-forward) and the set-point from ``speed_setpoint`` (std_msgs/Float64,
-rad/s) or the ``setpoint`` parameter; publishes ``flow_command`` (m^3/s) at ``rate`` on the
+rad/s, signed: a negative one turns the motor backwards) or the ``setpoint`` parameter; publishes ``flow_command`` (m^3/s) at ``rate`` on the
 node's clock (so it follows ``/clock`` with ``use_sim_time``) and ``/diagnostics``. The law
 (PI, anti-windup, feed-forward) is :class:`satmotor_ros.plant.controller.SpeedController`.
 """
@@ -32,12 +32,12 @@ from sensor_msgs.msg import FluidPressure, JointState
 from std_msgs.msg import Float64
 
 MAX_SETPOINT = 3000.0 * RPM
-"""Largest speed set-point accepted, [rad/s]."""
+"""Largest speed set-point accepted either way (a negative one turns backwards), [rad/s]."""
 
 _DEFAULTS = ControllerParams()
 PARAMETERS: tuple[ParamSpec, ...] = (
-    ParamSpec('setpoint', 0.0, 'speed set-point until one arrives on speed_setpoint', 'rad/s',
-              0.0, MAX_SETPOINT),
+    ParamSpec('setpoint', 0.0, 'speed set-point until one arrives on speed_setpoint; '
+              'negative: backwards', 'rad/s', -MAX_SETPOINT, MAX_SETPOINT),
     ParamSpec('rate', 100.0, 'control rate on the node clock', 'Hz', 1.0, 1000.0),
     ParamSpec('kp', _DEFAULTS.kp, 'proportional gain', 'm^3/rad', 0.0, 1.0e-3),
     ParamSpec('ki', _DEFAULTS.ki, 'integral gain', 'm^3/(s*rad)', 0.0, 1.0e-2),
@@ -144,9 +144,9 @@ class SpeedControllerNode(Node):
         self.get_logger().warning(what, throttle_duration_sec=1.0)
 
     def _on_setpoint(self, msg: Float64) -> None:
-        if not (math.isfinite(msg.data) and 0.0 <= msg.data <= MAX_SETPOINT):
-            self._refuse(f'speed set-point {msg.data!r} rad/s is outside [0, {MAX_SETPOINT:.1f}]'
-                         f'; holding {self.setpoint!r}')
+        if not (math.isfinite(msg.data) and abs(msg.data) <= MAX_SETPOINT):
+            self._refuse(f'speed_setpoint.data = {msg.data!r} rad/s: not finite or beyond '
+                         f'+-{MAX_SETPOINT / RPM:.0f} rpm; holding {self.setpoint / RPM:.1f} rpm')
             return
         self.setpoint = msg.data
 

@@ -10,7 +10,10 @@ command is
 with e = n_set - n the speed error, b the set-point weight of the proportional part
 (b < 1 keeps the proportional kick off a set-point step the feed-forward already makes),
 Q_sat the command clipped to the pump's range and T_t = k_p / k_i the back-calculation
-time constant (anti-windup). The feed-forward is
+time constant (anti-windup). The set-point is signed: a negative one turns the motor
+backwards, through the pump's range mirrored, [-flow_max, -flow_min] (a reversing valve in
+front of the same pump; the plant and the model run in all four quadrants). The
+feed-forward is
 
 - ``model``: the absorbency of eq. (36) at the set-point speed and the measured port
   pressure drop, i.e. the inverse model: the flow that gives n_set at this pressure
@@ -118,6 +121,25 @@ class SpeedController:
             return naive
         return flow
 
+    def flow_range(self, setpoint: float) -> tuple[float, float]:
+        """
+        Give the flow commands that may drive toward `setpoint`.
+
+        Parameters
+        ----------
+        setpoint : float
+            Speed set-point, signed, [rad/s]
+
+        Returns
+        -------
+        tuple of float
+            [flow_min, flow_max] for a set-point >= 0, the mirror [-flow_max, -flow_min]
+            for a negative one, [m^3/s]
+
+        """
+        p = self.params
+        return (p.flow_min, p.flow_max) if setpoint >= 0.0 else (-p.flow_max, -p.flow_min)
+
     def update(self, setpoint: float, speed: float, dp: float, dt: float) -> float:
         """
         Advance the controller by dt and return the flow command.
@@ -136,7 +158,8 @@ class SpeedController:
         Returns
         -------
         float
-            Flow command within [flow_min, flow_max], [m^3/s]
+            Flow command within [flow_min, flow_max], or within [-flow_max, -flow_min]
+            for a negative set-point, [m^3/s]
 
         Raises
         ------
@@ -153,7 +176,8 @@ class SpeedController:
         error = setpoint - speed
         ff = self.feedforward_flow = self.feedforward(setpoint, dp)
         raw = ff + p.kp * (p.setpoint_weight * setpoint - speed) + self.integral
-        command = min(max(raw, p.flow_min), p.flow_max)
+        low, high = self.flow_range(setpoint)
+        command = min(max(raw, low), high)
         self.saturated = command != raw
         rate = p.ki * error
         if p.anti_windup and p.ki > 0.0 and p.kp > 0.0:
