@@ -15,7 +15,7 @@ import sys
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-BLOCKER = '''
+BLOCKER = """
 import importlib.abc, sys
 ROS = {'rclpy', 'rpyutils', 'rcl_interfaces', 'builtin_interfaces', 'rosgraph_msgs',
        'ament_index_python'}
@@ -28,7 +28,7 @@ class NoRos(importlib.abc.MetaPathFinder):
         return None
 
 sys.meta_path.insert(0, NoRos())
-'''
+"""
 
 
 def _console_scripts():

@@ -4,8 +4,9 @@ The ``speed_controller`` node: an example drive controller, speed loop on comman
 
 Reads ``joint_states`` (measured speed), ``inlet_pressure`` and ``outlet_pressure`` (for the
 model-based feed-forward) and the set-point from ``speed_setpoint`` (std_msgs/Float64,
-rad/s, signed: a negative one turns the motor backwards) or the ``setpoint`` parameter; publishes ``flow_command`` (m^3/s) at ``rate`` on the
-node's clock (so it follows ``/clock`` with ``use_sim_time``) and ``/diagnostics``. The law
+rad/s, signed: a negative one turns the motor backwards) or the ``setpoint`` parameter;
+publishes ``flow_command`` (m^3/s) at ``rate`` on the node's clock (so it follows
+``/clock`` with ``use_sim_time``) and ``/diagnostics``. The law
 (PI, anti-windup, feed-forward) is :class:`satmotor_ros.plant.controller.SpeedController`.
 """
 
