@@ -134,7 +134,7 @@ def test_node_publishes_the_library_prediction_and_recovers_from_bad_input(
         assert motor.residual[0].data == pytest.approx(50.0 - expected.speed, rel=1e-15)
         ok = _wait_diag(h, motor, 0, 'OK')
         keys = {kv.key: kv.value for kv in ok.values}
-        assert float(keys['inlet_pressure.fluid_pressure [Pa]']) == P_IN
+        assert float(keys['inlet_pressure.fluid_pressure [MPa]']) == pytest.approx(P_IN / MPA)
         assert keys['model status'] == 'OK'
         assert keys['predictions published'] == str(len(motor.predicted))
 

@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import argparse
+from collections.abc import Sequence
 import math
 import sys
 from types import ModuleType
@@ -32,7 +33,7 @@ _PREFIX = 'motor_options.'  # the argparse dest of a motor option: prefix + fiel
 
 
 def add_subcommand(sub: argparse._SubParsersAction[argparse.ArgumentParser], name: str,
-                   module: ModuleType) -> None:
+                   module: ModuleType, examples: Sequence[str] = ()) -> None:
     """
     Add the subcommand a module defines; its parsed options go to ``command`` as keywords.
 
@@ -45,11 +46,24 @@ def add_subcommand(sub: argparse._SubParsersAction[argparse.ArgumentParser], nam
     module : module
         Defines ``HELP`` and ``DESCRIPTION`` (short and long help), ``add_arguments(parser)``
         and ``command`` (runs it and returns the exit code), [-]
+    examples : sequence of str
+        Command lines shown under "examples:" at the end of its ``--help``, [-]
 
     """
-    parser = sub.add_parser(name, help=module.HELP, description=module.DESCRIPTION)
+    epilog = 'examples:\n' + '\n'.join(f'  {line}' for line in examples) if examples else None
+    parser = sub.add_parser(name, help=module.HELP, description=module.DESCRIPTION,
+                            epilog=epilog, formatter_class=_ExamplesFormatter)
     parser.set_defaults(command=module.command)
     module.add_arguments(parser)
+
+
+class _ExamplesFormatter(argparse.HelpFormatter):
+    """Wrap the description as usual but keep the examples' lines as they are written."""
+
+    def _fill_text(self, text: str, width: int, indent: str) -> str:
+        if text.startswith('examples:'):
+            return ''.join(indent + line for line in text.splitlines(keepends=True))
+        return super()._fill_text(text, width, indent)
 
 
 def add_motor_options(parser: argparse.ArgumentParser, *, liquid_required: bool = False,
@@ -71,6 +85,7 @@ def add_motor_options(parser: argparse.ArgumentParser, *, liquid_required: bool 
     group = parser.add_argument_group('motor and liquid')
     group.add_argument('--liquid', dest=_PREFIX + 'liquid', required=liquid_required,
                        default=None if liquid_required else MotorOptions.liquid,
+                       metavar='NAME',
                        help="coefficient set and its liquid: 'oil' or 'water' for the packaged "
                             'SM-0,75/25, or any set in --motor'
                             + ('' if liquid_required else ' (default: oil)'))

@@ -48,7 +48,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Add the options of ``satmotor demo``."""
     parser.add_argument('--liquid', choices=(*LIQUIDS, 'both'), default='both',
                         help='liquid(s) to run (default: both)')
-    parser.add_argument('--duration', default='24',
+    parser.add_argument('--duration', default='24', metavar='SECONDS',
                         help='length of the cycle per run in seconds of simulated time '
                              '(default 24; the steps scale with it)')
     parser.add_argument('--effect', action='append', default=[], metavar='NAME=VALUE',

@@ -21,6 +21,27 @@ SUBCOMMANDS = {'demo': demo, 'operating-point': operating_point,
                'validate': validate}
 """Each ``satmotor`` subcommand and the module that defines it, in the order of ``--help``."""
 
+EXAMPLES = {
+    'demo': ['satmotor demo    # both liquids, 24 s simulated each, into out/demo',
+             'satmotor demo --liquid water --duration 12 --out out/short',
+             'satmotor demo --effect clearance_wear=1e-9 --no-loop --out out/worn'],
+    'operating-point': ['satmotor operating-point --liquid water --flow 5 --dp-i 25',
+                        'satmotor operating-point --flow 10 --dp 100bar --json',
+                        'satmotor operating-point --flow 10 --dp 100bar --family paszota '
+                        '--displacement 0.30in^3/rev'],
+    'characteristics': ['satmotor characteristics --liquid oil --out out/oil',
+                        'satmotor characteristics --liquid water --law eq39 --out out/water39'],
+    'replay': ['satmotor replay out/demo/bags/water_model --liquid water --out out/water.csv',
+               'satmotor replay rig_bag --topic-map /rig/q:=flow_command --out-bag '
+               'out/rig_predicted --no-plot'],
+    'calibrate': ['satmotor calibrate bench.csv --liquid water --out out/cal',
+                  'satmotor calibrate log.exp --columns mbari_pto --liquid oil '
+                  "--displacement '0.30 in^3/rev' --out out/cal_log"],
+    'validate': ['satmotor validate today.csv --motor out/cal/coefficients.yaml --liquid water '
+                 '--out out/val'],
+}
+"""Example command lines of each subcommand, shown at the end of its ``--help``."""
+
 INTERRUPTED = 130
 """Exit code after SIGINT or SIGTERM (128 + SIGINT, as a shell reports Ctrl-C), [-]."""
 
@@ -72,7 +93,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument('--version', action='version', version=f'%(prog)s {__version__}')
     sub = parser.add_subparsers(dest='subcommand', required=True, metavar='COMMAND')
     for name, module in SUBCOMMANDS.items():
-        add_subcommand(sub, name, module)
+        add_subcommand(sub, name, module, EXAMPLES[name])
     return parser
 
 

@@ -226,3 +226,30 @@ def motor_options(values: Mapping[str, Any]) -> MotorOptions:
 
     """
     return MotorOptions(**{name: values[name] for name in MOTOR_KEYS})
+
+
+def liquid_source(node: Node) -> str:
+    """
+    Say where the node's liquid came from, and log it once at start-up.
+
+    A liquid left at its default is a guess about the user's rig: the INFO line says so
+    and how to set it (issue 21).
+
+    Parameters
+    ----------
+    node : rclpy.node.Node
+        A node that declared the :data:`MOTOR_PARAMETERS`, [-]
+
+    Returns
+    -------
+    str
+        ``'parameter'`` when ``liquid`` was given (command line, parameter file, overrides),
+        ``'default'`` otherwise.
+
+    """
+    liquid = node.get_parameter('liquid').value
+    if 'liquid' in node._parameter_overrides:  # what the command line and files set
+        node.get_logger().info(f'liquid: {liquid}')
+        return 'parameter'
+    node.get_logger().info(f'liquid: {liquid} (the default; set the liquid parameter)')
+    return 'default'

@@ -116,6 +116,7 @@ class MotorModelNode(Node):
         values = params.values(self, PARAMETERS)
         self._model: MotorModel | None = None
         self._model_error = ''
+        self._liquid_source = params.liquid_source(self)
         self._build_model(values)
         self._rule = rule_from_parameters(values)
         self._combiner = Combiner(self._rule)
@@ -188,6 +189,8 @@ class MotorModelNode(Node):
         names = {p.name for p in changed}
         for name in names:
             self._problems.pop(name, None)  # a start-up problem is over once it is set
+        if 'liquid' in names:
+            self._liquid_source = 'parameter'
         values = params.values(self, PARAMETERS)
         if names & set(params.MOTOR_KEYS):
             self._build_model(values)
@@ -279,7 +282,8 @@ class MotorModelNode(Node):
         if self._worst is None or pred.level >= self._worst.level:
             self._worst = pred
         if pred.level != self._last_level:
-            text = f'prediction {Level(pred.level).name}: {pred.message}'
+            text = f'prediction {Level(pred.level).name}'
+            text += '' if pred.message == 'OK' else f': {pred.message}'
             if pred.level == Level.OK:  # one call site per severity (rclpy requires it)
                 self.get_logger().info(text)
             elif pred.level == Level.WARN:
@@ -315,17 +319,22 @@ class MotorModelNode(Node):
         now = self._now_ns()
         pred = self._worst if self._worst is not None else self._idle_report(now)
         self._worst = None
-        values: dict[str, Any] = {}
+        values: dict[str, Any] = {}  # in the units a person reads; n/a where there is none
         for name, value, age in zip(INPUTS, pred.inputs, self._combiner.snapshot(now).ages):
-            values[f'{FIELDS[name]} [{UNITS[name]}]'] = value
-            values[f'{TOPICS[name]} age [s]'] = age
+            unit, text = diag.human(value, UNITS[name])
+            values[f'{FIELDS[name]} [{unit}]'] = text
+            values[f'{TOPICS[name]} age [s]'] = diag.human(age, 's')[1]
         units = ('Pa', 'Pa', 'Pa', 'rad/s', *(['m^3/s'] * len(LOSS_COMPONENTS)), 'rad/s')
-        for name, unit, value in zip(OUTPUTS, units,
-                                     pred.outputs or [float('nan')] * len(OUTPUTS)):
+        for name, si_unit, value in zip(OUTPUTS, units,
+                                        pred.outputs or [float('nan')] * len(OUTPUTS)):
             key = LOSSES_PREFIX + name if name in LOSS_COMPONENTS else name
-            values[f'{key} [{unit}]'] = value
+            unit, text = diag.human(value, si_unit)
+            values[f'{key} [{unit}]'] = text
+        ran = pred.valid or pred.status != 0  # an ERROR of the inputs never ran the model
         values.update({
-            'model status': describe_status(pred.status), 'model': self._describe_model(),
+            'model status': describe_status(pred.status) if ran else 'not run',
+            'model': self._describe_model(), 'liquid': self._liquid(),
+            'liquid_source': self._liquid_source,
             'predictions published': self._published,
             'predictions rejected': self._rejected,
             'joint_states without joint': self._no_joint, 'joint_name': self._joint,
@@ -339,6 +348,9 @@ class MotorModelNode(Node):
         name = f'{self.get_fully_qualified_name()}: motor model'
         self._pub_diag.publish(diag.array(Time(nanoseconds=now), [diag.status(
             name, self._model.name if self._model else 'motor', level, message, values)]))
+
+    def _liquid(self) -> str:
+        return str(self.get_parameter('liquid').value)
 
     def _idle_report(self, now: int) -> Prediction:
         """Say why no prediction was made within the timeout: the inputs' state now."""

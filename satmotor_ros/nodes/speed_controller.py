@@ -83,6 +83,7 @@ class SpeedControllerNode(Node):
             self.get_logger().error(f'parameter {problem}')
         self.values = params.values(self, PARAMETERS)
         self.law = self._build(self.values)  # invalid start-up parameters raise here
+        self._liquid_source = params.liquid_source(self)
         self.add_on_set_parameters_callback(self._validate)
         self.add_post_set_parameters_callback(self._apply)
         self.setpoint = self.values['setpoint']
@@ -129,6 +130,8 @@ class SpeedControllerNode(Node):
 
     def _apply(self, changes: list[RosParameter]) -> None:
         values, law = self._pending
+        if any(p.name == 'liquid' for p in changes):
+            self._liquid_source = 'parameter'
         law.integral = self.law.integral  # bumpless: keep the integrator
         self.law = law
         if values['setpoint'] != self.values['setpoint']:
@@ -206,13 +209,15 @@ class SpeedControllerNode(Node):
         elif self.law.saturated:
             level, message = 1, 'flow command saturated'
         self._rejected_since = 0
-        values = {
-            'setpoint [rad/s]': self.setpoint, 'speed [rad/s]': self.speed or 0.0,
-            'flow_command [m^3/s]': self.command,
-            'feedforward [m^3/s]': self.law.feedforward_flow,
-            'integral [m^3/s]': self.law.integral,
+        values = {  # in the units a person reads; no measurement yet: n/a
+            'setpoint [rpm]': diag.human(self.setpoint, 'rad/s')[1],
+            'speed [rpm]': diag.human(self.speed, 'rad/s')[1],
+            'flow_command [l/min]': diag.human(self.command, 'm^3/s')[1],
+            'feedforward [l/min]': diag.human(self.law.feedforward_flow, 'm^3/s')[1],
+            'integral [l/min]': diag.human(self.law.integral, 'm^3/s')[1],
             'feedforward': self.law.params.feedforward, 'rejected_inputs': self.rejected,
-            'last_rejection': self.last_rejection,
+            'last_rejection': self.last_rejection, 'liquid': self.values['liquid'],
+            'liquid_source': self._liquid_source,
         }
         status = diag.status(f'{self.get_fully_qualified_name()}: speed loop', 'speed loop',
                              level, message, values)

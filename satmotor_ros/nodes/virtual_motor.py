@@ -160,6 +160,7 @@ class VirtualMotorNode(Node):
             problem = next(iter(problems.values())).partition('; using the default')[0]
             raise ValueError(f'parameter {problem}')
         self._setup = Setup(self._values())  # an inconsistent set-up raises here
+        self._liquid_source = params.liquid_source(self)
         self.plant = Plant(self._setup.model, self._setup.params, self._setup.load)
         self.add_on_set_parameters_callback(self._validate)
         self.add_post_set_parameters_callback(self._apply)
@@ -223,6 +224,8 @@ class VirtualMotorNode(Node):
 
     def _apply(self, changes: list[RosParameter]) -> None:
         setup, old = self._pending, self._setup
+        if any(p.name == 'liquid' for p in changes):
+            self._liquid_source = 'parameter'
         model_changed = any(setup.values[k] != old.values[k]
                             for k in ('liquid', 'motor_file', 'displacement_law'))
         self.plant.reconfigure(setup.params, setup.model if model_changed else None)
@@ -239,15 +242,16 @@ class VirtualMotorNode(Node):
         self.rejected += 1
         self._rejected_since_diagnostics += 1
         self.last_rejection = what
-        self.get_logger().warning(f'{what}; holding {self._command!r} m^3/s',
-                                  throttle_duration_sec=1.0)
+        held = ' '.join(reversed(diag.human(self._command, 'm^3/s')))
+        self.get_logger().warning(f'{what}; holding {held}', throttle_duration_sec=1.0)
 
     def _on_command(self, msg: Float64) -> None:
         value = msg.data
         problem = self.plant.check_command(value)
         limit = self._setup.values['max_flow_command']
         if problem is None and abs(value) > limit:
-            problem = f'flow command {value!r} m^3/s is beyond max_flow_command = +-{limit!r}'
+            problem = (f'flow_command.data = {value!r} m^3/s: beyond max_flow_command '
+                       f'+-{limit / LPM:.4g} l/min')
         if problem is not None:
             self._refuse(problem)
         else:
@@ -414,15 +418,21 @@ class VirtualMotorNode(Node):
             message = f'model refused {plant.invalid_points} point(s): ' \
                       f'{describe_status(plant.model_status)}'
         self._rejected_since_diagnostics = 0
-        values = {
-            'sim_time [s]': now_sim, 'realtime_factor [-]': factor,
-            'flow_command [m^3/s]': self._command,
+        state = plant.state  # the true state: measure() would draw sensor noise
+        values = {  # in the units a person reads
+            'sim_time [s]': diag.human(now_sim, 's')[1],
+            'realtime_factor [-]': f'{factor:.2f}',
+            'flow_command [l/min]': diag.human(self._command, 'm^3/s')[1],
+            'speed [rpm]': diag.human(state.speed, 'rad/s')[1],
+            'inlet_pressure [MPa]': diag.human(state.inlet_pressure, 'Pa')[1],
+            'outlet_pressure [MPa]': diag.human(state.outlet_pressure, 'Pa')[1],
             'load_torque [N*m]': 'profile' if self._load_torque is None else self._load_torque,
             'rejected_inputs': self.rejected, 'last_rejection': self.last_rejection,
             'unanswered_steps': self.unanswered_steps,
-            'relief_flow [m^3/s]': flows.relief,
+            'relief_flow [l/min]': diag.human(flows.relief, 'm^3/s')[1],
             'model_status': describe_status(plant.model_status),
-            'model_rebuilds': plant.rebuilds, 'liquid': plant.model.liquid.name,
+            'model_rebuilds': plant.rebuilds, 'liquid': self._setup.values['liquid'],
+            'liquid_name': plant.model.liquid.name, 'liquid_source': self._liquid_source,
         }
         status = diag.status(f'{self.get_fully_qualified_name()}: plant', plant.model.name,
                              level, message, values)

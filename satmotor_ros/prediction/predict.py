@@ -22,7 +22,7 @@ import numpy.typing as npt
 from satmotor_ros.model import (COMPONENTS, describe_status, INVALID, MotorModel, Point,
                                 PointStatus)
 from satmotor_ros.model.revolutions import revolutions
-from satmotor_ros.model.units import ATMOSPHERE
+from satmotor_ros.model.units import ATMOSPHERE, LPM, MPA
 from satmotor_ros.prediction.rule import (describe_input, FIELDS, input_level, INPUTS,
                                           InputState, Level, Snapshot, SnapshotBatch)
 
@@ -299,8 +299,9 @@ class PredictionBatch(NamedTuple):
 
 
 def _model_note(status: int, flow: float, dp: float) -> str:
-    return (f'model status {describe_status(status)} at flow_command.data = {flow!r} m^3/s, '
-            f'dp = {dp!r} Pa')
+    # read by people (logs, diagnostics, replay's message column): hydraulic units
+    return (f'model status {describe_status(status)} at flow_command {flow / LPM:.4f} l/min, '
+            f'dp {dp / MPA:.4f} MPa')
 
 
 def _level_table() -> npt.NDArray[np.uint8]:
