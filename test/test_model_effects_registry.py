@@ -61,7 +61,8 @@ def test_shipped_kinds_are_found_one_per_file():
     """Every shipped kind is registered from its own module, in the library's order."""
     names = [k.name for k in ranked()]
     assert names == ['flow_sensor_offset', 'flow_sensor_gain', 'speed_sensor_gain',
-                     'external_leakage', 'viscosity_temperature', 'clearance_wear', 'channel',
+                     'external_leakage', 'viscosity_temperature', 'clearance_wear',
+                     'leakage_wear', 'channel',
                      'reverse_loss', 'term', 'threshold']
     for name in names:  # each from the file named after it
         assert importlib.import_module(f'satmotor_ros.model.effects.{name}').KIND is KINDS[name]

@@ -20,8 +20,8 @@ from satmotor_ros.model.effects import build_candidates, Candidate, CandidateDat
 from satmotor_ros.model.viscosity import ViscosityLaw
 
 
-def build_library(parts: LossParts, channels: Mapping[str, FloatArray],
-                  law: ViscosityLaw) -> tuple[list[Candidate], list[str]]:
+def build_library(parts: LossParts, channels: Mapping[str, FloatArray], law: ViscosityLaw,
+                  family: str = '') -> tuple[list[Candidate], list[str]]:
     """
     Build every candidate the data can test, kind by kind in the registry's order.
 
@@ -33,6 +33,9 @@ def build_library(parts: LossParts, channels: Mapping[str, FloatArray],
         Extra channels at the same points (SI; temperature in degC), [-]
     law : ViscosityLaw
         Viscosity law of the liquid, [-]
+    family : str
+        The model family of `parts`: kinds that do not apply to it are not offered;
+        '' offers every kind, [-]
 
     Returns
     -------
@@ -42,7 +45,7 @@ def build_library(parts: LossParts, channels: Mapping[str, FloatArray],
         Why other candidates were not offered (missing or constant channel).
 
     """
-    return build_candidates(CandidateData(parts, channels, law, frozenset()))
+    return build_candidates(CandidateData(parts, channels, law, frozenset(), family))
 
 
 __all__ = ['Candidate', 'build_library']

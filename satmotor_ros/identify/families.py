@@ -3,7 +3,8 @@
 The structure before the effect: which model family the data support best, out of sample.
 
 Each family of :mod:`satmotor_ros.model.families` is fitted to the same points without any
-effect (one factor per linear part of its Q_vl, :func:`~.parts.loss_parts`) and scored by
+effect (its channel drop where the data pin it, :mod:`.base`, then one factor per linear
+part of its Q_vl, :func:`~.parts.loss_parts`) and scored by
 its cross-validated error of Q_vl, with the folds and the selector the effect search uses.
 The motor's own family (its file's, or the SM-0,75/25's) is kept unless another one cuts
 that error by more than the selector's ``min_gain``: like an effect, a change of structure
@@ -20,11 +21,12 @@ structures apart, whichever was kept.
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 import math
 from typing import Any
 
 import numpy as np
+from satmotor_ros.identify.base import BaseFit, fit_base
 from satmotor_ros.identify.errors import IdentificationError
 from satmotor_ros.identify.parts import loss_parts, LossParts
 from satmotor_ros.identify.selection import CrossValidatedSelector, Errors
@@ -115,6 +117,7 @@ class FamilyChoice:
     n_points: int  # points the families were compared on [-]
     verdict: str  # why this family, one sentence
     tie: NearTie | None = None  # the two best families, when the data do not tell them apart
+    bases: Mapping[str, BaseFit] = field(default_factory=dict)  # each family's base (.base)
 
     def as_list(self) -> list[dict[str, Any]]:
         """Return the comparison for ``calibration.json``: one entry per family, best first."""
@@ -206,12 +209,17 @@ def compare_families(points: BenchTable, liquid: str, specs: dict[str, MotorSpec
         If no family can be fitted to the points.
 
     """
-    models = {}
+    models, bases = {}, {}
     for name, spec in specs.items():
         try:
             models[name] = MotorModel.from_spec(spec, liquid)
         except ModelError:
             continue
+        try:  # the base each family earns: its channel drop where the data pin it
+            bases[name] = fit_base(spec, liquid, points, nuisance)
+        except IdentificationError:
+            continue
+        models[name] = MotorModel.from_spec(bases[name].spec, liquid)
     common, parts = _parts_on(models, points, nuisance or {})
     scored = {}
     outlier = np.zeros(len(common), dtype=bool)
@@ -245,16 +253,16 @@ def compare_families(points: BenchTable, liquid: str, specs: dict[str, MotorSpec
     tie = _near_tie(scores, scored, keep, selector())
     if best.family == own.family:
         verdict = f'{own.family} has the least out-of-sample error of the families'
-        return FamilyChoice(own.family, tuple(scores), n, verdict, tie)
+        return FamilyChoice(own.family, tuple(scores), n, verdict, tie, bases)
     if own.error is not None and best.rmse >= (1.0 - min_gain) * own.rmse:
         verdict = (f'{own.family} kept: {best.family} cuts the out-of-sample error by only '
                    f'{100.0 * (1.0 - best.rmse / own.rmse):.1f} % (need > '
                    f'{100.0 * min_gain:.0f} %)')
-        return FamilyChoice(own.family, tuple(scores), n, verdict, tie)
+        return FamilyChoice(own.family, tuple(scores), n, verdict, tie, bases)
     cut = (f'cuts the out-of-sample error of {own.family} by '
            f'{100.0 * (1.0 - best.rmse / own.rmse):.1f} %' if own.error is not None
            else f'fits where {own.family} cannot')
-    return FamilyChoice(best.family, tuple(scores), n, f'{best.family} {cut}', tie)
+    return FamilyChoice(best.family, tuple(scores), n, f'{best.family} {cut}', tie, bases)
 
 
 def _near_tie(scores: list[FamilyScore], scored: Mapping[str, tuple[LossParts, FloatArray]],

@@ -39,7 +39,8 @@ class Component:
     """
 
     name: str  # the factor's name, e.g. 'leakage_scale'
-    pieces: tuple[tuple[str, FloatArray], ...]  # (Modifier field scaling it or '', Q [m^3/s])
+    pieces: tuple[tuple[str, FloatArray], ...]  # (Modifier fields scaling it, '*'-joined, or
+    # '', Q [m^3/s])
     speed_power: float = 0.0  # it grows as n^power at a fixed dp_i (how a speed gain acts) [-]
     floor: float = 0.0  # least factor: a share known otherwise (e.g. C_fc beta_l) [-]
     describes: str = ''  # what the factor multiplies, for the report
@@ -48,10 +49,19 @@ class Component:
     def flow(self, mod: Modifier) -> FloatArray:
         """Return the component at factor 1 under an effect's modifier, [m^3/s]."""
         factor, total = self.pieces[0]
-        total = getattr(mod, factor) * total if factor else total
+        total = _scaled(mod, factor, total)
         for factor, column in self.pieces[1:]:
-            total = total + (getattr(mod, factor) * column if factor else column)
+            total = total + _scaled(mod, factor, column)
         return total / mod.speed_gain ** self.speed_power if self.speed_power else total
+
+
+def _scaled(mod: Modifier, factors: str, column: FloatArray) -> FloatArray:
+    """Return `column` times the Modifier fields named in `factors` ('a*b'; '' for none)."""
+    if not factors:
+        return column
+    for name in factors.split('*'):
+        column = getattr(mod, name) * column
+    return column
 
 
 @dataclass(frozen=True)
@@ -232,7 +242,8 @@ def _family_parts(model: MotorModel, flow: FloatArray, n: FloatArray, dp: FloatA
         q = np.asarray(losses[part.name], dtype=float)
         if not np.any(q):
             continue
-        modifier = 'flat_clearance' if part.name in GAP_LEAKAGE else ''
+        modifier = '*'.join((*(('flat_clearance',) if part.name in GAP_LEAKAGE else ()),
+                             *(('leakage',) if part.name in model.family.leakage else ())))
         components.append(Component(f'{part.name}_scale', ((modifier, q),), part.speed_exponent,
                                     0.0, f'{", ".join(part.coefficients)} ({part.source})',
                                     part.name))

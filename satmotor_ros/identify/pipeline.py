@@ -14,6 +14,7 @@ from typing import Any, Literal
 
 import numpy as np
 
+from satmotor_ros.identify.base import BaseFit, fit_base
 from satmotor_ros.identify.candidates import build_library, Candidate
 from satmotor_ros.identify.errors import DataError, IdentificationError
 from satmotor_ros.identify.families import compare_families, family_specs, FamilyChoice
@@ -77,6 +78,7 @@ class Calibration:
     samples: Samples | None = None  # the time series' samples in 'transient' mode
     inflation: float = 1.0  # variance inflation of the final fit's residuals [-]
     n_folds: int = 5  # cross-validation folds asked for (at most one per point) [-]
+    base: BaseFit | None = None  # the nonlinear coefficients the base fitted and kept
 
     @property
     def selection(self) -> Selection:
@@ -233,13 +235,18 @@ class Calibration:
         return {'warnings': found} if found else {}
 
     def family_comparison(self) -> dict[str, Any]:
-        """Return how the family was chosen: the verdict, each family's error, any near tie."""
+        """
+        Return how the family was chosen: the verdict, each family's error, any near tie.
+
+        ``base`` says which nonlinear coefficients the base fitted and kept (:mod:`.base`).
+        """
+        base = {'base': self.base.as_dict()} if self.base is not None else {}
         if self.family is None:
             return {'verdict': f'{self.model.family.name} pinned by the user (--family)',
-                    'n_points': None, 'families': []}
+                    'n_points': None, 'families': [], **base}
         return {'verdict': self.family.verdict, 'n_points': self.family.n_points,
                 'families': self.family.as_list(),
-                'near_tie': self.family.tie.as_dict() if self.family.tie else None}
+                'near_tie': self.family.tie.as_dict() if self.family.tie else None, **base}
 
     def mode_fields(self) -> dict[str, Any]:
         """
@@ -477,13 +484,14 @@ def calibrate(table: BenchTable, liquid: str = 'oil', spec: MotorSpec | None = N
         raise IdentificationError(msg)
     spec, table = _without_effects(spec, liquid, table)
     spec, model, read, choice = _family_and_rows(spec, liquid, table, options)
+    spec, model, read, base = _with_base(spec, liquid, table, options, read, choice)
     points, parts, rows, samples = read.table, read.parts, read.source_rows, read.samples
     note = implausible(parts)
     if note:
         points = replace(points, notes=points.notes + (note,))
     law = standard_law(model.liquid, liquid)
     channels = {**points.channels, 'p_in': points.p_in, 'p_out': points.p_out}
-    candidates, skipped = build_library(parts, channels, law)
+    candidates, skipped = build_library(parts, channels, law, model.family.name)
     selector = _selector(options, points, samples)
     forward = selector.select(parts, candidates)
     first = forward.steps[0]
@@ -503,7 +511,20 @@ def calibrate(table: BenchTable, liquid: str = 'oil', spec: MotorSpec | None = N
                        Errors.of(first.baseline.cv_error[at], parts.loss[at]),
                        Errors.of(forward.final.cv_error[at], parts.loss[at]), rows, choice,
                        read.mode, read.reason, samples, inflation,
-                       options.n_folds)
+                       options.n_folds, base)
+
+
+def _with_base(spec: MotorSpec, liquid: str, table: BenchTable, options: Options, read: Rows,
+               choice: FamilyChoice | None) -> tuple[MotorSpec, MotorModel, Rows, BaseFit]:
+    """Fit the base's channel drop where the data pin it (:mod:`.base`); re-read the rows."""
+    base = choice.bases.get(choice.chosen) if choice is not None else None
+    if base is None:
+        base = fit_base(spec, liquid, read.table, read.parts.nuisance)
+    model = MotorModel.from_spec(base.spec, liquid)
+    if not base.changed:
+        return base.spec, model, read, base
+    again = read_rows(model, table, replace(options, mode=read.mode))
+    return base.spec, model, replace(again, reason=read.reason), base
 
 
 def _selector(options: Options, points: BenchTable,

@@ -345,6 +345,7 @@ def _families(cal: Calibration) -> list[str]:
     """Describe the model family and how it was chosen (the structure before the effect)."""
     comparison = cal.family_comparison()
     lines = ['## Model family', '', f'**{cal.model.family.name}**: {comparison["verdict"]}.', '']
+    lines += _base(cal)
     if comparison.get('near_tie'):
         note = comparison['near_tie']['note']
         lines += [f'**{note[0].upper()}{note[1:]}.**', '']  # family names keep their case
@@ -361,6 +362,19 @@ def _families(cal: Calibration) -> list[str]:
               "(cross-validated). The motor's own family is kept unless another cuts its "
               'error by more than the least gain an effect must bring; `--family` pins it.', '']
     return lines
+
+
+def _base(cal: Calibration) -> list[str]:
+    """Say which nonlinear coefficients the base fitted (channel drop) and which it kept."""
+    if cal.base is None:
+        return []
+    base = cal.base
+    fitted = [f'`{f["coefficient"]}` = {f["value"]:.4g} (packaged {f["packaged"]:.4g}, 95 % '
+              f'[{f["ci95"][0]:.4g}, {f["ci95"][1]:.4g}])' for f in base.fitted]
+    kept = ', '.join(f'`{k["coefficient"]}` = {k["value"]:.4g}' for k in base.kept)
+    return [f'**Base, before any effect**: {base.note}.', '',
+            f'- fitted: {"; ".join(fitted) or "none"}',
+            f'- kept (the data cannot pin them): {kept or "none"}', '']
 
 
 def _written_effects(summary: dict[str, Any]) -> list[str]:

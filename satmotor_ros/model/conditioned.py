@@ -54,6 +54,42 @@ def _solve(excess: Callable[[float], float], lo: float, f_lo: float, hi: float,
     return x, not failed and abs(excess(x)) <= check
 
 
+def variant(bare: ModelCore, viscosity: float, growth: float, leakage: float) -> ModelCore:
+    """
+    Return the motor at another viscosity, with grown clearances and a worn leakage.
+
+    Parameters
+    ----------
+    bare : ModelCore
+        The motor as configured, [-]
+    viscosity : float
+        Kinematic viscosity of the liquid, [m^2/s]
+    growth : float
+        Growth of both axial clearances h_R and h_S, [m]
+    leakage : float
+        Factor on the family's leakage parts (:attr:`Family.leakage`), [-]
+
+    Returns
+    -------
+    ModelCore
+        The motor so changed.
+
+    """
+    g: MotorGeometry = bare.geometry
+    if growth:
+        g = replace(g, clearance_rotor=g.clearance_rotor + growth,
+                    clearance_satellites=g.clearance_satellites + growth)
+    liquid = bare.liquid
+    if viscosity != liquid.kinematic_viscosity:
+        liquid = replace(liquid, kinematic_viscosity=viscosity)
+    spec = bare.coefficient_set
+    if leakage != 1.0:
+        family = bare.family
+        spec = replace(spec, coefficients=family.scaled(
+            spec.coefficients, dict.fromkeys(family.leakage, leakage)))
+    return ModelCore(g, spec, bare.valid_range, liquid, bare.law_name)
+
+
 class ConditionedModel:
     """
     The effects of a model's coefficient set, evaluated point by point.
@@ -80,7 +116,7 @@ class ConditionedModel:
             if f is not None and (reverse or not kind.reverse) and e.acts(negative))
             for reverse in (False, True) for negative in (False, True)}
         self._bare = core
-        self._variants: dict[tuple[float, float], ModelCore] = {}
+        self._variants: dict[tuple[float, float, float], ModelCore] = {}
 
     # -- conditions ------------------------------------------------------------------------
 
@@ -93,23 +129,16 @@ class ConditionedModel:
             raise ModelError(msg)
         return float(channels[name])
 
-    def _variant(self, viscosity: float, growth: float) -> ModelCore:
+    def _variant(self, viscosity: float, growth: float, leakage: float) -> ModelCore:
         bare = self._bare
-        if growth == 0.0 and viscosity == bare.liquid.kinematic_viscosity:
+        if growth == 0.0 and leakage == 1.0 and viscosity == bare.liquid.kinematic_viscosity:
             return bare
-        key = (viscosity, growth)
+        key = (viscosity, growth, leakage)
         model = self._variants.get(key)
         if model is None:
-            g: MotorGeometry = bare.geometry
-            if growth:
-                g = replace(g, clearance_rotor=g.clearance_rotor + growth,
-                            clearance_satellites=g.clearance_satellites + growth)
-            liquid = bare.liquid
-            if viscosity != liquid.kinematic_viscosity:
-                liquid = replace(liquid, kinematic_viscosity=viscosity)
+            model = variant(bare, viscosity, growth, leakage)
             if len(self._variants) >= _CACHE:
                 self._variants.clear()
-            model = ModelCore(g, bare.coefficient_set, bare.valid_range, liquid, bare.law_name)
             self._variants[key] = model
         return model
 
@@ -149,7 +178,7 @@ class ConditionedModel:
             if effect.acts(negative):
                 now = kind.condition(effect, x, now)
         try:
-            model = self._variant(now.viscosity, now.growth)
+            model = self._variant(now.viscosity, now.growth, now.leakage)
         except (ConfigError, OverflowError, ValueError):
             return None, now.p_ex, 0.0, int(PointStatus.BEYOND_LIMIT)
         if not math.isfinite(now.extra):

@@ -36,13 +36,14 @@ class MotorCache:
         self.tolerance = tolerance
         self.viscosity = model.liquid.kinematic_viscosity  # of the current build [m^2/s]
         self.clearance_growth = 0.0  # of the current build [m]
+        self.leakage = 1.0  # factor on the family's leakage parts of the current build [-]
         geometry = model.geometry
         self._h0 = 0.5 * (geometry.clearance_rotor + geometry.clearance_satellites)
         self.rebuilds = 0
 
-    def update(self, viscosity: float, clearance_growth: float) -> bool:
+    def update(self, viscosity: float, clearance_growth: float, leakage: float = 1.0) -> bool:
         """
-        Rebuild the model if viscosity or clearances moved beyond the tolerance.
+        Rebuild the model if viscosity, clearances or leakage moved beyond the tolerance.
 
         Parameters
         ----------
@@ -50,6 +51,8 @@ class MotorCache:
             Kinematic viscosity the liquid has now, [m^2/s]
         clearance_growth : float
             Growth of both axial clearances since new, [m]
+        leakage : float
+            Factor on the family's leakage parts since new (``leakage_wear``), [-]
 
         Returns
         -------
@@ -59,7 +62,8 @@ class MotorCache:
         """
         tol = self.tolerance
         if (abs(viscosity - self.viscosity) <= tol * self.viscosity
-                and abs(clearance_growth - self.clearance_growth) <= tol * self._h0):
+                and abs(clearance_growth - self.clearance_growth) <= tol * self._h0
+                and abs(leakage - self.leakage) <= tol * self.leakage):
             return False
         base = self.base
         liquid = dataclasses.replace(base.liquid, kinematic_viscosity=viscosity)
@@ -67,9 +71,15 @@ class MotorCache:
             base.geometry,
             clearance_rotor=base.geometry.clearance_rotor + clearance_growth,
             clearance_satellites=base.geometry.clearance_satellites + clearance_growth)
-        self.model = MotorModel(geometry, base.coefficient_set, base.valid_range, liquid,
+        spec = base.coefficient_set
+        if leakage != 1.0:
+            family = base.family
+            spec = dataclasses.replace(spec, coefficients=family.scaled(
+                spec.coefficients, dict.fromkeys(family.leakage, leakage)))
+        self.model = MotorModel(geometry, spec, base.valid_range, liquid,
                                 base.displacement_law, base.name)
         self.viscosity = viscosity
         self.clearance_growth = clearance_growth
+        self.leakage = leakage
         self.rebuilds += 1
         return True

@@ -454,7 +454,7 @@ class Plant:
         channels = self._channels()
         for effect in self._injection.drift:
             now = kind_of(effect).condition(effect, channels[effect.regressor], now)
-        if self._motor.update(now.viscosity, now.growth):
+        if self._motor.update(now.viscosity, now.growth, now.leakage):
             self._q_guess = None
             self._point = self._motor.model.absorbency_point
 

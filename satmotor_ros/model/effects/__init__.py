@@ -17,10 +17,12 @@ defines ``KIND = MyKind()`` (doc/effects.md). The kinds shipped:
                            viscosity in eqs. (1), (5) and (35)
 ``clearance_wear``         h_R and h_S grow by k (x - reference) >= 0, x = ``time`` [s]
                            or ``revolutions`` [rev], in eqs. (1), (2) and (5)
+``leakage_wear``           the leakage of a balawender or paszota motor grows by the factor
+                           1 + max(0, k (x - reference)), x = ``time`` or ``revolutions``
 ``channel:<name>``         extra loss k (x - reference) in Q_vl, x the channel <name>
 ``reverse_loss``           extra loss k |dp_i| |n| in Q_vl while the shaft turns backwards
 ``term:<expression>``      extra loss k dp_i^a n^b in Q_vl, the exponents fitted
-``threshold:dp``           extra loss k max(0, dp_i - x_c)^e in Q_vl (a valve cracking open)
+``threshold:dp``           extra loss k max(0, |dp_i| - x_c)^e in Q_vl (a valve cracking open)
 ``flow_sensor_offset``     the flowmeter reads Q + k
 ``flow_sensor_gain``       the flowmeter reads (1 + k) Q
 ``speed_sensor_gain``      the speed sensor reads (1 + k) n
@@ -493,6 +495,8 @@ def build_candidates(data: CandidateData) -> tuple[list[Candidate], list[str]]:
     out: list[Candidate] = []
     skipped: list[str] = []
     for kind in ranked():
+        if data.family and kind.families is not None and data.family not in kind.families:
+            continue  # e.g. clearance_wear of a family without clearances
         offered, why = kind.candidates(data)
         out += offered
         skipped += why

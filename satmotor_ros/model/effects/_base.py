@@ -110,6 +110,7 @@ class Conditions(NamedTuple):
     growth: float  # growth of both axial clearances h_R, h_S [m]
     p_ex: float  # pressure that drives the external leakage Q_ex of eq. (24) [Pa]
     extra: float  # extra loss in Q_vl that does not depend on n or dp_i [m^3/s]
+    leakage: float = 1.0  # factor on the family's leakage parts (Family.leakage) [-]
 
 
 class SensorError(NamedTuple):
@@ -130,13 +131,14 @@ class Modifier:
     commutation: FloatArray | float = 1.0  # factor on Q_C [-]
     additive: FloatArray | float = 0.0  # extra loss [m^3/s]
     offset: float = 0.0  # flowmeter offset [m^3/s]
+    leakage: FloatArray | float = 1.0  # factor on a family's leakage parts (wear) [-]
 
     def __add__(self, other: Modifier) -> Modifier:
         """Compose two effects: gains and factors multiply, extra losses and offsets add."""
         return Modifier(self.flow_gain * other.flow_gain, self.speed_gain * other.speed_gain,
                         self.flat_clearance * other.flat_clearance,
                         self.commutation * other.commutation, self.additive + other.additive,
-                        self.offset + other.offset)
+                        self.offset + other.offset, self.leakage * other.leakage)
 
 
 @dataclass(frozen=True)
@@ -242,6 +244,7 @@ class CandidateData(NamedTuple):
     channels: Mapping[str, FloatArray]  # extra channels (SI; temperature in degC)
     law: ViscosityLaw  # the liquid's viscosity law, pinned at its viscosity
     covered: frozenset[str]  # channels a named kind reads (no generic channel: candidate)
+    family: str = ''  # the model family of the parts; '' offers every kind
 
 
 class Synthetic(NamedTuple):

@@ -9,9 +9,10 @@ from typing import Any
 import numpy as np
 
 from satmotor_ros.model._typing import FloatArray, Real
-from satmotor_ros.model.effects._base import (Candidate, CandidateData, Effect, EffectKind,
-                                              finite, Loss, Modifier, negative_rows, Shape,
-                                              Synthetic, two_sided)
+from satmotor_ros.model.effects._base import (Candidate, CandidateData, DIRECTIONS, Effect,
+                                              EffectKind, finite, Loss, Modifier,
+                                              negative_rows, PlantParameter, Shape, Synthetic,
+                                              two_sided)
 from satmotor_ros.model.errors import ConfigError
 
 MIN_ABOVE = {'both': (0.15, 4), 'positive': (0.03, 8), 'negative': (0.03, 8)}
@@ -38,6 +39,32 @@ class Threshold(EffectKind):
     source = 'a valve that cracks open (relief, bypass)'
     evaluation = ('extra loss k max(0, dp - reference)^exponent added to Q_vl (eq. 31), dp '
                   '[Pa] the chamber drop dp_i of eq. (34), reference the cracking drop [Pa]')
+
+    plant_parameters = (
+        PlantParameter('valve_conductance', 0.0, 'flow per Pa of chamber drop above the '
+                       'crack pressure through a valve (threshold:dp, exponent 1)',
+                       'm^3/(s*Pa)', 0.0, 1.0e-8),
+        PlantParameter('valve_crack', 20.0e6, 'chamber drop where that valve cracks open',
+                       'Pa', 0.0, 1.0e9),
+        PlantParameter('valve_direction', 'both', 'sign of dp = p_a - p_b where it opens',
+                       choices=DIRECTIONS),
+    )
+
+    def from_plant(self, values: Mapping[str, Any]) -> Effect | None:
+        """Return the valve the node parameters set (exponent 1), None at k = 0."""
+        k, direction = values['valve_conductance'], values['valve_direction']
+        if direction not in DIRECTIONS:
+            msg = f'effects.valve_direction = {direction!r}: use {", ".join(DIRECTIONS)}'
+            raise ConfigError(msg)
+        return Effect(f'{self.name}:dp', k, 'dp', values['valve_crack'],
+                      options=(('exponent', 1.0),), direction=direction) if k else None
+
+    def plant_values(self, effect: Effect | None) -> dict[str, Any]:
+        """Return k, the crack pressure and the direction of `effect`."""
+        if effect is None:
+            return super().plant_values(None)
+        return {'valve_conductance': effect.coefficient, 'valve_crack': effect.reference,
+                'valve_direction': effect.direction}
 
     def regressor(self, suffix: str, value: Any, where: str) -> str:
         """Read the regressor of the id's suffix: ``dp``."""

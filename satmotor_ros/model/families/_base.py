@@ -240,6 +240,8 @@ class Family(ABC):
     quantities: Mapping[str, tuple[str, str]] = {}  # YAML field -> (unit kind, SI unit)
     components: Mapping[str, str] = {}  # breakdown component it has -> label with its eq.
     laws: tuple[str, ...] = ('eq33',)  # the displacement_law names it accepts
+    channel: tuple[str, ...] = ('c_t', 'c_l')  # coefficients the channel drop is linear in
+    leakage: tuple[str, ...] = ('leakage',)  # linear parts that leak through gaps (wear)
 
     def check_law(self, law: str) -> None:
         """

@@ -187,6 +187,8 @@ class Balawender(Family):
     """
 
     name = 'balawender'
+    channel = ('c_ich',)  # eq. (27)
+    leakage = ('laminar', 'turbulent')  # eqs. (20)-(23)
     title = 'the earlier literature model, eqs. (15)-(28), with its low-viscosity variant'
     equations = 'eqs. (15)-(28)'
     coefficients_type = BalawenderCoefficients

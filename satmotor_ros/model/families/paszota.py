@@ -148,6 +148,7 @@ class Paszota(Family):
     """
 
     name = 'paszota'
+    leakage = ('losses',)  # eq. (29): the whole loss, no source told apart
     title = "Paszota and Maczyszyn's model of any constant-displacement motor, eqs. (29)-(30)"
     equations = 'eqs. (29)-(30)'
     coefficients_type = PaszotaCoefficients

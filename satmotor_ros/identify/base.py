@@ -1,0 +1,292 @@
+# SPDX-License-Identifier: Apache-2.0
+"""
+The base fits what the data identify: a family's channel drop, before any effect is tried.
+
+A motor known by its displacement only (or a file for another motor) carries
+coefficients scaled by similarity from the SM-0,75/25: for a 4.9 cm^3/rev motor the
+channel drop of eq. (35) comes out at 9.4 MPa at 26 l/min, where the velocity head of
+its passages gives a few tenths of an MPa. Kept fixed, such a guess makes a speed term
+or a sensor gain absorb the mismatch, and the calibration names it as an effect.
+
+So the base fits one factor f >= 0 on the coefficients the family's channel drop is
+linear in (:attr:`Family.channel`: C_t and C_l of eq. (35), C_ich of eq. (27)), with
+the factors of the linear parts refitted at every f (a profile), on the rows usable over
+the whole range of f. The range is physical: in motor mode the chambers must still see
+a drop, so the channel drop may not exceed the port drop (at the
+:data:`PHYSICAL_QUANTILE` of the motor-mode rows, against noise). The factor is
+*fitted* only where the data pin it: the profile's Huber objective at f must beat the
+kept value's by chi2(1) at :data:`ALPHA` (its variance inflated by the correlation of
+neighbouring samples of a time series) and its 95 % profile interval must not span the
+whole range. Otherwise it is *kept*: the packaged value, or the physical bound where the
+packaged value is beyond it. Every other nonlinear coefficient of the family (the
+exponents of Table 1, the clearance law) is kept, as the data cannot separate it from
+the linear factors (:mod:`.fit`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, fields, replace
+import math
+from typing import Any
+
+import numpy as np
+from satmotor_ros.identify.errors import IdentificationError
+from satmotor_ros.identify.fit import HUBER
+from satmotor_ros.identify.parts import loss_parts, NO_EFFECT
+from satmotor_ros.identify.table import BenchTable
+from satmotor_ros.identify.transient import variance_inflation
+from satmotor_ros.model import MotorModel, MotorSpec
+from satmotor_ros.model._typing import FloatArray
+from satmotor_ros.model.families.defaults import DEFAULTS_NOTE
+from satmotor_ros.model.units import LPM, MPA
+from scipy import optimize, stats
+
+ALPHA = 0.01
+"""Level at which the fitted factor must beat the kept one, [-]."""
+
+PHYSICAL_QUANTILE = 0.05
+"""Share of the motor-mode rows whose port drop may fall below the channel drop (noise), [-]."""
+
+GRID = 10
+"""Log-spaced factors the profile starts from (beside 0 and the kept value), [-]."""
+
+MIN_ROWS = 12
+"""Fewest rows usable over the whole range of the factor for it to be fitted, [-]."""
+
+IRLS_STEPS = 6
+"""Reweighted least-squares steps of the Huber fit of the linear factors at each factor, [-]."""
+
+
+@dataclass(frozen=True)
+class BaseFit:
+    """What the base fitted and kept, and the motor it leaves the calibration with."""
+
+    spec: MotorSpec  # the motor with the fitted (or kept) channel coefficients
+    fitted: tuple[dict[str, Any], ...]  # {'coefficient', 'value', 'packaged', 'ci95', ...}
+    kept: tuple[dict[str, Any], ...]  # {'coefficient', 'value', 'why'}
+    channel_drop: dict[str, Any]  # the drop at the largest flow, packaged and as used
+    note: str  # one sentence for the report
+
+    @property
+    def changed(self) -> bool:
+        """Return whether the motor differs from the one given."""
+        return bool(self.fitted) or self.channel_drop['factor'] != 1.0
+
+    def as_dict(self) -> dict[str, Any]:
+        """Return the record ``calibration.json`` holds under ``base``."""
+        return {'fitted': list(self.fitted), 'kept': list(self.kept),
+                'channel_drop': self.channel_drop, 'note': self.note}
+
+
+def guessed(spec: MotorSpec) -> bool:
+    """Return whether the coefficients are a family's defaults scaled by similarity to a size."""
+    return spec.name.endswith(DEFAULTS_NOTE)
+
+
+def _with_factor(spec: MotorSpec, liquid: str, names: tuple[str, ...],
+                 factor: float) -> MotorSpec:
+    """Return `spec` with the coefficients `names` of `liquid`'s set times `factor`."""
+    chosen = spec.sets[liquid]
+    coef = chosen.coefficients
+    coef = replace(coef, **{n: getattr(coef, n) * factor for n in names})
+    return replace(spec, sets={**spec.sets, liquid: replace(chosen, coefficients=coef)})
+
+
+def _kept_others(model: MotorModel, names: tuple[str, ...]) -> list[dict[str, Any]]:
+    """Name every other nonlinear coefficient of the family, kept as the file gives it."""
+    linear = {c for part in model.family.linear_parts(model.coef) for c in part.coefficients}
+    return [{'coefficient': f.name, 'value': float(getattr(model.coef, f.name)),
+             'why': 'not separable from the linear factors by Q, n and dp'}
+            for f in fields(model.coef) if f.name not in linear and f.name not in names]
+
+
+def _physical_bound(model: MotorModel, points: BenchTable) -> float:
+    """Return the largest factor whose channel drop stays below the port drop in motor mode."""
+    flow, dp = points.flow, points.dp
+    motor = (flow * dp > 0.0) & (flow * points.speed > 0.0)
+    drop = np.asarray(model.equations.channel_drop(np.abs(flow[motor])), dtype=float)
+    ratio = np.abs(dp[motor]) / np.where(drop > 0.0, drop, np.nan)
+    ratio = ratio[np.isfinite(ratio)]
+    return float(np.quantile(ratio, PHYSICAL_QUANTILE)) if ratio.size else math.inf
+
+
+class _Profile:
+    """The base's Huber objective as a function of the channel factor, on fixed rows."""
+
+    def __init__(self, spec: MotorSpec, liquid: str, names: tuple[str, ...],
+                 points: BenchTable, nuisance: Mapping[str, FloatArray]) -> None:
+        self.spec, self.liquid, self.names = spec, liquid, names
+        self.points, self.nuisance = points, nuisance
+        self.scale: float | None = None
+        self.seen: dict[float, float] = {}
+
+    def residual(self, factor: float) -> FloatArray:
+        """Return the base's residual at `factor`: the linear factors by Huber IRLS, [m^3/s]."""
+        model = MotorModel.from_spec(_with_factor(self.spec, self.liquid, self.names, factor),
+                                     self.liquid)
+        parts, usable = loss_parts(model, self.points)
+        if not usable.all():
+            raise IdentificationError('a row left the usable range inside the profile')
+        columns = [c.flow(NO_EFFECT) for c in parts.components]
+        x = np.column_stack(columns + [np.asarray(v, dtype=float)
+                                       for v in self.nuisance.values()])
+        y = parts.loss
+        weight = np.ones(y.size)
+        for _ in range(IRLS_STEPS if self.scale else 1):
+            root = np.sqrt(weight)
+            beta = np.linalg.lstsq(x * root[:, None], y * root, rcond=None)[0]
+            r = y - x @ beta
+            if self.scale:
+                z = np.abs(r) / self.scale
+                weight = np.where(z <= HUBER, 1.0, HUBER / np.maximum(z, 1e-300))
+        return np.asarray(r, dtype=float)
+
+    def __call__(self, factor: float) -> float:
+        """Return the Huber objective (2 rho of the standardised residuals) at `factor`."""
+        factor = float(factor)
+        if factor not in self.seen:
+            try:
+                z = np.abs(self.residual(factor)) / (self.scale or LPM)
+                self.seen[factor] = float(np.sum(np.where(z <= HUBER, z * z,
+                                                          2.0 * HUBER * z - HUBER * HUBER)))
+            except (IdentificationError, np.linalg.LinAlgError):
+                self.seen[factor] = math.inf
+        return self.seen[factor]
+
+
+def fit_base(spec: MotorSpec, liquid: str, points: BenchTable,
+             nuisance: Mapping[str, FloatArray] | None = None) -> BaseFit:
+    """
+    Fit the family's channel drop where the data pin it; keep it, and say so, where not.
+
+    Parameters
+    ----------
+    spec : MotorSpec
+        The motor (its family's coefficients for `liquid`), [-]
+    liquid : str
+        Coefficient set, [-]
+    points : BenchTable
+        The rows the calibration fits (steady points or a recording's bins), [-]
+    nuisance : mapping of str to ndarray, optional
+        Regressors fitted beside the factors at every row of `points` (a
+        transient recording's terms), [SI]
+
+    Returns
+    -------
+    BaseFit
+        The motor to calibrate further and what was fitted and kept.
+
+    """
+    model = MotorModel.from_spec(spec, liquid)
+    names = tuple(n for n in model.family.channel if getattr(model.coef, n) > 0.0)
+    others = _kept_others(model, model.family.channel)
+    if not guessed(spec):
+        kept = [{'coefficient': n, 'value': float(getattr(model.coef, n)),
+                 'why': "the motor's own (not scaled by similarity)"}
+                for n in model.family.channel]
+        return BaseFit(spec, (), tuple(kept + others), {'factor': 1.0},
+                       "the channel drop is kept: the motor's own coefficients, not a guess "
+                       'scaled by similarity')
+    top = float(np.max(np.abs(points.flow))) if len(points) else 0.0
+    packaged_drop = float(model.equations.channel_drop(top)) if top > 0.0 else 0.0
+
+    def result(factor: float, fitted: list[dict[str, Any]], kept: list[dict[str, Any]],
+               note: str) -> BaseFit:
+        used = _with_factor(spec, liquid, names, factor) if factor != 1.0 else spec
+        drop = {'flow_lpm': top / LPM, 'packaged_mpa': packaged_drop / MPA,
+                'used_mpa': packaged_drop * factor / MPA, 'factor': factor}
+        return BaseFit(used, tuple(fitted), tuple(kept + others), drop, note)
+
+    if not names or top <= 0.0:
+        kept = [{'coefficient': n, 'value': float(getattr(model.coef, n)),
+                 'why': 'no channel drop to fit'} for n in model.family.channel]
+        return result(1.0, [], kept, 'the channel drop is kept: the model has none to fit')
+    bound = _physical_bound(model, points)
+    kept_factor = min(1.0, bound)
+    why_kept = ('the packaged value' if kept_factor == 1.0 else
+                'the physical bound: the packaged drop exceeds the port drop of '
+                f'{100 * (1 - PHYSICAL_QUANTILE):.0f} % of the motor-mode rows')
+    rows = _rows(model, spec, liquid, names, points, bound)
+    profile = _Profile(spec, liquid, names, points.select(rows) if not rows.all() else points,
+                       {k: np.asarray(v)[rows] for k, v in (nuisance or {}).items()})
+    if int(rows.sum()) < MIN_ROWS or not math.isfinite(bound):
+        return _kept(result, names, model, kept_factor, 'too few rows usable over the range')
+    try:
+        residual = profile.residual(kept_factor)
+    except (IdentificationError, np.linalg.LinAlgError) as err:
+        return _kept(result, names, model, kept_factor, f'the base cannot be fitted ({err})')
+    mad = 1.4826 * float(np.median(np.abs(residual - np.median(residual))))
+    profile.scale = max(mad, 1e-6 * LPM)
+    best = _minimum(profile, bound, kept_factor)
+    inflation = variance_inflation(profile.residual(best)) if points.time_series else 1.0
+    gain = (profile(kept_factor) - profile(best)) / inflation
+    limit = float(stats.chi2.ppf(1.0 - ALPHA, 1))
+    low, high = _interval(profile, best, bound, profile(best)
+                          + inflation * float(stats.chi2.ppf(0.95, 1)))
+    spans = low <= bound * 1e-3 and high >= bound * 0.999
+    if gain <= limit or spans:
+        why = (f'the data do not pin it (profile: chi2 gain {gain:.3g} <= {limit:.3g}'
+               if gain <= limit else 'the 95 % profile interval spans the whole range (')
+        return _kept(result, names, model, kept_factor,
+                     f'{why}, factor range 0-{bound:.3g}); kept at {why_kept}')
+    fitted = [{'coefficient': n, 'value': float(getattr(model.coef, n)) * best,
+               'packaged': float(getattr(model.coef, n)),
+               'ci95': [float(getattr(model.coef, n)) * low, float(getattr(model.coef, n)) * high],
+               'factor': best, 'bounds': [0.0, float(getattr(model.coef, n)) * bound]}
+              for n in names]
+    note = (f'channel drop fitted: {packaged_drop * best / MPA:.3g} MPa at {top / LPM:.3g} '
+            f'l/min (packaged {packaged_drop / MPA:.3g} MPa; factor {best:.3g}, 95 % '
+            f'{low:.3g}-{high:.3g}, physical range 0-{bound:.3g})')
+    return result(best, fitted, [], note)
+
+
+def _kept(result: Any, names: tuple[str, ...], model: MotorModel, factor: float,
+          why: str) -> BaseFit:
+    kept = [{'coefficient': n, 'value': float(getattr(model.coef, n)) * factor, 'why': why}
+            for n in names]
+    return result(factor, [], kept, f'channel drop kept: {why}')
+
+
+def _rows(model: MotorModel, spec: MotorSpec, liquid: str, names: tuple[str, ...],
+          points: BenchTable, bound: float) -> np.ndarray:
+    """Return the rows usable at no channel drop and at the bound (so at every f between)."""
+    ends = [0.0, bound] if math.isfinite(bound) else [0.0]
+    usable = np.ones(len(points), dtype=bool)
+    for factor in ends:
+        at = MotorModel.from_spec(_with_factor(spec, liquid, names, factor), liquid)
+        try:
+            usable &= loss_parts(at, points)[1]
+        except IdentificationError:
+            return np.zeros(len(points), dtype=bool)
+    return usable
+
+
+def _interval(profile: _Profile, best: float, bound: float,
+              level: float) -> tuple[float, float]:
+    """Return the factors where the profile crosses `level` either side of `best`."""
+    def crossing(end: float) -> float:
+        if not profile(end) > level:
+            return end
+        return float(optimize.brentq(lambda f: profile(f) - level, min(best, end),
+                                     max(best, end), xtol=1e-4 * max(bound, 1e-9),
+                                     maxiter=30))
+    return crossing(0.0), crossing(bound)
+
+
+def _minimum(profile: _Profile, bound: float, kept: float) -> float:
+    """Return the factor of least objective: a log grid, then a bounded search around it."""
+    grid = sorted({0.0, kept, *np.geomspace(bound * 1e-3, bound, GRID)})
+    values = [profile(f) for f in grid]
+    i = int(np.argmin(values))
+    lo, hi = grid[max(i - 1, 0)], grid[min(i + 1, len(grid) - 1)]
+    if hi > lo:
+        found = optimize.minimize_scalar(profile, bounds=(lo, hi), method='bounded',
+                                         options={'xatol': 1e-3 * max(hi, 1e-9),
+                                                  'maxiter': 16})
+        if profile(float(found.x)) < values[i]:
+            return float(found.x)
+    return grid[i]
+
+
+__all__ = ['ALPHA', 'BaseFit', 'fit_base', 'guessed']

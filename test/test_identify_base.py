@@ -1,0 +1,91 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The base fits the channel drop the data pin, keeps what they cannot, and says which."""
+
+import json
+
+import numpy as np
+import pytest
+from satmotor_ros.identify.base import _with_factor, fit_base
+from satmotor_ros.identify.output import write_json, write_yaml
+from satmotor_ros.identify.pipeline import calibrate
+from satmotor_ros.identify.table import BenchTable
+from satmotor_ros.model import load_motor, MotorModel
+from satmotor_ros.model.families import FAMILY_NAMES
+from satmotor_ros.model.families.defaults import default_motor
+from satmotor_ros.model.units import CM3_PER_REV, LPM, MPA, RPM
+
+SIZE = 4.92 * CM3_PER_REV  # a motor known by its displacement only
+
+
+def _points(truth, noise, seed=1, count=400):
+    """Steady points over 300-5000 rpm and 2-20 MPa, the flow of `truth` plus noise."""
+    rng = np.random.default_rng(seed)
+    speed = rng.uniform(300.0, 5000.0, count) * RPM
+    dp = rng.uniform(2.0, 20.0, count) * MPA
+    flow = truth.absorbency(speed, dp, errors='mask').flow
+    ok = np.isfinite(flow)
+    flow = flow + rng.normal(0.0, noise * LPM, count)
+    return BenchTable(speed[ok], flow[ok], dp[ok] + 0.5 * MPA, np.full(int(ok.sum()), 0.5 * MPA))
+
+
+def _truth(family, factor):
+    spec = default_motor(family, SIZE)
+    channel = MotorModel.from_spec(spec, 'oil').family.channel
+    return spec, MotorModel.from_spec(_with_factor(spec, 'oil', channel, factor), 'oil')
+
+
+@pytest.mark.parametrize('family', FAMILY_NAMES)
+def test_a_plausible_channel_drop_is_fitted_for_every_family(family):
+    spec, truth = _truth(family, 0.5)
+    base = fit_base(spec, 'oil', _points(truth, 0.02))
+    assert base.fitted and not any(k['coefficient'] in truth.family.channel for k in base.kept)
+    for row in base.fitted:
+        true = getattr(truth.coef, row['coefficient'])
+        assert row['ci95'][0] <= true <= row['ci95'][1]
+        assert row['value'] == pytest.approx(true, rel=0.15)
+        assert row['packaged'] == getattr(MotorModel.from_spec(spec, 'oil').coef,
+                                          row['coefficient'])
+    assert base.channel_drop['used_mpa'] == pytest.approx(
+        truth.equations.channel_drop(base.channel_drop['flow_lpm'] * LPM) / MPA, rel=0.15)
+    fitted = MotorModel.from_spec(base.spec, 'oil')
+    assert all(getattr(fitted.coef, r['coefficient']) == r['value'] for r in base.fitted)
+
+
+def test_a_drop_the_data_cannot_see_is_kept_and_named():
+    spec, truth = _truth('paszota', 1.0)
+    base = fit_base(spec, 'oil', _points(truth, 0.5, count=40))
+    assert not base.fitted and not base.changed and base.spec is spec
+    kept = {k['coefficient']: k for k in base.kept}
+    assert {'c_t', 'c_l', 'a_pv', 'a_nv'} <= set(kept)
+    assert 'do not pin it' in kept['c_t']['why'] or 'spans' in kept['c_t']['why']
+    assert kept['c_t']['value'] == MotorModel.from_spec(spec, 'oil').coef.c_t
+
+
+def test_the_motor_s_own_coefficients_are_kept_not_refitted():
+    packaged = load_motor()
+    truth = MotorModel.from_spec(_with_factor(packaged, 'oil', ('c_t', 'c_l'), 0.3), 'oil')
+    base = fit_base(packaged, 'oil', _points(truth, 0.02))
+    assert not base.changed and base.spec is packaged
+    assert "motor's own" in base.note
+
+
+def test_the_guess_refuted_by_the_port_drop_is_not_kept_beyond_physics():
+    spec, truth = _truth('sliwinski2017', 0.02)
+    base = fit_base(spec, 'oil', _points(truth, 0.02))
+    assert base.channel_drop['packaged_mpa'] > 5.0  # the similarity guess
+    assert base.channel_drop['used_mpa'] < 1.0  # what the data support
+    assert base.fitted[0]['bounds'][1] < MotorModel.from_spec(spec, 'oil').coef.c_t
+
+
+def test_the_calibration_writes_what_the_base_fitted_and_the_yaml_loads_it(tmp_path):
+    spec, truth = _truth('sliwinski2017', 0.3)
+    cal = calibrate(_points(truth, 0.02, count=120), 'oil', spec=spec)
+    write_json(cal, tmp_path / 'calibration.json')
+    base = json.loads((tmp_path / 'calibration.json').read_text())['family_comparison']['base']
+    fitted = {f['coefficient']: f['value'] for f in base['fitted']}
+    assert 'beta' in {k['coefficient'] for k in base['kept']}  # Table 1's exponents: kept
+    assert set(fitted) == {'c_t', 'c_l'}
+    write_yaml(cal, tmp_path / 'coefficients.yaml')
+    loaded = MotorModel.from_spec(load_motor(tmp_path / 'coefficients.yaml'), 'oil')
+    assert loaded.coef.c_t == pytest.approx(fitted['c_t'], rel=1e-12)
+    assert loaded.coef.c_t < 0.6 * MotorModel.from_spec(spec, 'oil').coef.c_t
