@@ -15,12 +15,11 @@ never expanded into an error message. The caps live in :mod:`satmotor_ros.limits
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
-import stat
 from typing import Any
 
-from satmotor_ros.limits import YAML_MAX_BYTES, YAML_MAX_DEPTH, YAML_MAX_DIGITS, YAML_MAX_NODES
+from satmotor_ros.limits import (LimitError, read_capped, YAML_MAX_BYTES, YAML_MAX_DEPTH,
+                                 YAML_MAX_DIGITS, YAML_MAX_NODES)
 import yaml
 
 
@@ -180,13 +179,10 @@ def read_yaml(path: str | Path) -> Any:
         a cap; one line, without the document.
 
     """
-    # O_NONBLOCK: opening a FIFO does not wait for a writer, so fstat can refuse it
-    with open(os.open(path, os.O_RDONLY | os.O_NONBLOCK), 'rb') as file:
-        if not stat.S_ISREG(os.fstat(file.fileno()).st_mode):
-            raise YamlLimitError('not a regular file (a FIFO, device or directory)')
-        data = file.read(YAML_MAX_BYTES + 1)
-    if len(data) > YAML_MAX_BYTES:
-        raise _too_large()
+    try:
+        data = read_capped(path, YAML_MAX_BYTES, 'SATMOTOR_YAML_MAX_BYTES')
+    except LimitError as err:
+        raise YamlLimitError(str(err)) from None
     try:
         text = data.decode('utf-8')
     except UnicodeDecodeError as err:

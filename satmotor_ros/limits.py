@@ -15,7 +15,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 import difflib
 import os
+from pathlib import Path
 import re
+import stat
 
 CAP_MAX = (1 << 63) - 1
 """Largest value a cap may be given (the 64-bit sizes and counts it is compared with), [-]."""
@@ -84,6 +86,17 @@ RATE_MAX_PREDICTIONS = _cap('SATMOTOR_RATE_MAX_PREDICTIONS', 4_000_000)
 CSV_MAX_COLUMNS = _cap('SATMOTOR_CSV_MAX_COLUMNS', 256)
 """Most columns of a CSV or text log read; calibration's work grows with each, [-]."""
 
+TEXT_MAX_BYTES = _cap('SATMOTOR_TEXT_MAX_BYTES', 128 << 20)
+"""Largest text log (CSV, ``.exp``) read as DATA: about a million rows of 18 columns, [byte]."""
+
+TEXT_MAX_ROWS = _cap('SATMOTOR_TEXT_MAX_ROWS', 500_000)
+"""Most data rows of a text log (a points table of 500 000 rows calibrates in about 100 s and
+1 GB; 2.8 h of a 50 Hz log), [-]."""
+
+TEXT_MAX_CHANNELS = _cap('SATMOTOR_TEXT_MAX_CHANNELS', 256)
+"""Most channels a column mapping may name (each is a set of candidate effects, as a
+column is), [-]."""
+
 CURVE_MAX_POINTS = _cap('SATMOTOR_CURVE_MAX_POINTS', 100_000)
 """Most points per curve of ``satmotor characteristics --points`` (about 40 MB), [-]."""
 
@@ -109,6 +122,47 @@ CLI refuses to run with one (one line), a node logs each as an ERROR and runs on
 defaults."""
 
 
+class LimitError(ValueError):
+    """A file is not a regular file or is larger than its cap; the message is one line."""
+
+
+def read_capped(path: str | Path, most: int, variable: str) -> bytes:
+    """
+    Read a regular file of at most `most` bytes, reading no more than that.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The file, [-]
+    most : int
+        Largest size read, [byte]
+    variable : str
+        The cap's variable, named when it is hit, [-]
+
+    Returns
+    -------
+    bytes
+        The file's content.
+
+    Raises
+    ------
+    OSError
+        If the file cannot be opened or read (a symbolic link loop among them).
+    LimitError
+        If it is not a regular file (a FIFO would block, ``/dev/zero`` never end) or is
+        larger than `most`.
+
+    """
+    # O_NONBLOCK: opening a FIFO does not wait for a writer, so fstat can refuse it
+    with open(os.open(path, os.O_RDONLY | os.O_NONBLOCK), 'rb') as file:
+        if not stat.S_ISREG(os.fstat(file.fileno()).st_mode):
+            raise LimitError('not a regular file (a FIFO, device or directory)')
+        data = file.read(most + 1)
+    if len(data) > most:
+        raise LimitError(f'larger than {most} bytes (the cap {variable})')
+    return data
+
+
 def bag_budget(stored_bytes: int) -> int:
     """
     Return how many bytes a bag of `stored_bytes` may decompress to.
@@ -128,6 +182,7 @@ def bag_budget(stored_bytes: int) -> int:
 
 
 __all__ = ['BAD_OVERRIDES', 'BadOverride', 'BAG_FLOOR_BYTES', 'BAG_MAX_BYTES', 'BAG_MAX_RATIO',
-           'CAP_MAX', 'CSV_MAX_COLUMNS', 'CURVE_MAX_POINTS',
-           'PLOT_MAX_PANELS', 'RATE_MAX_PREDICTIONS', 'YAML_MAX_BYTES',
-           'YAML_MAX_DEPTH', 'YAML_MAX_DIGITS', 'YAML_MAX_NODES', 'bag_budget']
+           'CAP_MAX', 'CSV_MAX_COLUMNS', 'CURVE_MAX_POINTS', 'LimitError',
+           'PLOT_MAX_PANELS', 'RATE_MAX_PREDICTIONS', 'TEXT_MAX_BYTES', 'TEXT_MAX_CHANNELS',
+           'TEXT_MAX_ROWS', 'YAML_MAX_BYTES', 'YAML_MAX_DEPTH', 'YAML_MAX_DIGITS',
+           'YAML_MAX_NODES', 'bag_budget', 'read_capped']

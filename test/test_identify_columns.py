@@ -90,12 +90,13 @@ def test_a_comma_log_with_absolute_pressures_and_a_signed_speed(tmp_path):
 
 
 def test_an_optional_channel_the_log_lacks_is_skipped_with_a_note(tmp_path):
-    log = _log(tmp_path, HEAD + '1 2 3 4\n')
+    log = _log(tmp_path, HEAD.replace('\n', ',Aux\n') + '1 2 3 4 5\n')
     doc = {'columns': GOOD, 'channels': {'force': {'column': 'Force', 'optional': True},
-                                         'up': {'column': 'Up', 'optional': True}}}
+                                         'aux': {'column': 'Aux', 'optional': True}}}
     table = read_log(log, mapping_from_dict(doc))
-    assert set(table.channels) == {'up'}
-    assert "force: no column 'Force', skipped (optional)" in table.notes[0]
+    assert set(table.channels) == {'aux'}
+    assert ('sanity check: channels.force (optional) is absent, its effects are not tested: '
+            "no column 'Force' in the log") in table.notes[1]
     with pytest.raises(DataError, match="channels.force: no column 'Force'"):
         read_log(log, mapping_from_dict({'columns': GOOD, 'channels': {'force': 'Force'}}))
 

@@ -11,7 +11,8 @@ import sys
 from satmotor_ros.cli._common import CliError, fail
 from satmotor_ros.identify import BenchTable, DataError, IdentificationError, read_csv
 from satmotor_ros.identify.columns import load_mapping, read_log
-from satmotor_ros.identify.table import BAD_CELLS, IMPOSSIBLE
+from satmotor_ros.identify.table import BAD_CELLS, IMPOSSIBLE, negative_losses
+from satmotor_ros.identify.textfile import SANITY
 from satmotor_ros.model import ModelError
 
 
@@ -46,7 +47,7 @@ def add_data_arguments(parser: argparse.ArgumentParser,
                              '(doc/columns.md)')
 
 
-def load_data(data: str, columns: str = '') -> BenchTable:
+def load_data(data: str, columns: str = '', displacement: float | None = None) -> BenchTable:
     """
     Load a bench CSV, a log through a column mapping, or a rosbag2 directory.
 
@@ -59,6 +60,8 @@ def load_data(data: str, columns: str = '') -> BenchTable:
         Path as typed, [-]
     columns : str
         ``--columns``: a mapping file or packaged name; '' for a bench CSV or a bag, [-]
+    displacement : float, optional
+        The motor's displacement, to name one that makes most losses negative, [m^3/rad]
 
     Returns
     -------
@@ -72,18 +75,29 @@ def load_data(data: str, columns: str = '') -> BenchTable:
 
     """
     path = Path(data)
-    if not path.exists():
+    try:
+        path.stat()
+    except FileNotFoundError:
         msg = f'DATA {data!r}: no such file or directory'
-        raise DataError(msg)
+        raise DataError(msg) from None
+    except OSError as err:  # a loop of symbolic links, a directory we may not enter
+        msg = f'DATA {data!r}: {err.strerror}'
+        raise DataError(msg) from None
     if path.is_dir():
         if columns:
             msg = f'--columns {columns!r}: a column mapping reads text logs, not a rosbag2'
             raise DataError(msg)
         from satmotor_ros.identify.bag import read_bag
-        return read_bag(path)
-    table = read_log(path, load_mapping(columns)) if columns else read_csv(path)
-    for note in table.notes:
-        if note.startswith((IMPOSSIBLE, BAD_CELLS)):
+        table = read_bag(path)
+        said: tuple[str, ...] = ()  # a bag's notes are in its report only
+    else:
+        table = read_log(path, load_mapping(columns)) if columns else read_csv(path)
+        said = table.notes
+    if displacement is not None:
+        checked = negative_losses(table, displacement)
+        said, table = said + checked.notes[len(table.notes):], checked
+    for note in said:
+        if note.startswith((IMPOSSIBLE, BAD_CELLS, SANITY)):
             print(f'warning: {data}: {note}', file=sys.stderr)
     return table
 

@@ -65,9 +65,11 @@ def check_target(option: str, target: Path, inputs: Sequence[str | Path], force:
         One line naming the option, the path and what to do.
 
     """
-    resolved = target.resolve()
+    resolved = resolve(option, target)
     for item in inputs:
-        source = Path(item).resolve()
+        source = _resolve_or_none(Path(item))
+        if source is None:
+            continue  # a loop: reading it is one line naming its option
         if resolved == source or source.is_relative_to(resolved) \
                 or resolved.is_relative_to(source):
             raise CliError(f'{option} {str(target)!r}: is or contains the input {str(item)!r}; '
@@ -77,6 +79,42 @@ def check_target(option: str, target: Path, inputs: Sequence[str | Path], force:
         raise CliError(f'{option} {str(target)!r} exists and is not an earlier output of '
                        f'satmotor {command}; choose a new path or pass --force to replace it')
     _probe(option, target)
+
+
+def resolve(option: str, path: Path) -> Path:
+    """
+    Return `path` made absolute with its symbolic links followed; a loop is one line.
+
+    Parameters
+    ----------
+    option : str
+        The option that named it, for the message, [-]
+    path : pathlib.Path
+        The path as typed, [-]
+
+    Returns
+    -------
+    pathlib.Path
+        The resolved path (the part that does not exist kept as given).
+
+    Raises
+    ------
+    CliError
+        If its symbolic links form a loop (or cannot be read).
+
+    """
+    resolved = _resolve_or_none(path)
+    if resolved is None:
+        raise CliError(f'{option} {str(path)!r}: its symbolic links form a loop (or cannot be '
+                       'followed); choose another path')
+    return resolved
+
+
+def _resolve_or_none(path: Path) -> Path | None:
+    try:
+        return path.resolve()
+    except (RuntimeError, OSError):  # RuntimeError('Symlink loop ...') before Python 3.13
+        return None
 
 
 def _probe(option: str, target: Path) -> None:
@@ -310,4 +348,4 @@ def png_metadata(command: str) -> dict[str, str]:
 
 
 __all__ = ['MARKER', 'check_target', 'output_dir', 'output_file', 'png_by', 'png_metadata',
-           'written_by']
+           'resolve', 'written_by']

@@ -71,7 +71,7 @@ def _calibrate(data: str, out: str, mode: Mode, alpha: float, folds: int,
     inputs = [name for name in (data, options.motor_file, columns) if name]
     check_target('--out', Path(out), inputs, force, written_by('calibrate'), 'calibrate')
     spec = options.spec()
-    table = load_data(data, columns)
+    table = load_data(data, columns, spec.geometry.displacement)
     cal = calibrate(table, options.liquid, spec, Options(alpha=alpha, n_folds=folds, mode=mode,
                                                          compare_families=not options.family))
     warnings = cal.warnings().get('warnings', [])

@@ -24,7 +24,7 @@ from satmotor_ros.bags import (BagError, describe_topics, encode_many, FLOAT64, 
 from satmotor_ros.cli import _fastcsv as fastcsv
 from satmotor_ros.cli._common import add_motor_options, CliError, fail
 from satmotor_ros.cli._output import (check_target, MARKER, output_file, png_by, png_metadata,
-                                      written_by)
+                                      resolve, written_by)
 from satmotor_ros.interface import (CHANNELS, JOINT_NAME, LOSS_COMPONENTS, LOSSES_PREFIX,
                                     MotorOptions, PREDICTED_JOINT_STATE, SPEED_RESIDUAL)
 from satmotor_ros.model import describe_status, ModelError, MotorModel
@@ -182,7 +182,7 @@ def command(bag: str, out: str | None, out_bag: str | None, plot: str | None, no
 
 def _refuse_clashes(targets: dict[str, Path]) -> None:
     """Refuse two outputs on one path, or one inside another (an output directory)."""
-    resolved = {option: path.resolve() for option, path in targets.items()}
+    resolved = {option: resolve(option, path) for option, path in targets.items()}
     for first, (option, path) in enumerate(resolved.items()):
         for other, there in list(resolved.items())[first + 1:]:
             if path == there or path.is_relative_to(there) or there.is_relative_to(path):
@@ -423,7 +423,7 @@ def _plot_path(bag: str, out: str | None, plot: str | None, no_plot: bool) -> Pa
         return Path(plot)
     if out is not None:
         return Path(out).with_name(Path(out).stem + '_speed.png')
-    return Path(f'{Path(bag).resolve().name}_speed.png')
+    return Path(f'{resolve("BAG", Path(bag)).name}_speed.png')
 
 
 def plot_speed(path: Path, batch: PredictionBatch, label: str, max_points: int = 20000) -> None:

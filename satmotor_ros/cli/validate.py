@@ -57,7 +57,8 @@ def _validate(data: str, out: str, mode: Mode, options: MotorOptions, columns: s
     inputs = [name for name in (data, options.motor_file, columns) if name]
     check_target('--out', Path(out), inputs, force, written_by('validate'), 'validate')
     model = options.build_model()
-    result = validate(load_data(data, columns), model, options.liquid, mode)
+    table = load_data(data, columns, model.geometry.displacement)
+    result = validate(table, model, options.liquid, mode)
     with output_dir('--out', out, 'validate', inputs, force) as tmp:
         summary = write_validation(result, tmp)
     target = Path(out)

@@ -20,7 +20,9 @@ from satmotor_ros.bounded_yaml import read_yaml, shown, YamlLimitError
 from satmotor_ros.identify.errors import DataError
 from satmotor_ros.identify.table import (BenchTable, column_to_si, KNOWN_KINDS,
                                          table_from_columns)
-from satmotor_ros.identify.textfile import HEADERS, read_cells, SEPARATORS, split_unit
+from satmotor_ros.identify.textfile import (HEADERS, read_cells, SANITY, SEPARATORS,
+                                            split_unit)
+from satmotor_ros.limits import CSV_MAX_COLUMNS
 from satmotor_ros.model.config import default_config_path
 from satmotor_ros.model.errors import ConfigError, UnitError
 from satmotor_ros.model.units import (ATMOSPHERE, parse_quantity, pressure_reference,
@@ -173,8 +175,13 @@ def mapping_from_dict(doc: Any, where: str = '<mapping>') -> ColumnMapping:
     optional = [name for name, source in fields.items() if source.optional]
     if optional:
         raise _fail(f'{where}: columns.{optional[0]}.optional', 'only channels are optional')
+    named = _section(doc, 'channels', where)
+    if len(named) > CSV_MAX_COLUMNS:
+        raise _fail(f'{where}: channels', f'{len(named)} channels, more than the '
+                    f'{CSV_MAX_COLUMNS} columns a log may have (the cap SATMOTOR_CSV_MAX_COLUMNS; '
+                    'doc/outputs.md)')
     channels = {str(name): _source(value, f'{where}: channels.{name}', str(name))
-                for name, value in _section(doc, 'channels', where).items()}
+                for name, value in named.items()}
     clash = [name for name in channels if name in FIELDS]
     if clash:
         raise _fail(f'{where}: channels.{clash[0]}', 'is a bench field: put it under columns:')
@@ -207,7 +214,8 @@ def load_mapping(name: str | Path) -> ColumnMapping:
 
     """
     path = Path(name)
-    if not path.is_file() and '/' not in str(name) and not str(name).endswith('.yaml'):
+    if not (path.exists() or path.is_symlink()) and '/' not in str(name) \
+            and not str(name).endswith('.yaml'):
         try:
             path = default_config_path(f'{name}{SUFFIX}')
         except ConfigError:
@@ -224,11 +232,12 @@ def load_mapping(name: str | Path) -> ColumnMapping:
     return mapping_from_dict(doc, str(path))
 
 
-def _locate(source: Source, header: tuple[str, ...] | None, where: str) -> tuple[int, str]:
+def _locate(source: Source, header: tuple[str, ...] | None, width: int,
+            where: str) -> tuple[int, str]:
     """Return the column index and the unit the header gives it."""
     if isinstance(source.column, int):
-        if header is not None and source.column > len(header):
-            raise _fail(where, f'column {source.column}: the log has {len(header)} columns')
+        if source.column > width:
+            raise _fail(where, f'column {source.column}: the log has {width} columns')
         index = source.column - 1
         return index, split_unit(header[index])[1] if header else ''
     if header is None:
@@ -306,20 +315,25 @@ def read_log(path: str | Path, mapping: ColumnMapping) -> BenchTable:
     text = read_cells(path, mapping.separator, mapping.comment, mapping.header)
     columns: dict[str, tuple[str, np.ndarray]] = {}
     labels: dict[str, str] = {}
-    used: set[int] = set()
-    described = []
+    used: dict[int, str] = {}
+    described: list[str] = []
+    skipped: list[str] = []
     for section, sources in (('columns', mapping.fields), ('channels', mapping.channels)):
         for name, source in sources.items():
             where = f'{mapping.source}: {section}.{name}'
             try:
-                index, header_unit = _locate(source, text.header, where)
-            except DataError:
+                index, header_unit = _locate(source, text.header, text.data.shape[1], where)
+            except DataError as err:
                 if not source.optional:
                     raise
-                described.append(f'{name}: no column {source.column!r}, skipped (optional)')
+                skipped.append(f'{SANITY}: {section}.{name} (optional) is absent, its effects '
+                               f'are not tested: {str(err).removeprefix(where + ": ")}')
                 continue
-            unit = source.unit or header_unit
             label = split_unit(text.header[index])[0] if text.header else f'column {index + 1}'
+            if index in used:
+                raise _fail(where, f'column {label!r} is already {used[index]}: one column is '
+                                   'one quantity')
+            unit = _unit(source, name, header_unit, label, where)
             values = text.data[:, index]
             kind = _kind(name)
             if kind is not None:
@@ -327,7 +341,7 @@ def read_log(path: str | Path, mapping: ColumnMapping) -> BenchTable:
             else:
                 columns[name] = (unit, values * source.sign)
             labels[name] = f'{name} ({label})'
-            used.add(index)
+            used[index] = f'{section}.{name}'
             described.append(_describe(name, source, label, unit))
     if mapping.keep_others and text.header:
         for index, cell in enumerate(text.header):
@@ -336,7 +350,54 @@ def read_log(path: str | Path, mapping: ColumnMapping) -> BenchTable:
                 columns[name] = (unit, text.data[:, index])
     note = f'columns mapped by {mapping.source}: {"; ".join(described)}'
     table = table_from_columns(columns, str(path), labels=labels)
-    return replace(table, notes=(note, *table.notes))
+    return replace(table, notes=(note, *skipped, *text.notes, *table.notes))
+
+
+def _unit(source: Source, name: str, header_unit: str, label: str, where: str) -> str:
+    """
+    Return the unit a mapped column is read in: the mapping's, else the header's.
+
+    A mapping's unit of the field's kind that the header contradicts (another scale, or gauge
+    against absolute), or a ``reference:`` the header's unit contradicts, is refused: one of
+    the two is wrong and the data cannot say which.
+    """
+    kind = _kind(name)
+    if kind is None or source.area:
+        return source.unit or header_unit
+    header_is_kind = bool(header_unit) and _is_unit(header_unit, name)
+    header_is_kind = header_is_kind and bool(source.unit) and _is_unit(source.unit, name)
+    if header_is_kind and not _same_unit(source.unit, header_unit, name, kind):
+        raise _fail(f'{where}.unit', f"{source.unit!r} contradicts the unit of the log's "
+                    f'column {label!r} ({header_unit}); give the unit the data are in')
+    unit = source.unit or header_unit
+    if header_is_kind and kind == 'pressure' \
+            and pressure_reference(source.unit) is None:
+        unit = header_unit  # psi over psia: the header says more (gauge or absolute)
+    implied = pressure_reference(unit) if kind == 'pressure' and unit else None
+    if source.reference and implied and implied != source.reference:
+        raise _fail(f'{where}.reference', f'{source.reference} contradicts the unit '
+                    f"{unit!r} of the log's column {label!r}")
+    return unit
+
+
+def _is_unit(unit: str, name: str) -> bool:
+    try:
+        column_to_si(name, unit, np.zeros(1))
+    except DataError:
+        return False
+    return True
+
+
+def _same_unit(a: str, b: str, name: str, kind: str) -> bool:
+    """Whether two spellings give the same SI values and do not disagree on gauge/absolute."""
+    probe = np.array([0.0, 1.0])
+    if kind == 'pressure' and None not in (pressure_reference(a), pressure_reference(b)):
+        return pressure_reference(a) == pressure_reference(b) \
+            and np.allclose(column_to_si(name, a, probe), column_to_si(name, b, probe))
+    scale = [column_to_si(name, u, probe) for u in (a, b)]
+    if kind == 'pressure':  # psi and psig, bar and barg: the same scale, one says gauge
+        scale = [x - x[0] for x in scale]
+    return bool(np.allclose(scale[0], scale[1], rtol=1e-9, atol=0.0))
 
 
 __all__ = ['ColumnMapping', 'FIELDS', 'Source', 'load_mapping', 'mapping_from_dict', 'read_log']

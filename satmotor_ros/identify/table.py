@@ -4,13 +4,13 @@
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
 
 from satmotor_ros.identify.errors import DataError
-from satmotor_ros.identify.textfile import read_cells, shorten, split_unit
+from satmotor_ros.identify.textfile import read_cells, SANITY, shorten, split_unit
 from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.errors import UnitError
 from satmotor_ros.model.units import (ATMOSPHERE, kinds, pressure_reference, RPM, to_si,
@@ -37,6 +37,18 @@ _FLOORS = {'pressure': (-ATMOSPHERE, 1.0e3, 'kPa', 'a gauge pressure below vacuu
 
 BAD_CELLS = 'bad cells'
 """How the notes on absurd or missing cells begin (rows dropped or cells ignored)."""
+
+_NEGATIVE_LOSS = 0.02
+"""Median loss, as a share of q n, below which most rows' negative losses are named: a
+sensor gain of a per cent is an effect calibrate finds, not a wrong setup, [-]."""
+
+_RESTART_SHARE = 0.01
+"""Most share of time steps that may go backwards for the time to be read as restarts (more:
+the rows are not in time order, and time is one more channel)."""
+
+_RESTART_GAP = 1000.0
+"""A restarted recording is moved to begin this many median time steps after the one before:
+far beyond any gap that cuts a steady window or a transient stretch."""
 
 _CEILINGS = {'pressure': 1.0e10, 'temperature': 1.0e4, 'speed': 1.0e5, 'flow': 10.0,
              'torque': 1.0e7}
@@ -329,6 +341,37 @@ def _bad_cells(si: dict[str, FloatArray], labels: Mapping[str, str],
     return drop, tuple(notes)
 
 
+def _restarts(time: FloatArray) -> tuple[FloatArray, tuple[str, ...]]:
+    """
+    Find where the time starts again (logs joined in one file) and keep the pieces apart.
+
+    Each later piece is shifted to begin :data:`_RESTART_GAP` median steps after the end of
+    the one before, so that the rows stay in file order when sorted by time and nothing that
+    reads a time series joins two recordings; the note says so.
+    """
+    finite = np.isfinite(time)
+    t = time[finite]
+    step = np.diff(t)
+    back = np.flatnonzero(step < 0.0)
+    if back.size == 0 or back.size > _RESTART_SHARE * step.size:
+        return time, ()
+    forward = step[step > 0.0]
+    gap = _RESTART_GAP * (float(np.median(forward)) if forward.size else 1.0)
+    shift = np.zeros(t.size)
+    for i in back:
+        shift[i + 1:] += gap - step[i]  # piece i+1 begins `gap` after piece i ends
+    shifted = time.copy()
+    shifted[finite] = t + shift
+    rows = np.flatnonzero(finite)[back + 1]
+    where = '; '.join(f'data row {r + 1}: {t[i]:.6g} s -> {t[i + 1]:.6g} s'
+                      for r, i in zip(rows[:5], back[:5]))
+    more = f' and {rows.size - 5} more' if rows.size > 5 else ''
+    return shifted, (f'{SANITY}: the time restarts {rows.size} time(s) ({where}{more}): '
+                     f'read as {rows.size + 1} separate recordings, each later one moved to '
+                     f'begin {gap:.6g} s after the one before, so that no steady window or '
+                     'transient stretch joins two (two logs in one file?)',)
+
+
 def table_from_columns(columns: Mapping[str, tuple[str, np.ndarray]], source: str,
                        time_series: bool = False,
                        labels: Mapping[str, str] | None = None) -> BenchTable:
@@ -370,6 +413,9 @@ def table_from_columns(columns: Mapping[str, tuple[str, np.ndarray]], source: st
     si = {PORTS.get(name, name): column_to_si(name, unit, np.asarray(values, dtype=float))
           for name, (unit, values) in columns.items()}
     labels = {PORTS.get(name, name): labels.get(name, name) for name in columns}
+    restarted: tuple[str, ...] = ()
+    if 'time' in si:
+        si['time'], restarted = _restarts(si['time'])
     dropped, cells = _bad_cells(si, labels, time_series)
     good = ~dropped
     for name in REQUIRED:
@@ -389,7 +435,7 @@ def table_from_columns(columns: Mapping[str, tuple[str, np.ndarray]], source: st
     extra = {name: values[good].copy() for name, values in si.items() if name not in REQUIRED}
     speed, flow, p_in, p_out = (si[name][good].copy() for name in REQUIRED)
     return BenchTable(speed, flow, p_in, p_out, extra, units, source, time_series,
-                      notes + flagged)
+                      restarted + notes + flagged)
 
 
 def read_csv(path: str | Path) -> BenchTable:
@@ -430,7 +476,47 @@ def read_csv(path: str | Path) -> BenchTable:
         raise DataError(msg)
     columns = parse_header(list(text.header))
     named = {name: (unit, text.data[:, i]) for i, (name, unit) in enumerate(columns)}
-    return table_from_columns(named, str(path))
+    table = table_from_columns(named, str(path))
+    return replace(table, notes=text.notes + table.notes)
+
+
+def negative_losses(table: BenchTable, displacement: float) -> BenchTable:
+    """
+    Name a displacement that makes most of the table's volumetric losses negative.
+
+    The loss is Q_vl = sign(dp) (Q - q n) (eq. 36 in four quadrants, doc/quadrants.md) and
+    is never negative; noise makes some rows so, a wrong displacement or a flow or speed in
+    another unit than said makes most of them so.
+
+    Parameters
+    ----------
+    table : BenchTable
+        The data as read, [-]
+    displacement : float
+        The motor's displacement q, [m^3/rad]
+
+    Returns
+    -------
+    BenchTable
+        `table`, with a note beginning :data:`SANITY` when more than half of the rows that
+        turn under a pressure drop have a negative loss and the median loss is below
+        -:data:`_NEGATIVE_LOSS` of q n.
+
+    """
+    with np.errstate(invalid='ignore', over='ignore', divide='ignore'):
+        ideal = np.abs(displacement * table.speed)
+        loss = np.sign(table.dp) * (table.flow - displacement * table.speed)
+        share = loss / ideal
+    rows = np.isfinite(share) & (table.speed != 0.0) & (table.dp != 0.0)
+    negative = int((loss[rows] < 0.0).sum())
+    if not rows.any() or 2 * negative <= int(rows.sum()) \
+            or np.median(share[rows]) >= -_NEGATIVE_LOSS:
+        return table
+    note = (f'{SANITY}: the displacement {displacement * 2e6 * np.pi:.4g} cm^3/rev makes the '
+            f'volumetric loss sign(dp) (Q - q n) negative in {negative} of {int(rows.sum())} '
+            f'rows (median {float(np.median(share[rows])):.1%} of q n): the displacement '
+            '(--displacement, the motor file), or the unit of the flow or the speed, is wrong')
+    return replace(table, notes=table.notes + (note,))
 
 
 def write_csv(path: str | Path, columns: Mapping[str, tuple[str, np.ndarray]]) -> None:

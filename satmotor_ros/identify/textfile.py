@@ -17,10 +17,16 @@ import re
 import numpy as np
 
 from satmotor_ros.identify.errors import DataError
-from satmotor_ros.limits import CSV_MAX_COLUMNS
+from satmotor_ros.limits import (CSV_MAX_COLUMNS, LimitError, read_capped, TEXT_MAX_BYTES,
+                                 TEXT_MAX_ROWS)
 
 SEPARATORS = {'comma': ',', 'semicolon': ';', 'tab': '\t', 'whitespace': None}
 """Separator names a mapping may give (``auto`` too); ``None`` is any run of blanks."""
+
+SANITY = 'sanity check'
+"""How the notes on a suspicious setup begin (time that restarts, lines a comment rule left
+out, an optional channel absent, a displacement that makes most losses negative); each is said
+on stderr and in the report."""
 
 HEADERS = ('auto', 'first', 'comment', 'none')
 """Where the header is: decided from the file, the first non-comment line, the last comment
@@ -77,6 +83,7 @@ class TextTable:
     header: tuple[str, ...] | None  # header cells, None when the file has no header
     data: np.ndarray  # rows x columns, float; empty cells and 'nan' are NaN
     lines: np.ndarray  # 1-based line number in the file of each data row
+    notes: tuple[str, ...] = ()  # what the reading left out, e.g. comment lines among the data
 
 
 def _split(line: str, sep: str | None) -> list[str]:
@@ -114,9 +121,12 @@ def _header_cells(text: str, sep: str | None, width: int) -> list[str] | None:
 
 def _read_text(file: Path) -> str:
     try:
-        return file.read_text(encoding='utf-8-sig')
+        return read_capped(file, TEXT_MAX_BYTES, 'SATMOTOR_TEXT_MAX_BYTES').decode('utf-8-sig')
     except OSError as err:
         msg = f'cannot read {str(file)!r}: {err.strerror}'
+        raise DataError(msg) from None
+    except LimitError as err:
+        msg = f'{str(file)!r}: {err}; doc/outputs.md'
         raise DataError(msg) from None
     except UnicodeDecodeError:
         msg = f'{str(file)!r} is not a UTF-8 text file'
@@ -183,6 +193,7 @@ def read_cells(path: str | Path, separator: str = 'auto', comment: str = '#',
     file = Path(path)
     content: list[tuple[int, str]] = []
     last_comment = None
+    skipped: list[int] = []  # comment lines after the first data line
     for number, line in enumerate(_read_text(file).splitlines(), start=1):
         stripped = line.strip()
         if not stripped:
@@ -190,8 +201,14 @@ def read_cells(path: str | Path, separator: str = 'auto', comment: str = '#',
         if comment and stripped.startswith(comment):
             if not content:
                 last_comment = stripped[len(comment):].strip()
+            else:
+                skipped.append(number)
             continue
         content.append((number, line))
+        if len(content) > TEXT_MAX_ROWS + 1:  # the header and the rows the cap allows
+            msg = (f'{str(file)!r}: more than {TEXT_MAX_ROWS} data rows (the cap '
+                   'SATMOTOR_TEXT_MAX_ROWS; doc/outputs.md)')
+            raise DataError(msg)
     if not content:
         msg = f'{str(file)!r} is empty: expected a header row and data rows'
         raise DataError(msg)
@@ -234,4 +251,15 @@ def read_cells(path: str | Path, separator: str = 'auto', comment: str = '#',
     if data.shape[1] != len(names):
         msg = f'{str(file)!r}: rows have {data.shape[1]} cells, the header has {len(names)}'
         raise DataError(msg)
-    return TextTable(tuple(cells) if cells is not None else None, data, np.asarray(lines))
+    return TextTable(tuple(cells) if cells is not None else None, data, np.asarray(lines),
+                     _comment_note(skipped, comment, data.shape[0]))
+
+
+def _comment_note(skipped: list[int], comment: str, rows: int) -> tuple[str, ...]:
+    """Say how many lines among the data the comment rule left out, and which."""
+    if not skipped:
+        return ()
+    shown = ', '.join(map(str, skipped[:5])) + (f' and {len(skipped) - 5} more'
+                                                if len(skipped) > 5 else '')
+    return (f'{SANITY}: the comment rule {comment!r} left out {len(skipped)} lines among the '
+            f'{rows} data rows read (lines {shown}); if they are data, change file.comment',)
