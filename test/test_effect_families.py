@@ -107,3 +107,17 @@ def test_the_plant_opens_a_one_sided_valve_in_its_direction_only():
             speeds[name, command > 0] = plant.state.speed
     assert speeds['valve', True] == pytest.approx(speeds['none', True], rel=1e-9)
     assert abs(speeds['valve', False]) < 0.98 * abs(speeds['none', False])
+
+
+def test_the_plant_s_outlet_leakage_follows_the_flow_in_reverse():
+    k = 1.0e-12
+    leak = params_from_flat({'effects.external_leakage': k,
+                             'effects.leakage_driver': 'outlet'}).effects
+    for command, load in ((20 * LPM, 60.0), (-20 * LPM, -60.0)):
+        plant = Plant(MotorModel.default('water'), PlantParams(effects=leak),
+                      load=ConstantLoad(load))
+        plant.run(1500, command)
+        state, tank = plant.state, plant.params.lines.tank_pressure
+        outflow = state.outlet_pressure if command > 0 else state.inlet_pressure
+        assert plant.flows.leakage == pytest.approx(k * (outflow - tank), rel=1e-9)
+        assert abs(state.inlet_pressure - state.outlet_pressure) > 5 * MPA
