@@ -272,7 +272,9 @@ def test_lockstep_takes_one_period_per_flow_command(ros):
     assert '1 lockstep period(s) taken with no flow_command within lockstep_wait' in warned
     answered_time = [d for d in diagnostics if d.header.stamp.nanosec <= 520_000_000]
     assert answered_time and all(st.level == DiagnosticStatus.OK for d in answered_time
-                                 for st in d.status)
+                                 for st in d.status), [(d.header.stamp.nanosec, st.message)
+                                                       for d in answered_time for st in d.status
+                                                       if st.level != DiagnosticStatus.OK]
     assert node.set_parameters([Parameter('paused', value=True)])[0].successful
     _spin_until(executor, lambda: False, timeout=0.7)
     assert len(clock) == 55 and node.plant.state.time == pytest.approx(0.54, abs=1e-12)

@@ -19,8 +19,10 @@ from contextlib import contextmanager
 import json
 import os
 from pathlib import Path
+import re
 import shutil
 import signal
+import sys
 import threading
 
 from satmotor_ros.cli._common import CliError
@@ -37,6 +39,66 @@ _HELD = {signal.SIGINT, signal.SIGTERM}
 
 def _temporary(target: Path) -> Path:
     return target.with_name(f'.{target.name}.partial-{os.getpid()}')
+
+
+_PARTIAL = re.compile(r'\.(?P<name>.+)\.partial-(?P<pid>[0-9]{1,10})')
+_ASIDE = re.compile(r'\.(?P<name>.+)\.old-(?P<pid>[0-9]{1,10})-[0-9a-f]{8}')
+
+
+def _gone(pid: int) -> bool:
+    """Whether no process has the id `pid` (one of another user's is there)."""
+    if pid == os.getpid():
+        return False
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return True
+    except OSError:  # EPERM: alive; anything else: do not guess
+        return False
+    return False
+
+
+def clean_stale(directory: Path) -> list[Path]:
+    """
+    Tidy what runs killed outright (kill -9, a power cut) left in `directory`.
+
+    Only names this module makes are touched, and only when the process named in them is
+    gone: a temporary output ``.NAME.partial-PID`` is removed; an output renamed aside at
+    commit, ``.NAME.old-PID-HEX``, is put back if NAME is free again (it may be the user's),
+    and left where it is otherwise.
+
+    Parameters
+    ----------
+    directory : pathlib.Path
+        Where an output is about to be written, [-]
+
+    Returns
+    -------
+    list of pathlib.Path
+        What was put back under its own name.
+
+    """
+    restored: list[Path] = []
+    try:
+        entries = list(directory.iterdir()) if directory.is_dir() else []
+    except OSError:
+        return restored
+    for entry in entries:
+        partial, aside = _PARTIAL.fullmatch(entry.name), _ASIDE.fullmatch(entry.name)
+        found = partial or aside
+        if found is None or not _gone(int(found['pid'])):
+            continue
+        if partial is not None:
+            _remove(entry)
+            continue
+        home = entry.with_name(found['name'])
+        if not (home.exists() or home.is_symlink()):
+            try:
+                os.rename(entry, home)
+            except OSError:
+                continue
+            restored.append(home)
+    return restored
 
 
 def check_target(option: str, target: Path, inputs: Sequence[str | Path], force: bool,
@@ -222,6 +284,13 @@ def _remove(old: Path) -> None:
         old.unlink(missing_ok=True)
 
 
+def _tidy(target: Path) -> None:
+    """Clean what killed runs left beside `target`; say what was put back (one line each)."""
+    for home in clean_stale(target.parent):
+        print(f'satmotor: note: {str(home)!r} was left renamed aside by a run that was killed; '
+              'put back', file=sys.stderr)
+
+
 def _block_interrupts() -> bool:
     """Hold SIGINT and SIGTERM while an output is being swapped (delivered right after)."""
     if threading.current_thread() is not threading.main_thread():
@@ -266,6 +335,7 @@ def output_dir(option: str, out: str | Path, command: str, inputs: Sequence[str 
 
     """
     target = Path(out)
+    _tidy(target)
     check_target(option, target, inputs, force, written_by(command), command)
     target.parent.mkdir(parents=True, exist_ok=True)
     temporary = _temporary(target)
@@ -314,6 +384,7 @@ def output_file(option: str, out: str | Path, command: str, ours: Callable[[Path
 
     """
     target = Path(out)
+    _tidy(target)
     check_target(option, target, inputs, force, ours, command)
     target.parent.mkdir(parents=True, exist_ok=True)
     temporary = _temporary(target)
@@ -347,5 +418,5 @@ def png_metadata(command: str) -> dict[str, str]:
     return {'Software': f'satmotor {command}'}
 
 
-__all__ = ['MARKER', 'check_target', 'output_dir', 'output_file', 'png_by', 'png_metadata',
-           'resolve', 'written_by']
+__all__ = ['MARKER', 'check_target', 'clean_stale', 'output_dir', 'output_file', 'png_by',
+           'png_metadata', 'resolve', 'written_by']

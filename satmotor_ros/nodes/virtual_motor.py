@@ -192,7 +192,11 @@ class VirtualMotorNode(Node):
         self._pressure = {name: FluidPressure() for name in PRESSURE_TOPICS}
         self._flow, self._joint, self._temperature = Float64(), JointState(), Temperature()
         self._clock_msg = ClockMsg()
-        self.create_subscription(Float64, CHANNELS['flow'].topic, self._on_command, 10)
+        self._command_sub = self.create_subscription(Float64, CHANNELS['flow'].topic,
+                                                     self._on_command, 10)
+        self._diagnosed_at = time.monotonic()  # wall time of the last /diagnostics
+        self._report_now = False  # lockstep unanswered for long: report with the next period
+        self._controllers_warned = False
         self.create_subscription(Float64, CHANNELS['torque'].topic, self._on_load, 10)
         self._steady = Clock(clock_type=ClockType.STEADY_TIME)
         self._driver: Timer | GuardCondition | None = None
@@ -323,11 +327,15 @@ class VirtualMotorNode(Node):
 
     def _step_unanswered(self) -> None:
         """Lockstep and no command within ``lockstep_wait``: take the step anyway."""
-        if self._awaiting and time.monotonic() - self._published_at >= \
-                self._setup.values['lockstep_wait']:
+        now = time.monotonic()
+        if self._awaiting and now - self._published_at >= self._setup.values['lockstep_wait']:
             self.unanswered_steps += 1
             self._answer = True
             self._answered()
+            # no controller: simulated time crawls (one period per lockstep_wait), so the
+            # diagnostics follow the wall clock instead, with the period this step publishes
+            period = self._setup.values['diagnostics_period']
+            self._report_now = now - self._diagnosed_at >= period
 
     def _publish_state(self) -> None:
         self._publish()  # the sensors first, then the clock that makes a controller act on them
@@ -390,12 +398,20 @@ class VirtualMotorNode(Node):
         temp.header.stamp, temp.header.frame_id = stamp, frame
         temp.temperature, temp.variance = reading.temperature, sensors.temperature.noise ** 2
         self._temp_pub.publish(temp)
-        if reading.time >= self._next_diagnostics:
+        if reading.time >= self._next_diagnostics or self._report_now:
+            self._report_now = False
             self._next_diagnostics = reading.time + values['diagnostics_period']
             self._diagnose(stamp)
 
+    def _controllers(self) -> int:
+        """Count the publishers of flow_command (as remapped)."""
+        return self.count_publishers(self._command_sub.topic_name)
+
     def _diagnose(self, stamp: Time) -> None:
+        self._diagnosed_at = time.monotonic()
         plant = self.plant
+        lockstep = self._lockstep_timer is not None
+        controllers = self._controllers()
         flows = plant.flows
         now_wall, now_sim = time.monotonic(), plant.state.time
         wall0, sim0 = self._ticks_wall
@@ -410,8 +426,16 @@ class VirtualMotorNode(Node):
             level = 1
             message = f'{self.unanswered_steps - self._unanswered_reported} lockstep ' \
                       'period(s) taken with no flow_command within lockstep_wait'
+        elif lockstep and controllers > 1:
+            level = 1
+            message = (f'{controllers} publishers on flow_command: in lockstep the first '
+                       'command answers each period, so two controllers take turns')
         elif flows.relief > 0.0:
             level, message = 1, 'relief valve open'
+        if lockstep and controllers > 1 and not self._controllers_warned:
+            self._controllers_warned = True
+            self.get_logger().warning(f'{controllers} publishers on flow_command drive this '
+                                      'lockstep plant: more than one controller?')
         self._unanswered_reported = self.unanswered_steps
         if plant.invalid_points:
             level = 2
@@ -428,7 +452,7 @@ class VirtualMotorNode(Node):
             'outlet_pressure [MPa]': diag.human(state.outlet_pressure, 'Pa')[1],
             'load_torque [N*m]': 'profile' if self._load_torque is None else self._load_torque,
             'rejected_inputs': self.rejected, 'last_rejection': self.last_rejection,
-            'unanswered_steps': self.unanswered_steps,
+            'unanswered_steps': self.unanswered_steps, 'flow_command publishers': controllers,
             'relief_flow [l/min]': diag.human(flows.relief, 'm^3/s')[1],
             'model_status': describe_status(plant.model_status),
             'model_rebuilds': plant.rebuilds, 'liquid': self._setup.values['liquid'],
