@@ -2,6 +2,9 @@
 """
 ``external_leakage``: Q_ex = k_ex p (eq. 24), p the gauge pressure of the case or the outlet.
 
+A gauge pressure below atmosphere drives no leakage out of the motor: p is floored at 0, as
+the nodes (``prediction``) and the plant read their pressures.
+
 In a coefficient set the effect names the pressure that drives eq. (24); its
 coefficient is ``coefficients.external_leakage``. The virtual motor takes the
 same k_ex p from the inlet line to the tank (solved implicitly with the lines),
@@ -74,14 +77,16 @@ class ExternalLeakage(EffectKind):
         return OUTFLOW[reverse] if effect.regressor == 'p_out' else effect.regressor
 
     def condition(self, effect: Effect, x: float, now: Conditions) -> Conditions:
-        """Drive eq. (24) by the channel's gauge pressure `x` [Pa]."""
-        return now._replace(p_ex=x)
+        """Drive eq. (24) by the channel's gauge pressure `x` [Pa], floored at 0."""
+        return now._replace(p_ex=max(x, 0.0))  # below atmosphere nothing leaks out (NaN kept)
 
     def candidates(self, data: CandidateData) -> tuple[list[Candidate], list[str]]:
         """Offer k_ex >= 0 for each driving pressure that was measured and varies."""
         out, skipped = [], []
         for name in self.regressors:
             p = data.channels.get(name) if name != 'p_out' else outflow(data)
+            if p is not None:
+                p = np.maximum(p, 0.0)  # as the model: no leak out below atmosphere
             if p is None or not varies(p):
                 skipped.append(f'{self.name}({name}): {why_not(p)}')
                 continue

@@ -19,8 +19,9 @@ MIN_ABOVE = {'both': (0.15, 4), 'positive': (0.03, 8), 'negative': (0.03, 8)}
 """Least share of the points, and least number, above a fitted threshold, [-]: a one-sided
 valve opens near the top of its side's range, in a few per cent of a recording."""
 
-STARTS = {'both': (0.3, 0.7), 'positive': (0.5, 0.9), 'negative': (0.5, 0.9)}
-"""Starts of the fitted threshold, as shares of the range it may take, [-]."""
+STARTS = {'both': (0.3, 0.7), 'positive': (0.5, 0.8, 0.95), 'negative': (0.5, 0.8, 0.95)}
+"""Starts of the fitted threshold: shares of the range it may take (both sides), quantiles of
+the side's drops (one side: a valve cracks near the top of its side's range), [-]."""
 
 EXPONENTS = (0.5, 3.0)
 """Range of the fitted exponent e, [-]."""
@@ -144,7 +145,11 @@ class Threshold(EffectKind):
             return Effect(f'{self.name}:dp', k / (top - x_c) ** e, 'dp', x_c,
                           options=(('exponent', e),), direction=direction)
 
-        shape = (Shape('threshold', STARTS[direction], (0.0, 1.0), 'Pa', (low, high - low)),
+        starts = STARTS[direction]
+        if direction != 'both':
+            starts = tuple(float(np.clip((np.quantile(ordered, q) - low) / (high - low), 0.0, 1.0))
+                           for q in starts)
+        shape = (Shape('threshold', starts, (0.0, 1.0), 'Pa', (low, high - low)),
                  Shape('exponent', (1.0,), EXPONENTS))
         return Candidate(f'{self.name}:dp', 'dp', self.unit, self.source, dp, modify,
                          1.0e-3 / 60.0, (0.0, np.inf), 0.1e-3 / 60.0, make, shape, direction)
