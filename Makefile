@@ -14,7 +14,7 @@ VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.satmotor-installed
 
-.PHONY: all venv run test bench clean
+.PHONY: all venv run test bench fuzz clean
 
 all: test
 
@@ -47,6 +47,11 @@ test: $(STAMP)
 
 bench: $(STAMP)
 	$(PY) bench/bench_model.py
+
+# Hostile effect files, column mappings and logs through every reader and command, longer than
+# the suite's property tests (test/test_fuzz_hostile.py); the counts are in doc/outputs.md.
+fuzz: $(STAMP)
+	$(PY) bench/fuzz_hostile.py
 
 clean:
 	rm -rf $(VENV) build install log out .pytest_cache .hypothesis *.egg-info
