@@ -10,7 +10,7 @@ from satmotor_ros.identify.candidates import build_library
 from satmotor_ros.identify.fit import LossFit
 from satmotor_ros.identify.parts import loss_parts
 from satmotor_ros.identify.table import BenchTable
-from satmotor_ros.model import ConfigError, MotorModel, PointStatus
+from satmotor_ros.model import ConfigError, INVALID, MotorModel, PointStatus
 from satmotor_ros.model.config import default_config_path, motor_from_mapping
 from satmotor_ros.model.effects import Effect, effect_from_mapping, effect_to_mapping
 from satmotor_ros.model.units import LPM, MPA, RPM
@@ -75,7 +75,7 @@ def test_a_one_sided_valve_acts_on_its_side_only_point_equal_to_array(speed, dro
         array = model.absorbency(np.array([n, n]), np.array([dp, dp]), errors='mask')
         assert array.flow[0] == point.flow or point.flow != point.flow
         assert array.status[0] == point.status
-        if quadrant[1] != side or abs(bare.dp_i) <= VALVE['reference']:
+        if quadrant[1] != side or abs(dp) <= VALVE['reference']:
             assert point.flow == pytest.approx(bare.flow, rel=1e-12, abs=1e-15)
         elif not point.status & int(PointStatus.NO_ROOT | PointStatus.BEYOND_LIMIT):
             # the valve passes flow from the high- to the low-pressure port
@@ -159,3 +159,25 @@ def test_a_one_sided_effect_is_written_by_key_and_loads():
     spec = motor_from_mapping(yaml.safe_load(yaml.safe_dump(doc)))
     (effect,) = spec.sets['oil'].effects
     assert (effect.direction, effect.option('exponent')) == ('negative', 1.5)
+
+
+@settings(max_examples=40, deadline=None)
+@given(speed=st.floats(200.0, 2000.0), drop=st.floats(19.0, 28.0),
+       quadrant=st.sampled_from([(1, 1), (-1, -1), (-1, 1), (1, -1)]))
+def test_the_valve_opens_on_the_port_drop_beside_the_motor(speed, drop, quadrant):
+    """Q = Q_motor(n, dp) + k (|dp| - x_c) on the port drop, whichever drop is given."""
+    n, dp = quadrant[0] * speed * RPM, quadrant[1] * drop * MPA
+    both = model_with({'threshold:dp': VALVE})
+    point, motor = both.absorbency_point(n, dp), BARE.absorbency_point(n, dp)
+    valve = np.sign(dp) * VALVE['coefficient'] * (abs(dp) - VALVE['reference'])
+    if point.status & int(INVALID) or motor.status & int(INVALID):
+        return
+    assert point.flow == pytest.approx(motor.flow + valve, rel=1e-12, abs=1e-15)
+    assert point.total == pytest.approx(motor.total + valve, rel=1e-12, abs=1e-15)
+    assert (point.dp, point.dp_i) == (motor.dp, motor.dp_i)  # the valve's flow skips the channels
+    chamber = both.absorbency_point(n, dp_i=point.dp_i)
+    assert chamber.flow == pytest.approx(point.flow, rel=1e-9)
+    back = both.speed_point(point.flow, dp_i=point.dp_i)
+    if motor.flow * n > 0.0:  # motor mode: the flow tells the speed
+        assert back.speed == pytest.approx(n, rel=1e-7)
+        assert back.dp == pytest.approx(dp, rel=1e-9)

@@ -98,6 +98,7 @@ class Calibration:
     def effects(self) -> tuple[Effect, ...]:
         """Return the effects found at their fitted values, in order, with their fitted range."""
         data = {**self.table.channels, 'p_out': self.table.p_out, 'dp_i': self.parts.dp_i,
+                'dp': self.parts.dp,
                 'speed': self.parts.speed, 'flow': np.abs(self.parts.flow)}
 
         def fitted_on(effect: Effect) -> Effect:

@@ -103,7 +103,8 @@ class ConditionedModel:
 
     def __init__(self, core: ModelCore) -> None:
         """Sort the effects by what they do and keep the motor without them."""
-        every = [(kind_of(e), e) for e in core.coefficient_set.effects]
+        every = [(kind_of(e), e) for e in core.coefficient_set.effects
+                 if not kind_of(e).bypass]  # the port valves act beside the motor (valves.py)
         motor = [(kind, e) for kind, e in every if not kind.sensor]
         self._fitted = tuple((kind.reverse, e, fitted_bounds(e.fitted_range))
                              for kind, e in every if e.fitted_range)  # empty when none

@@ -40,6 +40,7 @@ from satmotor_ros.model.point import as_float, invalid_point
 from satmotor_ros.model.quadrants import chamber_drop, Channels, Quadrants, signed_map
 from satmotor_ros.model.results import LossBreakdown, OperatingPoints, Point, PointStatus
 from satmotor_ros.model.screening import Errors
+from satmotor_ros.model.valves import Valves
 
 DisplacementLaw = Literal['eq33', 'eq39']
 
@@ -143,6 +144,7 @@ class MotorModel:
         self._equations, self._point = core.eqs, core.point
         self.effects = coefficient_set.effects
         self._conditioned = ConditionedModel(core) if self.effects else None
+        self._valves = Valves(self.effects)
         self.channels = self._conditioned.channels if self._conditioned else ()
         self._quadrants = Quadrants(_Magnitudes(core, self._conditioned))
 
@@ -421,6 +423,13 @@ class MotorModel:
             flow = as_float('flow', flow)
         if type(p_ex) is not float:
             p_ex = as_float('p_ex', p_ex)
+        if self._valves:  # the motor's map at the flow the valves leave it
+            return self._valves.speed(self._speed_at, flow, port, value, p_ex, channels)
+        return self._speed_at(flow, port, value, p_ex, channels)
+
+    def _speed_at(self, flow: float, port: bool, value: float, p_ex: float,
+                  channels: Mapping[str, float] | None) -> Point:
+        """Return the motor's n(Q, dp) at one point, without the port valves."""
         try:
             if not (flow >= 0.0 and value >= 0.0):  # any other quadrant, or NaN
                 return self._quadrants.speed(flow, value, port, p_ex, channels)
@@ -478,6 +487,15 @@ class MotorModel:
             p_ex = as_float('p_ex', p_ex)
         if flow_guess is not None and type(flow_guess) is not float:
             flow_guess = as_float('flow_guess', flow_guess)
+        if self._valves:  # the motor's flow plus the valves'
+            return self._valves.absorbency(self._absorbency_at, speed, port, value, p_ex,
+                                           flow_guess, channels)
+        return self._absorbency_at(speed, port, value, p_ex, flow_guess, channels)
+
+    def _absorbency_at(self, speed: float, port: bool, value: float, p_ex: float,
+                       flow_guess: float | None,
+                       channels: Mapping[str, float] | None) -> Point:
+        """Return the motor's Q(n, dp) at one point, without the port valves."""
         try:
             if not (speed >= 0.0 and value >= 0.0):  # any other quadrant, or NaN
                 return self._quadrants.absorbency(speed, value, port, p_ex, flow_guess, channels)
@@ -516,6 +534,9 @@ class MotorModel:
             dp_i = as_float('dp_i', dp_i)
         if type(p_ex) is not float:
             p_ex = as_float('p_ex', p_ex)
+        if self._valves:
+            return self._valves.absorbency(self._absorbency_at, speed, False, dp_i, p_ex, None,
+                                           channels)
         if not (speed >= 0.0 and dp_i >= 0.0):
             return self._quadrants.absorbency(speed, dp_i, False, p_ex, None, channels)
         if self._conditioned is not None:

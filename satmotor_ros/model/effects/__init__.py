@@ -22,7 +22,8 @@ defines ``KIND = MyKind()`` (doc/effects.md). The kinds shipped:
 ``channel:<name>``         extra loss k (x - reference) in Q_vl, x the channel <name>
 ``reverse_loss``           extra loss k |dp_i| |n| in Q_vl while the shaft turns backwards
 ``term:<expression>``      extra loss k dp_i^a n^b in Q_vl, the exponents fitted
-``threshold:dp``           extra loss k max(0, |dp_i| - x_c)^e in Q_vl (a valve cracking open)
+``threshold:dp``           a valve across the ports passing k max(0, |dp| - x_c)^e, dp the
+                           port drop, beside the chambers (a relief valve cracking open)
 ``flow_sensor_offset``     the flowmeter reads Q + k
 ``flow_sensor_gain``       the flowmeter reads (1 + k) Q
 ``speed_sensor_gain``      the speed sensor reads (1 + k) n

@@ -201,6 +201,10 @@ class Parts(Protocol):
         """Measured n [rad/s]."""
 
     @property
+    def dp(self) -> FloatArray:
+        """Port drop |dp| [Pa]."""
+
+    @property
     def dp_i(self) -> FloatArray:
         """Chamber drop, eq. (34) [Pa]."""
 
@@ -382,6 +386,8 @@ class EffectKind:
     sensor: str = ''  # the channel of an instrument error ('flow', 'speed')
     reverse: bool = False  # its loss() applies only while the shaft turns backwards (n < 0)
     directional: bool = False  # it may act for one sign of dp only (Effect.direction)
+    bypass: bool = False  # its loss() is a valve across the ports: f(n, port dp), beside the
+    # motor's chambers and channels (satmotor_ros.model.valves)
     unit: str = '-'  # unit of the coefficient
     source: str = ''  # the physics or standard the term comes from
     evaluation: str = ''  # what the model does with it (written into the YAML)

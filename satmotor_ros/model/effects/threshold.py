@@ -1,5 +1,11 @@
 # SPDX-License-Identifier: Apache-2.0
-"""``threshold:dp``: an extra loss k max(0, dp_i - x_c)^e in Q_vl, a valve that cracks open."""
+"""
+``threshold:dp``: a valve across the ports passing k max(0, |dp| - x_c)^e, dp the port drop.
+
+A relief, bypass or anti-cavitation valve opens on the drop between the ports, and its flow
+runs beside the motor's chambers and channels (:mod:`satmotor_ros.model.valves`); it may
+open for one sign of dp = p_a - p_b only (``direction``).
+"""
 
 from __future__ import annotations
 
@@ -34,18 +40,21 @@ class Threshold(EffectKind):
     suffixed = True
     rank = 85
     directional = True
+    bypass = True
     keys = ('regressor', 'coefficient', 'reference', 'exponent')
     required = ('coefficient', 'reference')
     unit = 'm^3/s per Pa^e'
     source = 'a valve that cracks open (relief, bypass)'
-    evaluation = ('extra loss k max(0, dp - reference)^exponent added to Q_vl (eq. 31), dp '
-                  '[Pa] the chamber drop dp_i of eq. (34), reference the cracking drop [Pa]')
+    evaluation = ('a valve across the ports: flow k max(0, |dp| - reference)^exponent from the '
+                  'high- to the low-pressure port, beside the chambers and channels, added to '
+                  'Q and to Q_vl; dp [Pa] the port drop p_a - p_b, reference the cracking '
+                  'drop [Pa]; only where dp has the sign direction names')
 
     plant_parameters = (
-        PlantParameter('valve_conductance', 0.0, 'flow per Pa of chamber drop above the '
-                       'crack pressure through a valve (threshold:dp, exponent 1)',
+        PlantParameter('valve_conductance', 0.0, 'flow per Pa of port drop above the crack '
+                       'pressure through a valve across the ports (threshold:dp, exponent 1)',
                        'm^3/(s*Pa)', 0.0, 1.0e-8),
-        PlantParameter('valve_crack', 20.0e6, 'chamber drop where that valve cracks open',
+        PlantParameter('valve_crack', 20.0e6, 'port drop where that valve cracks open',
                        'Pa', 0.0, 1.0e9),
         PlantParameter('valve_direction', 'both', 'sign of dp = p_a - p_b where it opens',
                        choices=DIRECTIONS),
@@ -91,7 +100,7 @@ class Threshold(EffectKind):
                 'reference': effect.reference, 'exponent': effect.option('exponent', 1.0)}
 
     def loss(self, effect: Effect) -> Loss | None:
-        """Return k max(0, |dp_i| - x_c)^e (where the effect acts: Effect.direction)."""
+        """Return (n, dp) -> k max(0, |dp| - x_c)^e, dp the port drop (a bypass kind)."""
         k, x_c, e = effect.coefficient, effect.reference, effect.option('exponent', 1.0)
 
         def loss(n: Real, dp_i: Real) -> Real:
@@ -99,8 +108,8 @@ class Threshold(EffectKind):
         return loss
 
     def reads(self, effect: Effect) -> tuple[str, ...]:
-        """Read the chamber drop only."""
-        return ('dp_i',)
+        """Read the port drop only."""
+        return ('dp',)
 
     def candidates(self, data: CandidateData) -> tuple[list[Candidate], list[str]]:
         """
@@ -110,7 +119,7 @@ class Threshold(EffectKind):
         dp only; the one-sided candidates (``direction`` positive or negative)
         place the threshold among that side's points.
         """
-        dp = np.abs(data.parts.dp_i)
+        dp = np.abs(data.parts.dp)
         negative = negative_rows(data.parts)
         sides = [('both', np.ones(dp.shape, dtype=bool))]
         if two_sided(data.parts):
