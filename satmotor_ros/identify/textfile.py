@@ -8,6 +8,7 @@ decided elsewhere (:mod:`.table` for ``name [unit]`` headers, :mod:`.columns` fo
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 import csv
 from dataclasses import dataclass
 import io
@@ -119,18 +120,30 @@ def _header_cells(text: str, sep: str | None, width: int) -> list[str] | None:
     return None
 
 
-def _read_text(file: Path) -> str:
+def _read_lines(file: Path) -> Iterator[str]:
+    """
+    Yield the lines of a capped text file one by one (universal newlines, BOM dropped).
+
+    Line by line, never a list of every line: a file of many short lines costs no more than
+    its bytes until the row cap stops it.
+    """
     try:
-        return read_capped(file, TEXT_MAX_BYTES, 'SATMOTOR_TEXT_MAX_BYTES').decode('utf-8-sig')
+        data = read_capped(file, TEXT_MAX_BYTES, 'SATMOTOR_TEXT_MAX_BYTES')
     except OSError as err:
         msg = f'cannot read {str(file)!r}: {err.strerror}'
         raise DataError(msg) from None
     except LimitError as err:
         msg = f'{str(file)!r}: {err}; doc/outputs.md'
         raise DataError(msg) from None
-    except UnicodeDecodeError:
-        msg = f'{str(file)!r} is not a UTF-8 text file'
-        raise DataError(msg) from None
+    first = True
+    for raw in io.BytesIO(data):  # splits at b'\n' lazily, sharing the bytes
+        try:
+            text = raw.decode('utf-8-sig' if first else 'utf-8')
+        except UnicodeDecodeError:
+            msg = f'{str(file)!r} is not a UTF-8 text file'
+            raise DataError(msg) from None
+        first = False
+        yield from text.splitlines() or ('',)
 
 
 def _numbers(rows: list[list[str]], lines: list[int], names: list[str]) -> np.ndarray:
@@ -194,7 +207,7 @@ def read_cells(path: str | Path, separator: str = 'auto', comment: str = '#',
     content: list[tuple[int, str]] = []
     last_comment = None
     skipped: list[int] = []  # comment lines after the first data line
-    for number, line in enumerate(_read_text(file).splitlines(), start=1):
+    for number, line in enumerate(_read_lines(file), start=1):
         stripped = line.strip()
         if not stripped:
             continue
