@@ -181,3 +181,15 @@ def test_the_valve_opens_on_the_port_drop_beside_the_motor(speed, drop, quadrant
     if motor.flow * n > 0.0:  # motor mode: the flow tells the speed
         assert back.speed == pytest.approx(n, rel=1e-7)
         assert back.dp == pytest.approx(dp, rel=1e-9)
+
+
+def test_a_set_of_valves_only_maps_arrays_through_the_point_path():
+    model = model_with({'threshold:dp@negative': {**VALVE, 'direction': 'negative'}})
+    speed = np.array([800.0, -800.0, -800.0]) * RPM
+    dp = np.array([25.0, -25.0, -10.0]) * MPA
+    array = model.absorbency(speed, dp)
+    points = [model.absorbency_point(float(n), float(d)) for n, d in zip(speed, dp)]
+    assert list(array.flow) == [p.flow for p in points]
+    assert array.flow[1] < BARE.absorbency_point(-800 * RPM, -25 * MPA).flow
+    flows = model.speed(array.flow, dp)
+    assert np.allclose(flows.speed, speed, rtol=1e-7)

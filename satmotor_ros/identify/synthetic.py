@@ -173,7 +173,7 @@ def injected_effect(base: MotorModel, injection: Injection, speed: FloatArray,
     dp_i = base.absorbency(speed, dp=dp, errors='mask').dp_i
     data = Synthetic(np.abs(speed), np.abs(dp_i), channels,
                      standard_law(base.liquid, base.coefficient_set.name), injection.shape,
-                     np.sign(speed))
+                     np.sign(speed), np.abs(dp))
     return kind.scaled(injection.effect, injection.magnitude, injection.regressor, data)
 
 

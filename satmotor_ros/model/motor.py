@@ -30,7 +30,7 @@ from satmotor_ros.model.coefficients import (CoefficientSet, Liquid, MotorGeomet
 from satmotor_ros.model.conditioned import ConditionedModel, map_points
 from satmotor_ros.model.config import load_motor, MotorSpec
 from satmotor_ros.model.core import ModelCore
-from satmotor_ros.model.effects import true_flow, true_speed
+from satmotor_ros.model.effects import kind_of, true_flow, true_speed
 from satmotor_ros.model.errors import ModelError
 from satmotor_ros.model.families import DEFAULT_FAMILY, Family
 from satmotor_ros.model.families.defaults import default_motor
@@ -143,8 +143,9 @@ class MotorModel:
         self.derived, self.law = core.derived, core.eqs.law
         self._equations, self._point = core.eqs, core.point
         self.effects = coefficient_set.effects
-        self._conditioned = ConditionedModel(core) if self.effects else None
         self._valves = Valves(self.effects)
+        inside = any(not kind_of(e).bypass for e in self.effects)  # not only port valves
+        self._conditioned = ConditionedModel(core) if inside else None
         self.channels = self._conditioned.channels if self._conditioned else ()
         self._quadrants = Quadrants(_Magnitudes(core, self._conditioned))
 
@@ -286,7 +287,7 @@ class MotorModel:
         if method not in ('auto', 'iterative'):
             msg = f"method = {method!r}: use 'auto' or 'iterative'"
             raise ModelError(msg)
-        if self._conditioned is not None:
+        if self.effects:  # the single-point path, element by element
             return map_points(
                 lambda q, d, p, c: self.speed_point(q, **{dp_name: d}, p_ex=p, channels=c),
                 ('flow', flow), (dp_name, dp_value), p_ex, channels, self.geometry, errors)
@@ -331,7 +332,7 @@ class MotorModel:
 
         """
         dp_name, dp_value = self._which_dp(dp, dp_i)
-        if self._conditioned is not None:
+        if self.effects:  # the single-point path, element by element
             return map_points(
                 lambda n, d, p, c: self.absorbency_point(n, **{dp_name: d}, p_ex=p, channels=c),
                 ('speed', speed), (dp_name, dp_value), p_ex, channels, self.geometry, errors)

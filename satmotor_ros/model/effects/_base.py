@@ -260,6 +260,7 @@ class Synthetic(NamedTuple):
     law: ViscosityLaw  # the liquid's standard viscosity law
     shape: tuple[tuple[str, float], ...] = ()  # kind-specific numbers (a threshold, ...)
     rotation: FloatArray | float = 1.0  # sign of the true speed, -1, 0 or +1 [-]
+    dp: FloatArray | None = None  # port drop |dp| [Pa]; None: not known (dp_i stands in)
 
 
 @dataclass(frozen=True)

@@ -167,7 +167,8 @@ class Threshold(EffectKind):
         """Inject `magnitude` [m^3/s] at the largest drop; ``reference``, ``exponent`` in shape."""
         shape = dict(data.shape)
         x_c, e = shape['reference'], shape.get('exponent', 1.0)
-        peak = float(np.max(np.maximum(np.abs(data.dp_i) - x_c, 0.0) ** e))
+        drop = data.dp if data.dp is not None else data.dp_i  # the valve reads the port drop
+        peak = float(np.max(np.maximum(np.abs(drop) - x_c, 0.0) ** e))
         return Effect(name, magnitude / max(peak, 1e-300), 'dp', x_c, options=(('exponent', e),))
 
 
