@@ -107,3 +107,10 @@ def test_the_plant_and_the_controller_report_in_rpm_l_min_and_mpa(harness):
         for node in (motor, controller):
             harness.executor.remove_node(node)
             node.destroy_node()
+
+
+def test_a_value_that_shows_as_zero_has_no_sign():
+    from satmotor_ros.nodes._diagnostics import human
+    assert human(-1e-21, 'm^3/s') == ('l/min', '0.0000')
+    assert human(-2.0 * RPM, 'rad/s') == ('rpm', '-2.00')
+    assert human(float('nan'), 'Pa') == ('MPa', 'n/a') and human(None, 's') == ('s', 'n/a')

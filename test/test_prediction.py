@@ -317,3 +317,10 @@ def test_input_state_follows_the_rule_priority_on_floats_and_arrays(name):
             one = input_state(name, value, age, RULE.timeout_ns)
             many = input_state(name, np.array([value]), np.array([age]), RULE.timeout_ns)
             assert one == expected == many[0], (value, age)
+
+
+def test_the_model_note_shows_hydraulic_units_and_no_negative_zero():
+    from satmotor_ros.prediction.predict import _model_note
+    assert _model_note(4, -1e-12, -1e-3) == ('model status EXTRAPOLATED at flow_command 0.0000 '
+                                             'l/min, dp 0.0000 MPa')
+    assert _model_note(4, -5 * LPM, 19.5 * MPA).endswith('-5.0000 l/min, dp 19.5000 MPa')

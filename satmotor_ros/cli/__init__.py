@@ -9,6 +9,12 @@ import os
 for _name in ('OPENBLAS_NUM_THREADS', 'OMP_NUM_THREADS', 'MKL_NUM_THREADS'):
     os.environ.setdefault(_name, '1')
 
-from satmotor_ros.cli.main import main  # noqa: E402
+try:  # numpy, scipy and matplotlib take a while: a Ctrl-C meanwhile is no error
+    from satmotor_ros.cli.main import main  # noqa: E402
+except KeyboardInterrupt:
+    import sys  # noqa: E402
+
+    print('satmotor: interrupted while starting; nothing was written', file=sys.stderr)
+    raise SystemExit(130) from None
 
 __all__ = ['main']

@@ -19,6 +19,7 @@ from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock
 from satmotor_ros.cli._common import CliError
 from satmotor_ros.cli._demo_report import RunResult, write_run_bag
+from satmotor_ros.cli._safe_signals import signals_at_safe_points
 from satmotor_ros.interface import (CHANNELS, CLOCK, DIAGNOSTIC_ARRAY, FLOAT64, MODEL_OUTPUTS,
                                     TOPIC_TYPES)
 from satmotor_ros.nodes.motor_model import MotorModelNode
@@ -153,7 +154,8 @@ class Recorder(Node):
                 for topic, kept in self.messages.items()}
 
 
-def _wait_connected(executor: SingleThreadedExecutor, nodes: list[Node]) -> None:
+def _wait_connected(executor: SingleThreadedExecutor, nodes: list[Node],
+                    check: Callable[[], None]) -> None:
     """
     Spin until every publisher of the run is matched by every subscription on its topic.
 
@@ -176,6 +178,7 @@ def _wait_connected(executor: SingleThreadedExecutor, nodes: list[Node]) -> None
             raise CliError(f'the demo nodes did not find each other within '
                            f'{DISCOVERY_TIMEOUT:g} s (unmatched: {", ".join(missing)})')
         executor.spin_once(timeout_sec=0.01)
+        check()  # a Ctrl-C is raised here, never inside the executor's internals
 
 
 def run_cycle(liquid: str, feedforward: str, cycle: Cycle, effects: dict[str, Any],
@@ -210,46 +213,48 @@ def run_cycle(liquid: str, feedforward: str, cycle: Cycle, effects: dict[str, An
     # another demo (or any sim-time system) on the same ROS domain cannot cross this run
     context.init(args=['--ros-args', '-r', f'/clock:={namespace}/clock',
                        '-r', f'/diagnostics:={namespace}/diagnostics'])
-    executor = SingleThreadedExecutor(context=context)
-    nodes: list[Node] = []
-    try:
-        motor = VirtualMotorNode(context=context, namespace=namespace, parameter_overrides=[
-            Parameter('clock_mode', value='lockstep'), Parameter('paused', value=True),
-            Parameter('lockstep_wait', value=LOCKSTEP_WAIT), Parameter('liquid', value=liquid),
-            Parameter('publish_rate', value=CONTROL_RATE),
-            *(Parameter(k, value=v) for k, v in effects.items())])
-        sim = [Parameter('use_sim_time', value=True)]
-        controller = SpeedControllerNode(context=context, namespace=namespace,
-                                         parameter_overrides=[
-                                             *sim, Parameter('liquid', value=liquid),
-                                             Parameter('feedforward', value=feedforward),
-                                             Parameter('rate', value=CONTROL_RATE)])
-        predictor = MotorModelNode(context=context, namespace=namespace, parameter_overrides=[
-            *sim, Parameter('liquid', value=liquid)])
-        script = Script(cycle, context=context, namespace=namespace, parameter_overrides=sim)
-        recorder = Recorder(list(RECORDED), context=context, namespace=namespace)
-        nodes = [recorder, script, controller, predictor, motor]
-        for node in nodes:
-            executor.add_node(node)
-        _wait_connected(executor, nodes)
-        motor.set_parameters([Parameter('paused', value=False)])
-        label = f'{liquid}/{"ff" if feedforward == "model" else "pi"}'
-        start = time.monotonic()
-        plant = motor.plant
-        # two periods past the end: every message that answers the last period is in
-        beyond = cycle.duration + 2.0 / CONTROL_RATE
-        while plant.state.time < beyond:
-            executor.spin_once(timeout_sec=0.1)
-            if progress is not None:
-                progress.show(label, min(plant.state.time, cycle.duration))
-        wall = time.monotonic() - start
-        sim_seconds = cycle.duration
-        unanswered = motor.unanswered_steps
-    finally:
-        executor.shutdown()
-        for node in nodes:
-            node.destroy_node()
-        context.try_shutdown()
+    with signals_at_safe_points() as check:  # Ctrl-C between spins, not in a finaliser
+        executor = SingleThreadedExecutor(context=context)
+        nodes: list[Node] = []
+        try:
+            motor = VirtualMotorNode(context=context, namespace=namespace, parameter_overrides=[
+                Parameter('clock_mode', value='lockstep'), Parameter('paused', value=True),
+                Parameter('lockstep_wait', value=LOCKSTEP_WAIT), Parameter('liquid', value=liquid),
+                Parameter('publish_rate', value=CONTROL_RATE),
+                *(Parameter(k, value=v) for k, v in effects.items())])
+            sim = [Parameter('use_sim_time', value=True)]
+            controller = SpeedControllerNode(context=context, namespace=namespace,
+                                             parameter_overrides=[
+                                                 *sim, Parameter('liquid', value=liquid),
+                                                 Parameter('feedforward', value=feedforward),
+                                                 Parameter('rate', value=CONTROL_RATE)])
+            predictor = MotorModelNode(context=context, namespace=namespace, parameter_overrides=[
+                *sim, Parameter('liquid', value=liquid)])
+            script = Script(cycle, context=context, namespace=namespace, parameter_overrides=sim)
+            recorder = Recorder(list(RECORDED), context=context, namespace=namespace)
+            nodes = [recorder, script, controller, predictor, motor]
+            for node in nodes:
+                executor.add_node(node)
+            _wait_connected(executor, nodes, check)
+            motor.set_parameters([Parameter('paused', value=False)])
+            label = f'{liquid}/{"ff" if feedforward == "model" else "pi"}'
+            start = time.monotonic()
+            plant = motor.plant
+            # two periods past the end: every message that answers the last period is in
+            beyond = cycle.duration + 2.0 / CONTROL_RATE
+            while plant.state.time < beyond:
+                executor.spin_once(timeout_sec=0.1)
+                check()
+                if progress is not None:
+                    progress.show(label, min(plant.state.time, cycle.duration))
+            wall = time.monotonic() - start
+            sim_seconds = cycle.duration
+            unanswered = motor.unanswered_steps
+        finally:
+            executor.shutdown()
+            for node in nodes:
+                node.destroy_node()
+            context.try_shutdown()
     if progress is not None:
         progress.run_done(sim_seconds)
     messages = recorder.until(round(cycle.duration * 1e9))

@@ -41,7 +41,10 @@ def human(value: float | None, si_unit: str) -> tuple[str, str]:
     if value is None or value != value:
         return unit, NOT_AVAILABLE
     shown = value / size
-    return unit, f'{shown:.{decimals}f}' if math.isfinite(shown) else repr(shown)
+    if not math.isfinite(shown):
+        return unit, repr(shown)
+    text = f'{shown:.{decimals}f}'
+    return unit, text[1:] if text.startswith('-') and not float(text) else text  # no -0.00
 
 
 def format_value(value: object) -> str:

@@ -298,10 +298,16 @@ class PredictionBatch(NamedTuple):
         return describe(self.snapshot(i), self.timeout, int(self.status[i]), self.channels)[1]
 
 
+def _fixed(value: float) -> str:
+    """Four decimals, and no sign on a value that shows as zero (not '-0.0000')."""
+    text = f'{value:.4f}'
+    return text[1:] if text.startswith('-') and not float(text) else text
+
+
 def _model_note(status: int, flow: float, dp: float) -> str:
     # read by people (logs, diagnostics, replay's message column): hydraulic units
-    return (f'model status {describe_status(status)} at flow_command {flow / LPM:.4f} l/min, '
-            f'dp {dp / MPA:.4f} MPa')
+    return (f'model status {describe_status(status)} at flow_command {_fixed(flow / LPM)} '
+            f'l/min, dp {_fixed(dp / MPA)} MPa')
 
 
 def _level_table() -> npt.NDArray[np.uint8]:
