@@ -13,8 +13,9 @@ from satmotor_ros.identify.table import BenchTable
 from satmotor_ros.model import ConfigError, INVALID, MotorModel, PointStatus
 from satmotor_ros.model.config import default_config_path, motor_from_mapping
 from satmotor_ros.model.effects import Effect, effect_from_mapping, effect_to_mapping
-from satmotor_ros.model.units import LPM, MPA, RPM
+from satmotor_ros.model.units import ATMOSPHERE, LPM, MPA, RPM
 from satmotor_ros.model.viscosity import standard_law
+from satmotor_ros.prediction import Combiner, predict, Rule
 import yaml
 
 BASE = yaml.safe_load(default_config_path().read_text(encoding='utf-8'))
@@ -193,3 +194,22 @@ def test_a_set_of_valves_only_maps_arrays_through_the_point_path():
     assert array.flow[1] < BARE.absorbency_point(-800 * RPM, -25 * MPA).flow
     flows = model.speed(array.flow, dp)
     assert np.allclose(flows.speed, speed, rtol=1e-7)
+
+
+def test_the_prediction_motor_model_publishes_applies_the_valve_on_its_side_only():
+    """What the motor_model node computes: the valve acts where p_b > p_a only."""
+    rule = Rule(timeout=0.5)
+    valve = model_with({'threshold:dp@negative': {**VALVE, 'coefficient': 5e-12,
+                                                  'direction': 'negative'}})
+    speeds = {}
+    for model in (valve, BARE):
+        for sign in (1.0, -1.0):
+            combiner = Combiner(rule)
+            high, low = 25 * MPA + ATMOSPHERE, 0.5 * MPA + ATMOSPHERE
+            combiner.update('p_in', high if sign > 0 else low, 0)
+            combiner.update('p_out', low if sign > 0 else high, 0)
+            combiner.update('flow', sign * 20 * LPM, 1_000_000)
+            pred = predict(model, combiner.snapshot(1_000_000), rule.timeout)
+            speeds[model is valve, sign] = pred.output('speed')
+    assert speeds[True, 1.0] == speeds[False, 1.0]
+    assert 0.9 * abs(speeds[False, -1.0]) < abs(speeds[True, -1.0]) < abs(speeds[False, -1.0])
