@@ -21,11 +21,11 @@ from satmotor_ros.model.effects._base import (Candidate, CandidateData, DIRECTIO
                                               two_sided)
 from satmotor_ros.model.errors import ConfigError
 
-MIN_ABOVE = {'both': (0.15, 4), 'positive': (0.03, 8), 'negative': (0.03, 8)}
+MIN_ABOVE = {'both': (0.15, 4), 'positive': (0.01, 8), 'negative': (0.01, 8)}
 """Least share of the points, and least number, above a fitted threshold, [-]: a one-sided
-valve opens near the top of its side's range, in a few per cent of a recording."""
+valve opens near the top of its side's range, in one or a few per cent of a recording."""
 
-STARTS = {'both': (0.3, 0.7), 'positive': (0.5, 0.8, 0.95), 'negative': (0.5, 0.8, 0.95)}
+STARTS = {'both': (0.3, 0.7), 'positive': (0.6, 0.9, 0.98), 'negative': (0.6, 0.9, 0.98)}
 """Starts of the fitted threshold: shares of the range it may take (both sides), quantiles of
 the side's drops (one side: a valve cracks near the top of its side's range), [-]."""
 
