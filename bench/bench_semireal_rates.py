@@ -7,9 +7,10 @@ logs, cropped to its high-load part and decimated to 25 Hz, with the flow of a k
 (a family's defaults at 0.30 in^3/rev) and one or two effects injected by
 :mod:`satmotor_ros.identify.semireal` (a one-sided relief valve by a law that is not the
 threshold candidate's, a leak from the outflow port, wear, a flow or speed gain, a flow lag)
-at 0.25, 0.5, 1 and 2 times a realistic size, plus noise measured on the same log (white, AR(1),
-spikes) and one gross bad row. The case is written as an MBARI log and calibrated through
-``satmotor calibrate --columns mbari_pto`` as a user's file.
+at 0.25, 0.5, 1 and 2 times a realistic size, plus noise measured on the same log (white,
+Gaussian-correlated, spikes, and the timing jitter the logs show while the flow changes;
+``--noise steady`` leaves the jitter out) and one gross bad row. The case is written as an
+MBARI log and calibrated through ``satmotor calibrate --columns mbari_pto`` as a user's file.
 
 An effect counts as named when calibration.json names its kind (the two gains count for each
 other, a known tie; a lag when ``dynamics`` gives flow_lag nonzero and its excess over
@@ -27,6 +28,7 @@ from __future__ import annotations
 import argparse
 from concurrent.futures import ProcessPoolExecutor
 import contextlib
+from dataclasses import replace
 import io
 import json
 import os
@@ -114,10 +116,11 @@ def _named(kind: str, effect, found: dict) -> tuple[bool, bool | None]:
 
 
 def _case(spec) -> dict:
-    log, kinds, scale, seed = spec
+    log, kinds, scale, seed, steady = spec
     name, start, stop = LOGS[log]
     whole = load_trajectory(DATA / name)
     noise = estimate_noise(whole)
+    noise = replace(noise, jitter_s=0.0) if steady else noise
     trajectory = whole.crop(start, stop, STEP)
     rng = np.random.default_rng([seed, len(kinds), int(10 * scale)])
     direction = int(rng.choice([-1, 1]))
@@ -160,9 +163,12 @@ def main() -> None:
     parser.add_argument('--seeds', type=int, default=3)
     parser.add_argument('--jobs', type=int, default=2)
     parser.add_argument('--verbose', action='store_true', help='print every case')
+    parser.add_argument('--noise', choices=('real', 'steady'), default='real',
+                        help="'real': as measured on the log; 'steady': without its timing "
+                             'jitter while the flow changes')
     args = parser.parse_args()
     start = time.perf_counter()
-    specs = [s for seed in range(args.seeds) for s in _spec(seed)]
+    specs = [(*s, args.noise == 'steady') for seed in range(args.seeds) for s in _spec(seed)]
     with ProcessPoolExecutor(args.jobs) as pool:
         results = list(pool.map(_case, specs))
     per_kind: dict[str, list[tuple[bool, bool]]] = {}
@@ -172,7 +178,7 @@ def main() -> None:
     for r in results:
         if args.verbose:
             kinds = '+'.join(r['kinds']) or 'none'
-            print(f"{r['log']:7s} seed {r['seed']} x{r['scale']:.1f} {kinds:36s} -> "
+            print(f"{r['log']:7s} seed {r['seed']} x{r['scale']:.2f} {kinds:36s} -> "
                   f"{', '.join(r['found']) or 'none'}; dynamics {r['dynamics']}; valve "
                   f"{r['valve']} fitted {r['fitted']}; detectable {r['shown']} "
                   f"({r['took']:.1f} s)")
