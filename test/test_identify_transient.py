@@ -10,7 +10,9 @@ import pytest
 from satmotor_ros.cli import main
 from satmotor_ros.identify import calibrate, IdentificationError, Options
 from satmotor_ros.identify.candidates import build_library
+from satmotor_ros.identify.coverage import COVERED, MOST
 from satmotor_ros.identify.fit import LossFit
+from satmotor_ros.identify.pipeline import read_rows
 from satmotor_ros.identify.selection import CrossValidatedSelector
 from satmotor_ros.identify.synthetic import (Dynamics, first_order, generate_series,
                                              generate_transient, Injection, Plan,
@@ -19,7 +21,7 @@ from satmotor_ros.identify.table import write_csv
 from satmotor_ros.identify.transient import (bin_means, bins, segments, transient_samples,
                                              variance_inflation)
 from satmotor_ros.model import MotorModel
-from satmotor_ros.model.units import LPM
+from satmotor_ros.model.units import LPM, MPA
 from satmotor_ros.model.viscosity import standard_law
 
 
@@ -191,11 +193,32 @@ def test_one_speed_only_is_refused_saying_what_cannot_be_told_apart():
         calibrate(table, 'oil')
 
 
-def test_auto_keeps_steady_windows_when_there_are_enough():
+def test_auto_keeps_steady_windows_when_they_hold_most_samples_and_the_envelope():
     table = generate_series(Plan(liquid='oil'), Injection(), seed=2, samples=30000)
     cal = calibrate(table, 'oil')
     assert cal.mode == 'series' and cal.samples is None
-    assert 'mode' not in cal.summary()  # DESIGN.md's fields only
+    summary = cal.summary()
+    assert summary['mode'] == 'series' and 'span' in summary['mode_reason']
+    coverage = summary['coverage']
+    assert coverage['fraction'] >= MOST and coverage['envelope_share'] >= COVERED
+    assert coverage['samples_total'] == len(table)
+
+
+def test_auto_uses_every_sample_when_the_windows_miss_part_of_the_envelope():
+    # plateaus at low drop, then a stretch of fast moves that reach the top of the drop:
+    # the windows hold most samples but not the envelope, so every sample is used
+    table = generate_series(Plan(liquid='oil'), Injection(), seed=2, samples=30000)
+    dp = table.p_in - table.p_out
+    fast = np.arange(len(table)) > 0.8 * len(table)
+    wave = 0.6 + 0.4 * np.sin(np.arange(len(table)) / 7.0)
+    p_in = np.where(fast, table.p_out + wave * 1.3 * float(np.max(dp)), table.p_in)
+    steady = read_rows(MotorModel.default('oil'), table, Options())
+    assert steady.mode == 'series'
+    read = read_rows(MotorModel.default('oil'), replace(table, p_in=p_in), Options())
+    assert read.mode == 'transient', read.reason
+    assert 'of its operating envelope' in read.reason and 'every sample' in read.reason
+    assert read.coverage['samples_used'] > 0.9 * len(table)
+    assert read.coverage['envelope']['positive']['dp_mpa'][1] > 1.2 * float(np.max(dp)) / MPA
 
 
 def test_transient_bag_through_satmotor_calibrate(tmp_path, capsys):

@@ -43,7 +43,7 @@ def test_a_long_legend_stays_inside_the_residual_grid(tmp_path):
 
 def test_no_plot_is_cut_at_its_edges(signed):
     _, out = signed
-    for name in ('residuals', 'characteristics', 'ranking'):  # ranking: a long channel name
+    for name in ('residual_map', 'residuals', 'characteristics', 'ranking'):  # ranking: long name
         assert _edges_blank(out / f'{name}.png'), name
 
 

@@ -16,13 +16,16 @@ import numpy as np
 
 from satmotor_ros.identify.base import BaseFit, fit_base
 from satmotor_ros.identify.candidates import build_library, Candidate
+from satmotor_ros.identify.coverage import COVERED, coverage, envelope, envelope_share, MOST, TAIL
 from satmotor_ros.identify.errors import DataError, IdentificationError
 from satmotor_ros.identify.families import compare_families, family_specs, FamilyChoice
 from satmotor_ros.identify.fit import check_identifiable, FitReport, MIN_POINTS, written
 from satmotor_ros.identify.parts import loss_parts, LossParts, predict_flow
+from satmotor_ros.identify.regions import describe, Space
 from satmotor_ros.identify.selection import (at_bound, CrossValidatedSelector, Errors, Forward,
                                              Score, Selection)
-from satmotor_ros.identify.steady import extract_steady, looks_like_series, SteadyTolerance
+from satmotor_ros.identify.steady import (extract_steady, looks_like_series, steady_windows,
+                                          SteadyTolerance)
 from satmotor_ros.identify.table import BenchTable
 from satmotor_ros.identify.transient import (dynamics_summary, Samples, transient_samples,
                                              TransientOptions)
@@ -79,6 +82,7 @@ class Calibration:
     inflation: float = 1.0  # variance inflation of the final fit's residuals [-]
     n_folds: int = 5  # cross-validation folds asked for (at most one per point) [-]
     base: BaseFit | None = None  # the nonlinear coefficients the base fitted and kept
+    coverage: dict[str, Any] = field(default_factory=dict)  # Rows.coverage
 
     @property
     def selection(self) -> Selection:
@@ -177,6 +181,22 @@ class Calibration:
             out.append(row)
         return out
 
+    def missed_regions(self) -> list[dict[str, Any]]:
+        """
+        Describe each region the final model misses (:mod:`.regions`), most rows first.
+
+        Returns
+        -------
+        list of dict
+            kind, rows, direction, dp_mpa, speed_rpm, time_s (a time series) and
+            mean_residual_lpm (measured minus predicted flow, as read), per region.
+
+        """
+        p = self.parts
+        residual = (p.flow - self.forward.final.fit.predict(p)) * p.sign
+        space = Space(p.sign * p.dp, p.rotation * p.speed, self.table.channels.get('time'))
+        return [describe(kind, rows, residual, space) for kind, rows in self.forward.missed]
+
     def summary(self) -> dict[str, Any]:
         """
         Build the calibration.json object, with exactly the DESIGN.md fields.
@@ -204,7 +224,10 @@ class Calibration:
             'unit': first.get('unit'),
             'error_before': self.error_before.as_dict(),
             'error_after': self.error_after.as_dict(),
+            **self.with_outliers(),
+            'coverage': self.coverage,
             'effects': effects, 'outliers': self.outlier_rows(),
+            'missed_regions': self.missed_regions(),
             'candidates': [
                 {'effect': s.effect, 'regressor': s.candidate.regressor if s.candidate else None,
                  'cv_rmse_lpm': written(s.cv_rmse / LPM)} for s in ranked],
@@ -212,6 +235,25 @@ class Calibration:
             **self.mode_fields(),
             **self.warnings(),
         }
+
+    def with_outliers(self) -> dict[str, dict[str, float]]:
+        """
+        Return the errors before and after over every row, outliers included.
+
+        Returns
+        -------
+        dict
+            ``error_before_with_outliers`` and ``error_after_with_outliers``: out of
+            sample as ``error_before`` and ``error_after``, over every row (every
+            steady point, window or bin of samples) instead of the rows that are not
+            outliers.
+
+        """
+        loss = self.parts.loss
+        return {'error_before_with_outliers':
+                Errors.of(self.selection.baseline.cv_error, loss).as_dict(),
+                'error_after_with_outliers':
+                Errors.of(self.forward.final.cv_error, loss).as_dict()}
 
     def warnings(self) -> dict[str, list[str]]:
         """
@@ -251,19 +293,18 @@ class Calibration:
 
     def mode_fields(self) -> dict[str, Any]:
         """
-        Build calibration.json's fields beyond DESIGN.md's, in ``'transient'`` mode only.
+        Build calibration.json's fields on how the rows were read.
 
         Returns
         -------
         dict
-            Empty for steady points; for all samples ``mode``, ``mode_reason``,
-            ``n_samples``, ``bin_size`` (sample steps per row), ``variance_inflation``
+            ``mode`` and ``mode_reason`` always; for all samples also ``n_samples``, ``bin_size`` (sample steps per row), ``variance_inflation``
             and ``dynamics`` (each transient term's coefficient with its ci95, unit and
             meaning, :func:`~satmotor_ros.identify.transient.dynamics_summary`).
 
         """
         if self.samples is None:
-            return {}
+            return {'mode': self.mode, 'mode_reason': self.mode_reason}
         return {'mode': self.mode, 'mode_reason': self.mode_reason,
                 'n_samples': self.samples.n_samples, 'bin_size': self.samples.bin_size,
                 'variance_inflation': written(self.inflation),
@@ -353,10 +394,11 @@ class Rows:
     mode: Mode  # 'points', 'series' or 'transient'
     reason: str  # why that mode, one sentence
     samples: Samples | None = None  # the time series' samples in 'transient' mode
+    coverage: dict[str, Any] = field(default_factory=dict)  # coverage.coverage() of the rows
 
 
 def _steady_rows(model: MotorModel, table: BenchTable, points: BenchTable, mode: Mode,
-                 reason: str, check: bool) -> Rows:
+                 reason: str, check: bool, used: int | None = None) -> Rows:
     rows = _source_rows(table, points)
     parts, usable = loss_parts(model, points)
     if not usable.all():
@@ -366,27 +408,42 @@ def _steady_rows(model: MotorModel, table: BenchTable, points: BenchTable, mode:
         rows = None if rows is None else rows[usable]
     if check:
         check_identifiable(parts)
-    return Rows(points, parts, rows, mode, reason)
+    dp = points.p_in - points.p_out
+    return Rows(points, parts, rows, mode, reason,
+                coverage=coverage(len(points) if used is None else used, len(table), dp,
+                                  points.speed))
 
 
 def _transient_rows(model: MotorModel, table: BenchTable, options: Options,
                     reason: str, check: bool) -> Rows:
     samples = transient_samples(model, table, options.transient)
     if len(samples.parts) < MIN_POINTS:
-        msg = (f'too few rows: {samples.n_samples} of {len(table)} samples are usable, '
-               f'{len(samples.parts)} rows of {samples.bin_size} sample steps, need >= '
+        msg = (f'too few rows: {samples.n_samples} of {len(table)} samples are '
+               f'usable, {len(samples.parts)} rows of {samples.bin_size} sample steps, need >= '
                f'{MIN_POINTS}; a sample needs finite readings and a chamber drop within the '
                "model's limit, and a row needs neighbouring samples without a gap")
         raise IdentificationError(msg)
     if check:
         check_identifiable(samples.parts)
-    return Rows(samples.table, samples.parts, None, 'transient', reason, samples)
+    raw = samples.samples
+    at = samples.in_bins
+    return Rows(samples.table, samples.parts, None, 'transient', reason, samples,
+                coverage(samples.n_samples, len(table), (raw.p_in - raw.p_out)[at],
+                         raw.speed[at]))
 
 
 def read_rows(model: MotorModel, table: BenchTable, options: Options,
               check: bool = True) -> Rows:
     """
-    Read the rows as the mode says; in ``'auto'``, every sample when steady windows are few.
+    Read the rows as the mode says; in ``'auto'``, a time series' every sample by default.
+
+    In ``'auto'`` mode a time series is read as its steady windows only when there are
+    at least ``options.transient.min_steady`` of them, they hold most of its samples
+    (:data:`~satmotor_ros.identify.coverage.MOST`) and span its operating envelope
+    (:data:`~satmotor_ros.identify.coverage.COVERED` of the range of |dp| and of |n| in
+    each direction it runs in); otherwise every usable sample is used, with the transient
+    terms. Effects that live between the windows (a valve that opens during the fast
+    moves) are thus never hidden by the choice of rows.
 
     Parameters
     ----------
@@ -404,7 +461,7 @@ def read_rows(model: MotorModel, table: BenchTable, options: Options,
     Returns
     -------
     Rows
-        The rows, the model's components there, and the mode and why.
+        The rows, the model's components there, the mode and why, and the coverage.
 
     """
     mode = options.mode
@@ -416,23 +473,47 @@ def read_rows(model: MotorModel, table: BenchTable, options: Options,
     if mode != 'auto' or not is_series(table):
         why = {'points': 'asked for (--mode points)', 'series': 'asked for (--mode series)',
                'auto': 'the rows are not a time series: each is a steady point'}[mode]
+        if mode == 'series' or (mode == 'auto' and is_series(table)):
+            points, used = steady_windows(table, options.steady)
+            return _steady_rows(model, table, points, 'series', why, check, used)
         points = steady_points(table, mode, options.steady)
-        return _steady_rows(model, table, points, 'series' if mode == 'series' else 'points',
-                            why, check)
+        return _steady_rows(model, table, points, 'points', why, check)
     least = max(options.transient.min_steady, MIN_POINTS)
     try:
-        rows = _steady_rows(model, table, extract_steady(table, options.steady), 'series', '',
-                            check)
+        points, used = steady_windows(table, options.steady)
+        rows = _steady_rows(model, table, points, 'series', '', check, used)
     except (DataError, IdentificationError) as err:
         why = f'no usable steady windows ({err})'
     else:
-        if len(rows.parts) >= least:
-            return replace(rows, reason=f'a time series with {len(rows.parts)} steady '
-                                        f'windows (>= {least})')
-        why = f'only {len(rows.parts)} steady windows (< {least})'
+        why = _windows_verdict(table, rows, least)
+        if not why:
+            share = rows.coverage['envelope_share']
+            return replace(rows, reason=(
+                f'a time series whose {len(rows.parts)} steady windows (>= {least}) hold '
+                f'{100 * rows.coverage["fraction"]:.0f} % of the samples (>= '
+                f'{100 * MOST:.0f} %) and span {100 * share:.0f} % of its operating envelope '
+                f'(>= {100 * COVERED:.0f} %)'))
     return _transient_rows(model, table, options,
-                           f'a time series of {len(table)} samples with {why}: every sample '
+                           f'a time series of {len(table)} samples whose {why}: every sample '
                            'used, with the transient terms', check)
+
+
+def _windows_verdict(table: BenchTable, rows: Rows, least: int) -> str:
+    """Say why the steady windows do not stand for the recording ('' when they do)."""
+    dp = table.p_in - table.p_out
+    recording = envelope(dp, table.speed, TAIL)
+    share = envelope_share(rows.coverage['envelope'], recording, len(table))
+    rows.coverage['envelope_share'] = float(f'{share:.4g}')
+    fraction = rows.coverage['fraction']
+    held = (f'{len(rows.parts)} steady windows hold {100 * fraction:.0f} % of the samples and '
+            f'span {100 * share:.0f} % of its operating envelope')
+    if len(rows.parts) < least:
+        return f'{held} (need >= {least} windows)'
+    if fraction < MOST:
+        return f'{held} (need >= {100 * MOST:.0f} % of the samples)'
+    if share < COVERED:
+        return f'{held} (need >= {100 * COVERED:.0f} % of the envelope in each direction)'
+    return ''
 
 
 def _without_effects(spec: MotorSpec, liquid: str,
@@ -494,7 +575,7 @@ def calibrate(table: BenchTable, liquid: str = 'oil', spec: MotorSpec | None = N
     channels = {**points.channels, 'p_in': points.p_in, 'p_out': points.p_out}
     candidates, skipped = build_library(parts, channels, law, model.family.name)
     selector = _selector(options, points, samples)
-    forward = selector.select(parts, candidates)
+    forward = selector.select(parts, candidates, points.channels.get('time'))
     first = forward.steps[0]
     packaged_error = parts.flow - predict_flow(parts, np.ones(len(parts.components)))
     at = ~forward.outliers
@@ -512,7 +593,7 @@ def calibrate(table: BenchTable, liquid: str = 'oil', spec: MotorSpec | None = N
                        Errors.of(first.baseline.cv_error[at], parts.loss[at]),
                        Errors.of(forward.final.cv_error[at], parts.loss[at]), rows, choice,
                        read.mode, read.reason, samples, inflation,
-                       options.n_folds, base)
+                       options.n_folds, base, read.coverage)
 
 
 def _with_base(spec: MotorSpec, liquid: str, table: BenchTable, options: Options, read: Rows,
@@ -525,7 +606,8 @@ def _with_base(spec: MotorSpec, liquid: str, table: BenchTable, options: Options
     if not base.changed:
         return base.spec, model, read, base
     again = read_rows(model, table, replace(options, mode=read.mode))
-    return base.spec, model, replace(again, reason=read.reason), base
+    return base.spec, model, replace(again, reason=read.reason,
+                                     coverage={**read.coverage, **again.coverage}), base
 
 
 def _selector(options: Options, points: BenchTable,
@@ -564,7 +646,9 @@ def _family_and_rows(spec: MotorSpec, liquid: str, table: BenchTable,
     if read is None:
         return spec, model, read_rows(model, table, options), choice
     again = read_rows(model, table, replace(options, mode=read.mode))
-    return spec, model, replace(again, reason=read.reason), choice  # why the mode: as decided
+    # why the mode: as decided on the first reading
+    return spec, model, replace(again, reason=read.reason,
+                                coverage={**read.coverage, **again.coverage}), choice
 
 
 IMPLAUSIBLE = 'implausible data'

@@ -15,6 +15,7 @@ import numpy as np
 from satmotor_ros.identify.output import effect_block, fitted_coefficients
 from satmotor_ros.identify.parts import LossParts
 from satmotor_ros.identify.pipeline import AT_BOUND, Calibration
+from satmotor_ros.identify.residual_map import coverage_section, plot_residual_map
 from satmotor_ros.identify.selection import at_bound, Errors
 from satmotor_ros.identify.table import BenchTable
 from satmotor_ros.identify.transient import transient_section
@@ -274,8 +275,8 @@ def _plot_ranking(cal: Calibration, path: Path) -> None:
     plt.close(fig)
 
 
-PLOTS = {'residuals': _plot_residuals, 'characteristics': _plot_characteristics,
-         'ranking': _plot_ranking}
+PLOTS = {'residual_map': plot_residual_map, 'residuals': _plot_residuals,
+         'characteristics': _plot_characteristics, 'ranking': _plot_ranking}
 """The report's plots: ``<name>.png`` beside ``report.md``, in the report's order."""
 
 
@@ -314,13 +315,14 @@ def _outliers(cal: Calibration, summary: dict[str, Any]) -> list[str]:
              f'Noise of the measured flow estimated from the residuals: {np.min(sigma):.3g} to '
              f'{np.max(sigma):.3g} l/min (a floor plus a share of the reading). Each step weighs '
              "the points by it and by Huber's loss, and leaves out the points that are "
-             'outliers even under its best-fitting model.', '']
+             'isolated outliers even under its best-fitting model; outliers that cluster with '
+             'their neighbours stay in (see the regions above).', '']
     if not rows:
         return lines + ['No outlier.', '']
     keys = list(rows[0])
     return lines + [_table([[str(r[k]) for k in keys] for r in rows], keys), '',
-                    'These points decide nothing: they are left out of the fits and the '
-                    'error figures.', '']
+                    'These points decide nothing: they are left out of the fits and of the '
+                    'first error figures (the second pair includes them).', '']
 
 
 def _identifiability(cal: Calibration) -> list[str]:
@@ -401,7 +403,7 @@ def _written_effects(summary: dict[str, Any]) -> list[str]:
 
 def write_report(cal: Calibration, out: Path, summary: dict[str, object]) -> Path:
     """
-    Write ``report.md`` and its three PNG plots into `out`.
+    Write ``report.md`` and its PNG plots (:data:`PLOTS`) into `out`.
 
     Parameters
     ----------
@@ -432,6 +434,7 @@ def write_report(cal: Calibration, out: Path, summary: dict[str, object]) -> Pat
     lines += [''] + _families(cal)
     lines += ['## Result', '', f'**Effects: {found}**, found one after the other:', '']
     lines += _steps(cal) + ['']
+    lines += coverage_section(cal, summary)
     for step in cal.forward.steps:
         if step.runner_up is not None and step.chosen is not None:
             lines += [f'Runner-up of `{step.chosen.label}`: `{step.runner_up.label}`. The two '

@@ -31,9 +31,12 @@ candidates it refused when they fitted better than all of those.
 Every step weighs the points by a noise model estimated from the residuals
 of the step's best-fitting model (:mod:`.noise`): the F-test and the
 cross-validated error are those of standardised residuals, through Huber's
-loss, and the points that are outliers even under that model are left out of
-the step's fits, so that a bad row decides nothing, while a point that an
-effect explains is never mistaken for one.
+loss, and the points that are isolated outliers even under that model are
+left out of the step's fits, so that a bad row decides nothing, while a point
+that an effect explains is never mistaken for one. Outliers that cluster in
+the operating space or in time (:mod:`.regions`) are structure, not bad rows:
+they stay in every fit, where a candidate may explain them, and those the
+final model still misses are named as regions.
 
 Rows of a time series (:mod:`.transient`) have correlated residuals: a test
 fold then also keeps ``guard`` rows on each side out of its training, and the
@@ -52,6 +55,7 @@ from satmotor_ros.identify.errors import IdentificationError
 from satmotor_ros.identify.fit import HUBER, LossFit
 from satmotor_ros.identify.noise import noise_model, outliers, robust_scale
 from satmotor_ros.identify.parts import LossParts
+from satmotor_ros.identify.regions import clustered, regions, Space
 from satmotor_ros.identify.transient import variance_inflation
 from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.units import LPM
@@ -155,7 +159,8 @@ class Forward:
     steps: tuple[Selection, ...]  # every step; the last one chose nothing (or hit the limit)
     final: Score  # the model with every effect found
     sigma: FloatArray  # noise model of the last step [m^3/s]
-    outliers: np.ndarray  # bool: beyond the outlier limit under the final model
+    outliers: np.ndarray  # bool: isolated and beyond the outlier limit under the final model
+    missed: tuple[tuple[str, np.ndarray], ...] = ()  # kind and rows of each region missed
 
     @property
     def found(self) -> tuple[Score, ...]:
@@ -271,6 +276,7 @@ class CrossValidatedSelector:
         self.guard = guard if time_ordered else 0
         self.correlated = correlated
         self._tried: dict[int, FloatArray] = {}  # candidate id -> its parameters last fitted
+        self._space: Space | None = None  # where the rows lie, for clusters of outliers
 
     def score(self, parts: LossParts, effects: Sequence[Candidate], sigma: FloatArray,
               index: np.ndarray, start: FloatArray | None = None,
@@ -374,7 +380,21 @@ class CrossValidatedSelector:
         best = min([base, *fits], key=lambda f: f.objective_)
         residual = parts.flow - best.predict(parts)
         sigma = noise_model(residual, parts.flow, best.n_params, floor)
-        return sigma, outliers(residual, sigma), fits
+        return sigma, self._isolated(parts, residual, sigma), fits
+
+    def _isolated(self, parts: LossParts, residual: FloatArray,
+                  sigma: FloatArray) -> np.ndarray:
+        """Flag the outliers that do not cluster (:mod:`.regions`): the rows left out."""
+        flagged = outliers(residual, sigma)
+        if not flagged.any():
+            return flagged
+        return flagged & ~clustered(flagged, residual / sigma, self.space(parts))
+
+    def space(self, parts: LossParts) -> Space:
+        """Return where the rows lie (signed drop and speed, and time when given)."""
+        if self._space is None or self._space.dp.size != len(parts):
+            self._space = Space(parts.sign * parts.dp, parts.rotation * parts.speed)
+        return self._space
 
     def step(self, parts: LossParts, found: tuple[Candidate, ...],
              pool: Sequence[Candidate], start: FloatArray | None) -> Selection:
@@ -455,7 +475,8 @@ class CrossValidatedSelector:
         return Selection(baseline, ranking, best, runner, verdict + _at_bound(refused),
                          self.alpha, sigma, left_out, refused)
 
-    def select(self, parts: LossParts, candidates: Sequence[Candidate]) -> Forward:
+    def select(self, parts: LossParts, candidates: Sequence[Candidate],
+               time: FloatArray | None = None) -> Forward:
         """
         Add effects while the best remaining candidate passes the tests.
 
@@ -465,6 +486,8 @@ class CrossValidatedSelector:
             Components at the points, [-]
         candidates : sequence of Candidate
             The library built for these data, [-]
+        time : ndarray, optional
+            Time of each point, where outliers may also cluster, [s]
 
         Returns
         -------
@@ -475,6 +498,8 @@ class CrossValidatedSelector:
         found: tuple[Candidate, ...] = ()
         steps: list[Selection] = []
         self._tried = {}
+        self._space = Space(parts.sign * parts.dp, parts.rotation * parts.speed,
+                            None if time is None else np.asarray(time, dtype=float))
         start = None
         while True:
             pool = [c for c in candidates if not any(same_effect(c, f) for f in found)]
@@ -491,7 +516,9 @@ class CrossValidatedSelector:
         final = accepted[-1] if accepted else steps[0].baseline
         residual = parts.flow - final.fit.predict(parts)
         sigma = steps[-1].sigma
-        return Forward(tuple(steps), final, sigma, outliers(residual, sigma))
+        flagged = outliers(residual, sigma)
+        return Forward(tuple(steps), final, sigma, self._isolated(parts, residual, sigma),
+                       tuple(regions(flagged, residual / sigma, self.space(parts))))
 
 
 def _guarded(test: np.ndarray, guard: int, n: int) -> np.ndarray:

@@ -190,6 +190,28 @@ def extract_steady(table: BenchTable, tol: SteadyTolerance | None = None) -> Ben
     """
     Average each steady window of a time series into one operating point.
 
+    As :func:`steady_windows`, without the count of samples.
+
+    Parameters
+    ----------
+    table : BenchTable
+        Raw samples with a ``time`` channel, [-]
+    tol : SteadyTolerance, optional
+        The tolerances; the defaults when omitted, [-]
+
+    Returns
+    -------
+    BenchTable
+        One row per steady window, ``time_series`` False.
+
+    """
+    return steady_windows(table, tol)[0]
+
+
+def steady_windows(table: BenchTable, tol: SteadyTolerance | None = None) -> tuple[BenchTable, int]:
+    """
+    Average each steady window of a time series into one operating point.
+
     Every channel is averaged over the window, so extra channels survive;
     a ``revolutions`` channel (cumulative shaft revolutions at the window's
     mean time, integrated over the raw samples) is added, and ``time`` is the
@@ -206,6 +228,8 @@ def extract_steady(table: BenchTable, tol: SteadyTolerance | None = None) -> Ben
     -------
     BenchTable
         One row per steady window, ``time_series`` False.
+    int
+        Samples in the windows, [-]
 
     Raises
     ------
@@ -246,4 +270,4 @@ def extract_steady(table: BenchTable, tol: SteadyTolerance | None = None) -> Ben
             f'({100.0 * used / len(table):.0f} % of the samples)')
     return BenchTable(average(table.speed), average(table.flow), average(table.p_in),
                       average(table.p_out), channels, units, table.source, False,
-                      table.notes + (note,))
+                      table.notes + (note,)), used

@@ -124,6 +124,7 @@ class Samples:
     samples: BenchTable  # the raw samples in time order (with revolutions)
     usable: np.ndarray  # which of them the model can use [-]
     bounds: tuple[np.ndarray, np.ndarray]  # first and last sample of each row [-]
+    in_bins: np.ndarray  # which of the raw samples a row holds [-]
 
     guard = 1
     """Rows a test fold keeps out of training on each side: neighbours share a sample."""
@@ -445,7 +446,8 @@ def transient_samples(model: MotorModel, table: BenchTable,
     in_bins = np.zeros(time.size + 1, dtype=int)
     np.add.at(in_bins, a, 1)
     np.add.at(in_bins, b + 1, -1)
-    n_samples = int(np.count_nonzero(np.cumsum(in_bins)[:-1]))
+    held = np.cumsum(in_bins)[:-1] > 0
+    n_samples = int(np.count_nonzero(held))
     n_segments = int(first.sum())
     note = (f'all samples: {n_samples} of {len(table)} ({100.0 * n_samples / len(table):.0f} %) '
             f'in {n_segments} stretch(es) without a gap, step {step:.4g} s, averaged over '
@@ -454,7 +456,7 @@ def transient_samples(model: MotorModel, table: BenchTable,
     lags = [nuisance[name] for name in ('speed_lag', 'flow_lag') if name in nuisance]
     correlation = float(np.corrcoef(lags[0], lags[1])[0, 1]) if len(lags) == 2 else np.nan
     return Samples(rows, parts, n_samples, size, step, n_segments, tuple(left_out),
-                   correlation, table, usable, (a, b))
+                   correlation, table, usable, (a, b), held)
 
 
 def averaged(samples: Samples, x: FloatArray) -> FloatArray:
