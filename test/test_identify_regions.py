@@ -52,7 +52,7 @@ def test_a_span_of_time_clusters():
 
 @pytest.fixture(scope='module')
 def bump():
-    """A bump of flow in one region of the operating space no candidate has, and a bad row."""
+    """Calibrate on a bump of flow in one region no candidate has, beside a bad row."""
     table = generate(Plan(liquid='oil', n_points=120), Injection(), seed=2)
     dp = table.p_in - table.p_out
     region = (dp > 10e6) & (dp < 15e6) & (table.speed > 500 * RPM) & (table.speed < 1000 * RPM)

@@ -9,6 +9,7 @@ from pathlib import Path
 from satmotor_ros.cli._bench import add_data_arguments, load_data, run_bench_command
 from satmotor_ros.cli._common import add_motor_options
 from satmotor_ros.cli._output import check_target, output_dir, written_by
+from satmotor_ros.identify.coverage import calibrated_envelope
 from satmotor_ros.identify.pipeline import Mode, MODES
 from satmotor_ros.identify.validate import validate
 from satmotor_ros.identify.validation_report import write_validation
@@ -58,13 +59,18 @@ def _validate(data: str, out: str, mode: Mode, options: MotorOptions, columns: s
     check_target('--out', Path(out), inputs, force, written_by('validate'), 'validate')
     model = options.build_model()
     table = load_data(data, columns, model.geometry.displacement)
-    result = validate(table, model, options.liquid, mode)
+    calibrated = calibrated_envelope(options.motor_file) if options.motor_file else None
+    result = validate(table, model, options.liquid, mode, calibrated=calibrated)
     with output_dir('--out', out, 'validate', inputs, force) as tmp:
         summary = write_validation(result, tmp)
     target = Path(out)
     error = summary['error']
     outside = summary['n_extrapolated']
     flagged = f' ({outside} flagged EXTRAPOLATED)' if outside else ''
+    beyond = summary['outside_calibrated_envelope']
+    if beyond['share']:
+        flagged += (f'; {100 * beyond["share"]:.0f} % of the samples outside the calibrated '
+                    'envelope')
     return (f'{model.name}, set {options.liquid}, effects: {result.describe_effects()}; '
             f'RMSE of Q_vl {error["rmse_lpm"]:.4g} l/min, mean {error["mean_abs_pct"]:.3g} %, '
             f'max {error["max_abs_lpm"]:.4g} l/min over {summary["n_points"]} points{flagged}, '

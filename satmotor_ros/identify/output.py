@@ -132,6 +132,8 @@ def _document(cal: Calibration) -> dict[str, Any]:
         'valid_range': {f.name: float(getattr(spec.valid_range, f.name))
                         for f in fields(spec.valid_range)},
         'coefficient_sets': {cal.liquid: entry},
+        # where the fit's data lie; `satmotor validate` counts the samples outside it
+        'coverage': cal.coverage,
     }
 
 

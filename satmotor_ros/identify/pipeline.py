@@ -16,7 +16,8 @@ import numpy as np
 
 from satmotor_ros.identify.base import BaseFit, fit_base
 from satmotor_ros.identify.candidates import build_library, Candidate
-from satmotor_ros.identify.coverage import COVERED, coverage, envelope, envelope_share, MOST, TAIL
+from satmotor_ros.identify.coverage import (coverage, COVERED, envelope, envelope_share, MOST,
+                                            TAIL)
 from satmotor_ros.identify.errors import DataError, IdentificationError
 from satmotor_ros.identify.families import compare_families, family_specs, FamilyChoice
 from satmotor_ros.identify.fit import check_identifiable, FitReport, MIN_POINTS, written
@@ -298,9 +299,10 @@ class Calibration:
         Returns
         -------
         dict
-            ``mode`` and ``mode_reason`` always; for all samples also ``n_samples``, ``bin_size`` (sample steps per row), ``variance_inflation``
-            and ``dynamics`` (each transient term's coefficient with its ci95, unit and
-            meaning, :func:`~satmotor_ros.identify.transient.dynamics_summary`).
+            ``mode`` and ``mode_reason`` always; for all samples also ``n_samples``,
+            ``bin_size`` (sample steps per row), ``variance_inflation`` and ``dynamics``
+            (each transient term's coefficient with its ci95, unit and meaning,
+            :func:`~satmotor_ros.identify.transient.dynamics_summary`).
 
         """
         if self.samples is None:

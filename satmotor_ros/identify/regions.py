@@ -9,15 +9,15 @@ row is isolated: its neighbours fit. So an outlier counts as *clustered* when, a
 :data:`NEIGHBOURS` nearest rows in the operating space (signed dp and signed speed, each
 scaled by its range) or in time, at least :data:`MIN_AGREE` miss the same way by more
 than :data:`NEIGHBOUR_Z` noise levels, and by at least 1/:data:`LIKE` of the outlier's
-miss; so does an outlier next to a clustered one that misses alike (the region's edge). Clustered outliers stay in the fits, where
-the candidates may explain them; only isolated ones are left out. Clustered outliers
-that the final model still misses are grouped into regions (neighbours linked) and
-named in the report.
+miss; so does an outlier next to a clustered one that misses alike (the region's edge).
+Clustered outliers stay in the fits, where the candidates may explain them; only
+isolated ones are left out. Clustered outliers that the final model still misses are
+grouped into regions (neighbours linked) and named in the report.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -53,26 +53,48 @@ class Space:
     dp: FloatArray  # signed drop p_in - p_out [Pa]
     speed: FloatArray  # signed speed [rad/s]
     time: FloatArray | None = None  # [s], or None for steady points without time
+    cache: dict[str, Any] = field(default_factory=dict, compare=False, repr=False)
 
     def spaces(self) -> list[FloatArray]:
         """Return the scaled coordinates: the operating space, then time (if any)."""
-        def scaled(x: FloatArray) -> FloatArray:
-            span = float(np.ptp(x)) if x.size else 0.0
-            return (x - float(np.min(x))) / span if span > 0.0 else np.zeros_like(x)
-        out = [np.column_stack([scaled(self.dp), scaled(self.speed)])]
-        if self.time is not None and np.all(np.isfinite(self.time)):
-            out.append(scaled(self.time)[:, None])
-        return out
+        if 'spaces' not in self.cache:
+            def scaled(x: FloatArray) -> FloatArray:
+                span = float(np.ptp(x)) if x.size else 0.0
+                return (x - float(np.min(x))) / span if span > 0.0 else np.zeros_like(x)
+            out = [np.column_stack([scaled(self.dp), scaled(self.speed)])]
+            if self.time is not None and np.all(np.isfinite(self.time)):
+                out.append(scaled(self.time)[:, None])
+            self.cache['spaces'] = out
+        return list(self.cache['spaces'])
 
+    def neighbours(self, which: int, at: np.ndarray, k: int) -> np.ndarray:
+        """
+        Return the `k` nearest other rows of each row in `at`.
 
-def _neighbours(coords: FloatArray, at: np.ndarray, k: int) -> np.ndarray:
-    """Return the `k` nearest other rows of each row in `at`, [-]."""
-    tree = spatial.cKDTree(coords)
-    _, idx = tree.query(coords[at], k=k + 1)
-    idx = np.asarray(idx).reshape(at.size, k + 1)
-    own = idx == at[:, None]
-    keep = np.where(own.any(axis=1, keepdims=True), ~own, np.arange(k + 1) < k)
-    return idx[keep].reshape(at.size, k)
+        Parameters
+        ----------
+        which : int
+            The space, as :meth:`spaces` orders them, [-]
+        at : ndarray of int
+            Rows, [-]
+        k : int
+            Neighbours of each, [-]
+
+        Returns
+        -------
+        ndarray of int
+            ``(at.size, k)`` rows, nearest first.
+
+        """
+        coords = self.spaces()[which]
+        key = f'tree{which}'
+        if key not in self.cache:  # a step asks many times: build each tree once
+            self.cache[key] = spatial.cKDTree(coords)
+        _, idx = self.cache[key].query(coords[at], k=k + 1)
+        idx = np.asarray(idx).reshape(at.size, k + 1)
+        own = idx == at[:, None]
+        keep = np.where(own.any(axis=1, keepdims=True), ~own, np.arange(k + 1) < k)
+        return idx[keep].reshape(at.size, k)
 
 
 def clustered(flagged: np.ndarray, z: FloatArray, space: Space) -> np.ndarray:
@@ -103,7 +125,7 @@ def clustered(flagged: np.ndarray, z: FloatArray, space: Space) -> np.ndarray:
         return out
     at = np.flatnonzero(flagged)
     sign = np.sign(z)
-    nears = [_neighbours(coords, at, k) for coords in space.spaces()]
+    nears = [space.neighbours(i, at, k) for i in range(len(space.spaces()))]
     size = np.abs(z)
 
     def alike(near: np.ndarray) -> np.ndarray:
@@ -152,8 +174,8 @@ def regions(flagged: np.ndarray, z: FloatArray, space: Space) -> list[tuple[str,
     sign = np.sign(z)
     k = min(NEIGHBOURS, flagged.size - 1)
     found: list[tuple[str, np.ndarray]] = []
-    for kind, coords in zip(('operating space', 'time span'), space.spaces()):
-        near = _neighbours(coords, at, k)
+    for i, kind in zip(range(len(space.spaces())), ('operating space', 'time span')):
+        near = space.neighbours(i, at, k)
         found += [(kind, g) for g in _linked(at, near, sign)]
     return sorted(found, key=lambda g: -g[1].size)
 
@@ -208,7 +230,8 @@ def describe(kind: str, rows: np.ndarray, residual: FloatArray, space: Space) ->
     direction = 'both' if len(signs) != 1 else ('positive' if signs == {1.0} else 'negative')
     out: dict[str, Any] = {
         'kind': kind, 'rows': int(rows.size), 'direction': direction,
-        'dp_mpa': [float(f'{float(np.min(dp)) / MPA:.4g}'), float(f'{float(np.max(dp)) / MPA:.4g}')],
+        'dp_mpa': [float(f'{float(np.min(dp)) / MPA:.4g}'),
+                   float(f'{float(np.max(dp)) / MPA:.4g}')],
         'speed_rpm': [float(f'{float(np.min(n)) / RPM:.4g}'),
                       float(f'{float(np.max(n)) / RPM:.4g}')]}
     if space.time is not None:
@@ -219,5 +242,5 @@ def describe(kind: str, rows: np.ndarray, residual: FloatArray, space: Space) ->
     return out
 
 
-__all__ = ['LIKE', 'MIN_AGREE', 'MIN_REGION', 'NEIGHBOUR_Z', 'NEIGHBOURS', 'Space', 'clustered', 'describe',
-           'regions']
+__all__ = ['LIKE', 'MIN_AGREE', 'MIN_REGION', 'NEIGHBOUR_Z', 'NEIGHBOURS', 'Space', 'clustered',
+           'describe', 'regions']

@@ -38,7 +38,7 @@ def _map(ax: Any, dp: FloatArray, n: FloatArray, residual: FloatArray, limit: fl
          title: str) -> Any:
     """Draw one map panel and return its colour mapping."""
     order = np.argsort(np.abs(residual))  # the largest misses on top
-    style = dict(cmap='RdBu_r', vmin=-limit, vmax=limit)
+    style: dict[str, Any] = {'cmap': 'RdBu_r', 'vmin': -limit, 'vmax': limit}
     if dp.size <= SCATTER_MAX:
         drawn = ax.scatter(dp[order], n[order], c=residual[order], s=14, edgecolors='none',
                            **style)

@@ -31,9 +31,11 @@ candidates it refused when they fitted better than all of those.
 Every step weighs the points by a noise model estimated from the residuals
 of the step's best-fitting model (:mod:`.noise`): the F-test and the
 cross-validated error are those of standardised residuals, through Huber's
-loss, and the points that are isolated outliers even under that model are
-left out of the step's fits, so that a bad row decides nothing, while a point
-that an effect explains is never mistaken for one. Outliers that cluster in
+loss, and the points that are isolated outliers under that model and under
+the model with each candidate (judged per candidate, so a row that any
+candidate explains stays in) are left out of the step's fits, so that a bad
+row decides nothing, while a point that an effect explains is never mistaken
+for one. Outliers that cluster in
 the operating space or in time (:mod:`.regions`) are structure, not bad rows:
 they stay in every fit, where a candidate may explain them, and those the
 final model still misses are named as regions.
@@ -364,7 +366,13 @@ class CrossValidatedSelector:
 
     def _noise(self, parts: LossParts, found: tuple[Candidate, ...], pool: Sequence[Candidate],
                start: FloatArray | None) -> tuple[FloatArray, np.ndarray, list[LossFit]]:
-        """Estimate the step's noise and outliers from its best-fitting model."""
+        """
+        Estimate the step's noise from its best-fitting model, and the rows it leaves out.
+
+        A row is left out when it is an isolated outlier (:meth:`_isolated`) under the
+        best-fitting model and under the model with each candidate: a row that any
+        candidate explains stays in every fit of the step.
+        """
         floor = 1e-9 * float(np.max(np.abs(parts.flow)))
         everything = np.arange(len(parts))
         plain = LossFit(found).fit(parts, start=start)
@@ -380,7 +388,12 @@ class CrossValidatedSelector:
         best = min([base, *fits], key=lambda f: f.objective_)
         residual = parts.flow - best.predict(parts)
         sigma = noise_model(residual, parts.flow, best.n_params, floor)
-        return sigma, self._isolated(parts, residual, sigma), fits
+        left_out = self._isolated(parts, residual, sigma)
+        for fit in fits:  # an outlier only if it stays one under each candidate's model
+            if not left_out.any():
+                break
+            left_out &= self._isolated(parts, parts.flow - fit.predict(parts), sigma)
+        return sigma, left_out, fits
 
     def _isolated(self, parts: LossParts, residual: FloatArray,
                   sigma: FloatArray) -> np.ndarray:

@@ -208,7 +208,8 @@ def extract_steady(table: BenchTable, tol: SteadyTolerance | None = None) -> Ben
     return steady_windows(table, tol)[0]
 
 
-def steady_windows(table: BenchTable, tol: SteadyTolerance | None = None) -> tuple[BenchTable, int]:
+def steady_windows(table: BenchTable,
+                   tol: SteadyTolerance | None = None) -> tuple[BenchTable, int]:
     """
     Average each steady window of a time series into one operating point.
 

@@ -17,11 +17,12 @@ fitted on) are kept and counted.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
 
+from satmotor_ros.identify.coverage import outside
 from satmotor_ros.identify.effects import CalibratedModel
 from satmotor_ros.identify.errors import DataError, IdentificationError
 from satmotor_ros.identify.parts import loss_parts, LossParts
@@ -48,6 +49,8 @@ class Validation:
     effects: tuple[dict[str, Any], ...]  # the model's effects as loaded
     invalid: int = 0  # points (rows) left out because the model flags them invalid [-]
     extrapolated: int = 0  # points (rows) kept that the model flags EXTRAPOLATED [-]
+    coverage: dict[str, Any] = field(default_factory=dict)  # the rows' Rows.coverage
+    outside: dict[str, Any] | None = None  # samples outside the calibrated envelope
 
     def describe_effects(self) -> str:
         """Return the effects' names, comma-separated, or ``'none'``."""
@@ -64,14 +67,19 @@ class Validation:
             n_flagged (every point or row the model flags), n_invalid (those left
             out: the model flags them invalid) and n_extrapolated (those kept but
             flagged EXTRAPOLATED: outside the validated range or an effect's fitted
-            range).
+            range), coverage (DESIGN.md) and outside_calibrated_envelope (the samples
+            used that lie outside the envelope the model was calibrated on: samples,
+            of, share; null figures when the motor file holds no envelope).
 
         """
         return {'n_points': len(self.parts), 'error': self.error.as_dict(),
                 'liquid': self.liquid, 'motor': self.model.name,
                 'effects': list(self.effects), 'data': self.table.source,
                 'n_flagged': self.invalid + self.extrapolated, 'n_invalid': self.invalid,
-                'n_extrapolated': self.extrapolated}
+                'n_extrapolated': self.extrapolated, 'coverage': self.coverage,
+                'outside_calibrated_envelope': self.outside or {
+                    'samples': None, 'of': None, 'share': None,
+                    'note': 'the motor file holds no calibrated envelope (coverage)'}}
 
 
 def _bare(model: MotorModel) -> MotorModel:
@@ -82,7 +90,8 @@ def _bare(model: MotorModel) -> MotorModel:
 
 
 def validate(table: BenchTable, model: MotorModel, liquid: str, mode: Mode = 'auto',
-             tol: SteadyTolerance | None = None) -> Validation:
+             tol: SteadyTolerance | None = None,
+             calibrated: dict[str, Any] | None = None) -> Validation:
     """
     Compute the error of `model` on `table` without fitting anything.
 
@@ -100,6 +109,9 @@ def validate(table: BenchTable, model: MotorModel, liquid: str, mode: Mode = 'au
         transient terms are fitted to the residual: the model file does not hold them), [-]
     tol : SteadyTolerance, optional
         Steady-state tolerances, [-]
+    calibrated : dict, optional
+        The envelope the model was calibrated on
+        (:func:`~satmotor_ros.identify.coverage.calibrated_envelope`), [-]
 
     Returns
     -------
@@ -117,15 +129,17 @@ def validate(table: BenchTable, model: MotorModel, liquid: str, mode: Mode = 'au
     read = read_rows(_bare(model), table, Options(mode=mode, steady=tol or SteadyTolerance()),
                      check=False)
     if read.samples is not None:
-        return _validate_samples(read.samples, model, liquid)
+        raw = read.samples.samples.select(read.samples.in_bins)
+        return replace(_validate_samples(read.samples, model, liquid), coverage=read.coverage,
+                       outside=_outside(calibrated, raw))
     points = read.table
     parts, usable = loss_parts(_bare(model), points)
     if not usable.all():
         points = points.select(usable, f'left out {int((~usable).sum())} points outside the '
                                        'model (no flow the model can give, or a chamber '
                                        'drop out of range)')
-    calibrated = CalibratedModel(model)
-    predicted, extrapolated = _predicted(calibrated, points, parts)
+    evaluated = CalibratedModel(model)
+    predicted, extrapolated = _predicted(evaluated, points, parts)
     flagged = ~np.isfinite(predicted)
     if flagged.all():
         msg = f'{points.source}: the model flags every point invalid'
@@ -139,7 +153,17 @@ def validate(table: BenchTable, model: MotorModel, liquid: str, mode: Mode = 'au
     points = _note_extrapolated(points, int(extrapolated.sum()), 'points')
     residual = parts.flow - predicted
     return Validation(liquid, model, points, parts, residual, Errors.of(residual, parts.loss),
-                      tuple(calibrated.describe()), int(flagged.sum()), int(extrapolated.sum()))
+                      tuple(evaluated.describe()), int(flagged.sum()), int(extrapolated.sum()),
+                      read.coverage, _outside(calibrated, points))
+
+
+def _outside(calibrated: dict[str, Any] | None, rows: BenchTable) -> dict[str, Any] | None:
+    """Count the rows (samples) outside the calibrated envelope; None without one."""
+    if calibrated is None:
+        return None
+    out = outside(calibrated, rows.p_in - rows.p_out, rows.speed)
+    return {'samples': int(out.sum()), 'of': int(out.size),
+            'share': float(f'{out.sum() / max(out.size, 1):.4g}')}
 
 
 def _note_extrapolated(points: BenchTable, count: int, what: str) -> BenchTable:

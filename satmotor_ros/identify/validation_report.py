@@ -22,6 +22,25 @@ def _plot_residuals(val: Validation, path: Path) -> None:
                        f'{val.error.rmse_lpm:.4g} l/min)', path)
 
 
+def _coverage_lines(summary: dict[str, Any]) -> list[str]:
+    """Say which samples the error is over and how many lie outside the calibrated envelope."""
+    cov = summary['coverage']
+    lines = ['## Coverage', '']
+    if cov:
+        lines.append(f'The error is over {cov["samples_used"]} of {cov["samples_total"]} '
+                     f'samples ({100 * cov["fraction"]:.0f} %).')
+    beyond = summary['outside_calibrated_envelope']
+    if beyond['share'] is None:
+        lines.append(f'{beyond["note"][0].upper()}{beyond["note"][1:]}: the share of the data '
+                     'outside the range the model was fitted on is unknown.')
+    else:
+        share = 100 * beyond['share']
+        lines.append(f'**{beyond["samples"]} of {beyond["of"]} samples ({share:.1f} %) lie '
+                     'outside the envelope the model was calibrated on** (dp and n per '
+                     'direction, `coverage` in the motor file): there the model extrapolates.')
+    return lines + ['']
+
+
 def _report(val: Validation, summary: dict[str, Any]) -> str:
     """Return ``report.md``'s text."""
     err = val.error
@@ -38,6 +57,7 @@ def _report(val: Validation, summary: dict[str, Any]) -> str:
               'whole table is out of sample for the model. Compare the RMSE with the '
               "calibration's `error_after` (and the sensor noise): much larger, or a trend "
               'in the plots below, means the calibration no longer holds.', '',
+              *_coverage_lines(summary),
               '## Residual against each channel', '',
               *grid_note(channel_axes(val.parts, val.table)), '![residuals](residuals.png)', '',
               '## validation.json', '', '```json', json.dumps(summary, indent=2), '```', '']

@@ -1,0 +1,86 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Coverage: the envelope per direction, its share, and validate's samples outside it."""
+
+import json
+
+import numpy as np
+import pytest
+import yaml
+
+from satmotor_ros.cli import validate as validate_cli
+from satmotor_ros.identify import calibrate, write_csv
+from satmotor_ros.identify.coverage import (calibrated_envelope, envelope, envelope_share,
+                                            outside)
+from satmotor_ros.identify.errors import DataError
+from satmotor_ros.identify.output import write_yaml
+from satmotor_ros.identify.synthetic import generate, Injection, Plan
+from satmotor_ros.interface import MotorOptions
+from satmotor_ros.model.units import LPM, MPA, RPM
+
+
+def test_the_envelope_is_given_per_direction_of_the_drop():
+    dp = np.array([-20e6, -5e6, 2e6, 10e6])
+    speed = np.array([-1000, -200, 100, 800]) * RPM
+    env = envelope(dp, speed)
+    assert env['negative']['dp_mpa'] == [-20.0, -5.0]
+    assert env['negative']['speed_rpm'] == pytest.approx([-1000.0, -200.0])
+    assert env['positive']['dp_mpa'] == [2.0, 10.0] and env['positive']['samples'] == 2
+    # a sample beyond the top of one direction, or in a direction not calibrated, is outside
+    flags = outside({'positive': env['positive']}, np.array([5e6, 12e6, -5e6]),
+                    np.array([400, 400, -200]) * RPM)
+    assert flags.tolist() == [False, True, True]
+
+
+def test_the_share_of_the_envelope_is_the_least_span_covered_in_any_direction():
+    rng = np.random.default_rng(0)
+    dp = np.concatenate([rng.uniform(1e6, 20e6, 500), rng.uniform(-20e6, -1e6, 500)])
+    speed = rng.uniform(100, 1500, 1000) * RPM * np.sign(dp)
+    whole = envelope(dp, speed)
+    low = np.abs(dp) < 10.5e6
+    assert envelope_share(whole, whole, dp.size) == pytest.approx(1.0)
+    assert envelope_share(envelope(dp[low], speed[low]), whole, dp.size) == pytest.approx(
+        0.5, abs=0.05)
+    one_side = dp > 0
+    assert envelope_share(envelope(dp[one_side], speed[one_side]), whole, dp.size) == 0.0
+
+
+def _csv(path, table):
+    write_csv(path, {'time': ('s', table.channels['time']), 'speed': ('rpm', table.speed / RPM),
+                     'flow': ('l/min', table.flow / LPM), 'p_in': ('MPa', table.p_in / MPA),
+                     'p_out': ('MPa', table.p_out / MPA),
+                     'temperature': ('degC', table.channels['temperature'])})
+    return str(path)
+
+
+def test_validate_gives_the_share_of_samples_outside_the_calibrated_envelope(tmp_path, capsys):
+    narrow = generate(Plan(liquid='oil', dp_mpa=(2.0, 12.0), extra_channels=()), Injection(),
+                      seed=4)
+    wide = generate(Plan(liquid='oil', dp_mpa=(2.0, 22.0), extra_channels=()), Injection(),
+                    seed=5)
+    cal = calibrate(narrow, 'oil')
+    write_yaml(cal, tmp_path / 'coefficients.yaml')
+    written = yaml.safe_load((tmp_path / 'coefficients.yaml').read_text())
+    assert written['coverage'] == cal.summary()['coverage']
+    assert calibrated_envelope(tmp_path / 'coefficients.yaml') == written['coverage']['envelope']
+    for table, name, low, high in ((narrow, 'own', 0.0, 0.0), (wide, 'wide', 0.4, 0.6)):
+        out = tmp_path / name
+        code = validate_cli.command(_csv(tmp_path / f'{name}.csv', table), str(out), 'auto',
+                                    MotorOptions('oil', str(tmp_path / 'coefficients.yaml')))
+        assert code == 0, capsys.readouterr().err
+        result = json.loads((out / 'validation.json').read_text())
+        beyond = result['outside_calibrated_envelope']
+        assert low <= beyond['share'] <= high and beyond['of'] == result['n_points']
+        assert result['coverage']['samples_used'] == result['n_points'] >= len(table) - 2
+        report = (out / 'report.md').read_text()
+        assert 'outside the envelope the model was calibrated on' in report
+    assert 'outside the calibrated envelope' in capsys.readouterr().out
+
+
+def test_a_motor_file_without_an_envelope_says_so_and_a_malformed_one_is_refused(tmp_path):
+    plain = tmp_path / 'plain.yaml'
+    plain.write_text('motor: x\n')
+    assert calibrated_envelope(plain) is None
+    bad = tmp_path / 'bad.yaml'
+    bad.write_text('coverage:\n  envelope:\n    positive: {dp_mpa: [5, 1], speed_rpm: [0, 1]}\n')
+    with pytest.raises(DataError, match=r'coverage\.envelope\.positive\.dp_mpa'):
+        calibrated_envelope(bad)
