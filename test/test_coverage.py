@@ -5,7 +5,6 @@ import json
 
 import numpy as np
 import pytest
-import yaml
 
 from satmotor_ros.cli import validate as validate_cli
 from satmotor_ros.identify import calibrate, write_csv
@@ -16,6 +15,7 @@ from satmotor_ros.identify.output import write_yaml
 from satmotor_ros.identify.synthetic import generate, Injection, Plan
 from satmotor_ros.interface import MotorOptions
 from satmotor_ros.model.units import LPM, MPA, RPM
+import yaml
 
 
 def test_the_envelope_is_given_per_direction_of_the_drop():
