@@ -184,7 +184,7 @@ class Calibration:
 
     def missed_regions(self) -> list[dict[str, Any]]:
         """
-        Describe each region the final model misses (:mod:`.regions`), most rows first.
+        Describe each region the final model misses (:mod:`.regions`), largest miss first.
 
         Returns
         -------
@@ -196,7 +196,9 @@ class Calibration:
         p = self.parts
         residual = (p.flow - self.forward.final.fit.predict(p)) * p.sign
         space = Space(p.sign * p.dp, p.rotation * p.speed, self.table.channels.get('time'))
-        return [describe(kind, rows, residual, space) for kind, rows in self.forward.missed]
+        found = [describe(kind, rows, residual, space) for kind, rows in self.forward.missed]
+        # the largest miss first: a few rows far off before many rows a little off
+        return sorted(found, key=lambda r: -r['rows'] * abs(r['mean_residual_lpm']))
 
     def summary(self) -> dict[str, Any]:
         """

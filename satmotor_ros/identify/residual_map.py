@@ -164,7 +164,7 @@ def coverage_section(cal: Calibration, summary: dict[str, Any]) -> list[str]:
                         'misses by more than the outlier limit on several neighbouring rows.', '']
     lines += [f'**The final model misses {len(missed)} region(s)**: outliers that cluster in '
               'the operating space or in time are structure, not bad rows; they stayed in the '
-              'fits, and no candidate explained them. The largest:', '',
+              'fits, and no candidate explained them. The largest (rows times mean miss):', '',
               '| kind | rows | direction | dp [MPa] | n [rpm] | time [s] | mean miss [l/min] |',
               '| --- | --- | --- | --- | --- | --- | --- |']
     for r in missed[:REGIONS_SHOWN]:
