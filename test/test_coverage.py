@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """Coverage: the envelope per direction, its share, and validate's samples outside it."""
 
+from dataclasses import replace
 import json
 
 import numpy as np
@@ -12,8 +13,11 @@ from satmotor_ros.identify.coverage import (calibrated_envelope, envelope, envel
                                             outside)
 from satmotor_ros.identify.errors import DataError
 from satmotor_ros.identify.output import write_yaml
-from satmotor_ros.identify.synthetic import generate, Injection, Plan
+from satmotor_ros.identify.synthetic import (generate, generate_transient, Injection, Plan,
+                                             REALISTIC_DYNAMICS)
+from satmotor_ros.identify.transient import transient_samples
 from satmotor_ros.interface import MotorOptions
+from satmotor_ros.model import MotorModel
 from satmotor_ros.model.units import LPM, MPA, RPM
 import yaml
 
@@ -84,3 +88,14 @@ def test_a_motor_file_without_an_envelope_says_so_and_a_malformed_one_is_refused
     bad.write_text('coverage:\n  envelope:\n    positive: {dp_mpa: [5, 1], speed_rpm: [0, 1]}\n')
     with pytest.raises(DataError, match=r'coverage\.envelope\.positive\.dp_mpa'):
         calibrated_envelope(bad)
+
+
+def test_the_samples_left_out_of_every_row_are_counted_by_reason():
+    table = generate_transient(Plan(liquid='oil'), Injection(), REALISTIC_DYNAMICS, seed=3,
+                               duration_s=20.0)
+    flow = table.flow.copy()
+    flow[100:107] = np.nan
+    samples = transient_samples(MotorModel.default('oil'), replace(table, flow=flow))
+    note = samples.table.notes[-1]
+    assert 'left out: 7 without a finite reading' in note
+    assert samples.n_samples < len(table) - 6

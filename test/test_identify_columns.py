@@ -196,7 +196,22 @@ def test_calibrate_each_mbari_log_with_the_f11_displacement(mbari_calibrations, 
     result = json.loads((out / 'calibration.json').read_text())
     assert result['family'] in FAMILY_NAMES and result['n_points'] >= 20  # both directions
     assert len(result['family_comparison']['families']) == 3
-    assert result['error_after']['rmse_lpm'] <= result['error_before']['rmse_lpm'] < 0.2
+    # the steady windows hold a third of the samples and miss the top of the drop: every
+    # sample is used, and the error is over all of them (1-2 l/min: the valve, the transients)
+    assert result['mode'] == 'transient' and 'every sample' in result['mode_reason']
+    coverage = result['coverage']
+    assert coverage['fraction'] > 0.7 and coverage['samples_total'] > 19000
+    assert coverage['envelope']['negative']['dp_mpa'][0] < -20.0
+    before, after = result['error_before'], result['error_after']
+    # the selection weighs rows by their noise: the plain RMSE may rise a little
+    assert 0.5 < after['rmse_lpm'] <= 1.05 * before['rmse_lpm'] < 3.0
+    assert result['error_after_with_outliers']['rmse_lpm'] >= 0.99 * after['rmse_lpm']
+    # the relief valve at the top of the drop, one direction: found, or named as missed
+    valve = [e for e in result['effects'] if e['effect'].startswith('threshold:')
+             and e.get('direction') == 'negative']
+    missed = [r for r in result['missed_regions'] if r['direction'] == 'negative'
+              and r['dp_mpa'][0] < -19.0 and r['mean_residual_lpm'] < -1.0]
+    assert valve or missed
     report = (out / 'report.md').read_text()
     assert '## Model family' in report and 'columns mapped by' in report
     assert load_motor(out / 'coefficients.yaml').family == result['family']
@@ -206,13 +221,18 @@ def test_calibrate_each_mbari_log_with_the_f11_displacement(mbari_calibrations, 
 def test_validate_one_mbari_logs_calibration_on_the_other(mbari_calibrations, tmp_path, capsys,
                                                           calibrated, data):
     _, out, _ = mbari_calibrations[calibrated]
+    _, own, _ = mbari_calibrations[data]
     log = data_path('real', 'mbari_pto', data)
     code = main(['validate', str(log), '--columns', 'mbari_pto', '--liquid', 'oil',
                  '--motor', str(out / 'coefficients.yaml'), '--out', str(tmp_path / 'val')])
     assert code == 0, capsys.readouterr().err
     validation = json.loads((tmp_path / 'val' / 'validation.json').read_text())
-    assert validation['n_points'] >= 20
-    assert 0.0 < validation['error']['rmse_lpm'] < 2.0
+    assert validation['n_points'] >= 1000  # every sample, in bins
+    # issue 20: one log's calibration predicts the other within 2x that log's own error
+    own_error = json.loads((own / 'calibration.json').read_text())['error_after']['rmse_lpm']
+    assert 0.0 < validation['error']['rmse_lpm'] < 2.0 * own_error
+    beyond = validation['outside_calibrated_envelope']
+    assert 0.0 < beyond['share'] < 0.5 and beyond['of'] > 10000
 
 
 def test_an_older_log_of_the_rig_with_fewer_columns_reads_through_the_same_mapping(tmp_path):

@@ -42,8 +42,9 @@ final model still misses are named as regions.
 
 Rows of a time series (:mod:`.transient`) have correlated residuals: a test
 fold then also keeps ``guard`` rows on each side out of its training, and the
-F-test divides the statistic and the number of rows by the fit's variance
-inflation.
+F-test divides the statistic and the number of rows by the variance inflation
+of the baseline's residuals or of the candidate's, whichever is larger (a
+candidate that bends to slow noise whitens its own residuals).
 """
 
 from __future__ import annotations
@@ -320,7 +321,10 @@ class CrossValidatedSelector:
             q = full.n_params - baseline.fit.n_params
             dof = index.size - full.n_params
             drop = max(baseline.fit.objective_ - full.objective_, 0.0)
-            inflation = self.inflation(parts, full, sigma, index)
+            # under the null: the baseline's residuals keep the slow noise a candidate may
+            # have bent to, so the larger of the two inflations is the honest one
+            inflation = max(self.inflation(parts, full, sigma, index),
+                            self.inflation(parts, baseline.fit, sigma, index))
             if dof > 0 and full.objective_ > 0.0:
                 f = drop / q / (full.objective_ / dof) / inflation
                 p_value = float(special.fdtrc(q, max(int(index.size / inflation)

@@ -451,12 +451,50 @@ def transient_samples(model: MotorModel, table: BenchTable,
     n_segments = int(first.sum())
     note = (f'all samples: {n_samples} of {len(table)} ({100.0 * n_samples / len(table):.0f} %) '
             f'in {n_segments} stretch(es) without a gap, step {step:.4g} s, averaged over '
-            f'bins of {size} steps ({size * step:.3g} s, {a.size} rows)')
+            f'bins of {size} steps ({size * step:.3g} s, {a.size} rows)'
+            + left_out_samples(model, table, usable, held))
     rows = replace(rows, notes=rows.notes + (note,))
     lags = [nuisance[name] for name in ('speed_lag', 'flow_lag') if name in nuisance]
     correlation = float(np.corrcoef(lags[0], lags[1])[0, 1]) if len(lags) == 2 else np.nan
     return Samples(rows, parts, n_samples, size, step, n_segments, tuple(left_out),
                    correlation, table, usable, (a, b), held)
+
+
+def left_out_samples(model: MotorModel, table: BenchTable, usable: np.ndarray,
+                     held: np.ndarray) -> str:
+    """
+    Say why samples are in no row: which the model cannot use, and which no bin holds.
+
+    Parameters
+    ----------
+    model : MotorModel
+        The model evaluated at the samples, [-]
+    table : BenchTable
+        The samples in time order, [-]
+    usable : ndarray of bool
+        Which the model can use (:func:`~satmotor_ros.identify.parts.loss_parts`), [-]
+    held : ndarray of bool
+        Which a row holds, [-]
+
+    Returns
+    -------
+    str
+        ``'; left out: ...'`` with the count of each reason, or ``''`` when none is.
+
+    """
+    dp = table.p_in - table.p_out
+    with np.errstate(invalid='ignore'):
+        s = np.where(dp < 0.0, -1.0, 1.0)
+        finite = np.isfinite(table.flow) & np.isfinite(table.speed) & np.isfinite(dp)
+        no_flow = finite & ~((s * table.flow > 0.0) | (s * table.speed < 0.0))
+    reasons = [(int((~finite).sum()), 'without a finite reading'),
+               (int((no_flow & ~usable).sum()), 'with no flow the model can give (a shaft '
+                'that turns with the drop and no flow that way)'),
+               (int((finite & ~no_flow & ~usable).sum()), 'with a chamber drop outside 0 to '
+                f'{model.dp_limit / 1e6:.3g} MPa'),
+               (int((usable & ~held).sum()), 'in runs of usable samples too short for a bin')]
+    said = [f'{k} {why}' for k, why in reasons if k]
+    return '; left out: ' + ', '.join(said) if said else ''
 
 
 def averaged(samples: Samples, x: FloatArray) -> FloatArray:
