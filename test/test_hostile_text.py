@@ -17,6 +17,7 @@ from satmotor_ros.identify.columns import mapping_from_dict, read_log
 from satmotor_ros.identify.errors import DataError
 from satmotor_ros.identify.steady import extract_steady
 from satmotor_ros.identify.synthetic import generate, generate_series, Injection, Plan, to_columns
+from satmotor_ros.identify.table import table_from_columns
 from satmotor_ros.model.units import PSI
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -225,3 +226,14 @@ def test_a_displacement_that_makes_most_losses_negative_is_named(tmp_path, capsy
     code, _, err = _run(capsys, 'calibrate', bench, '--liquid', 'oil', '--out',
                         tmp_path / 'fine')
     assert code == 0 and 'sanity check' not in err
+
+
+def test_a_late_timestamp_is_jitter_not_a_restart():
+    time = np.arange(0.0, 10.0, 0.1)
+    time[50] = time[49] - 0.05  # one sample half a step late
+    ones = np.ones_like(time)
+    table = table_from_columns({'time': ('s', time), 'speed': ('rpm', 600 * ones),
+                                'flow': ('l/min', 20 * ones), 'p_in': ('MPa', 10 * ones),
+                                'p_out': ('MPa', ones)}, 'late.csv')
+    assert not any(note.startswith('sanity check') for note in table.notes)
+    assert np.array_equal(table.channels['time'], time)

@@ -46,6 +46,9 @@ _RESTART_SHARE = 0.01
 """Most share of time steps that may go backwards for the time to be read as restarts (more:
 the rows are not in time order, and time is one more channel)."""
 
+_RESTART_JITTER = 10.0
+"""A step back of more than this many median time steps is a restart, not a late sample."""
+
 _RESTART_GAP = 1000.0
 """A restarted recording is moved to begin this many median time steps after the one before:
 far beyond any gap that cuts a steady window or a transient stretch."""
@@ -352,11 +355,13 @@ def _restarts(time: FloatArray) -> tuple[FloatArray, tuple[str, ...]]:
     finite = np.isfinite(time)
     t = time[finite]
     step = np.diff(t)
-    back = np.flatnonzero(step < 0.0)
-    if back.size == 0 or back.size > _RESTART_SHARE * step.size:
-        return time, ()
     forward = step[step > 0.0]
-    gap = _RESTART_GAP * (float(np.median(forward)) if forward.size else 1.0)
+    typical = float(np.median(forward)) if forward.size else 1.0
+    # a timestamp a step or two late is jitter, left to the sort; a restart goes far back
+    back = np.flatnonzero(step < -_RESTART_JITTER * typical)
+    if back.size == 0 or np.count_nonzero(step < 0.0) > _RESTART_SHARE * step.size:
+        return time, ()
+    gap = _RESTART_GAP * typical
     shift = np.zeros(t.size)
     for i in back:
         shift[i + 1:] += gap - step[i]  # piece i+1 begins `gap` after piece i ends
