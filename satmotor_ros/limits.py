@@ -90,8 +90,8 @@ TEXT_MAX_BYTES = _cap('SATMOTOR_TEXT_MAX_BYTES', 128 << 20)
 """Largest text log (CSV, ``.exp``) read as DATA: about a million rows of 18 columns, [byte]."""
 
 TEXT_MAX_ROWS = _cap('SATMOTOR_TEXT_MAX_ROWS', 500_000)
-"""Most data rows of a text log (a points table of 500 000 rows calibrates in about 100 s and
-1 GB; 2.8 h of a 50 Hz log), [-]."""
+"""Most data rows of a text log (a points table of 500 000 rows calibrates in 121 s and
+1.07 GB; 2.8 h of a 50 Hz log), [-]."""
 
 TEXT_MAX_CHANNELS = _cap('SATMOTOR_TEXT_MAX_CHANNELS', 256)
 """Most channels a column mapping may name (each is a set of candidate effects, as a
