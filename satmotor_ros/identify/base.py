@@ -48,7 +48,7 @@ ALPHA = 0.01
 PHYSICAL_QUANTILE = 0.05
 """Share of the motor-mode rows whose port drop may fall below the channel drop (noise), [-]."""
 
-GRID = 10
+GRID = 8
 """Log-spaced factors the profile starts from (beside 0 and the kept value), [-]."""
 
 MIN_ROWS = 12
@@ -222,8 +222,10 @@ def fit_base(spec: MotorSpec, liquid: str, points: BenchTable,
     inflation = variance_inflation(profile.residual(best)) if points.time_series else 1.0
     gain = (profile(kept_factor) - profile(best)) / inflation
     limit = float(stats.chi2.ppf(1.0 - ALPHA, 1))
-    low, high = _interval(profile, best, bound, profile(best)
-                          + inflation * float(stats.chi2.ppf(0.95, 1)))
+    low, high = 0.0, bound
+    if gain > limit:  # the interval only matters for a factor that may be fitted
+        low, high = _interval(profile, best, bound, profile(best)
+                              + inflation * float(stats.chi2.ppf(0.95, 1)))
     spans = low <= bound * 1e-3 and high >= bound * 0.999
     if gain <= limit or spans:
         why = (f'the data do not pin it (profile: chi2 gain {gain:.3g} <= {limit:.3g}'
@@ -283,7 +285,7 @@ def _minimum(profile: _Profile, bound: float, kept: float) -> float:
     if hi > lo:
         found = optimize.minimize_scalar(profile, bounds=(lo, hi), method='bounded',
                                          options={'xatol': 1e-3 * max(hi, 1e-9),
-                                                  'maxiter': 16})
+                                                  'maxiter': 12})
         if profile(float(found.x)) < values[i]:
             return float(found.x)
     return grid[i]
