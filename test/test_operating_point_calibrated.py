@@ -58,7 +58,7 @@ def test_a_channel_free_term_is_evaluated_and_its_loss_shown(files, capsys):
     assert result['effects_lpm'] == pytest.approx(extra / LPM, rel=1e-6)
     assert result['effects_lpm'] > 0.0
     assert main(['operating-point', '--motor', str(motor), '--flow', '20', '--dp', '10']) == 0
-    assert f'+ effects ({name})' in capsys.readouterr().out
+    assert f'  of it from {name}' in capsys.readouterr().out
 
 
 def test_a_sensor_effect_file_gives_a_point(files, capsys):

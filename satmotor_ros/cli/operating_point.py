@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import argparse
+from dataclasses import replace
 import json
 import math
 from typing import Any, TypedDict
@@ -116,7 +117,7 @@ def command(flow: str, dp: str | None, dp_i: str | None, p_ex: str, channels: li
             raise CliError('give --dp or --dp-i')
     except (CliError, ModelError) as err:
         return fail(err)
-    result = _result(model, op, given)
+    result = _result(model, op, given, pex)
     print(json.dumps(_json_safe(result), indent=2, allow_nan=False) if as_json
           else _table(result))
     return 0
@@ -191,7 +192,18 @@ def _json_safe(value: Any) -> Any:
     return value
 
 
-def _result(model: MotorModel, op: OperatingPoints, channels: dict[str, float]) -> PointReport:
+def _effects_share(model: MotorModel, op: OperatingPoints, total_lpm: float, p_ex: float) -> float:
+    """Return how much of Q_vl the file's effects make: the total less the model's without."""
+    if not model.effects:
+        return 0.0
+    plain = MotorModel(model.geometry, replace(model.coefficient_set, effects=()),
+                       model.valid_range, model.liquid, model.displacement_law, model.name)
+    base = plain.breakdown(float(op.speed), float(op.dp_i), p_ex, errors='mask')
+    return total_lpm - float(base.total) / LPM
+
+
+def _result(model: MotorModel, op: OperatingPoints, channels: dict[str, float],
+            pex: float) -> PointReport:
     status = int(op.status)
     losses = {name: float(getattr(op.losses, name)) / LPM for name in COMPONENTS}
     return {
@@ -207,10 +219,8 @@ def _result(model: MotorModel, op: OperatingPoints, channels: dict[str, float]) 
         'speed_rad_s': float(op.speed),
         'speed_loss_rpm': float(op.speed_loss) / RPM,
         'losses_lpm': losses,
-        # what the file's effects add to Q_vl beyond the family's components (eq. 31's sum)
         'effects': [effect.name for effect in model.effects],
-        'effects_lpm': losses['total'] - sum(v for k, v in losses.items() if k != 'total')
-        if model.effects else 0.0,
+        'effects_lpm': _effects_share(model, op, losses['total'], pex),
         'channels': channels,
         'status': describe_status(status),
         'warnings': _warnings(status),
@@ -243,7 +253,7 @@ def _table(r: PointReport) -> str:
     labels = FAMILIES[r['family']].components  # the components the family has
     rows = [(labels[name], value) for name, value in r['losses_lpm'].items() if name in labels]
     if r['effects']:
-        rows.insert(-1, (f'+ effects ({", ".join(r["effects"])})', r['effects_lpm']))
+        rows.append((f'  of it from {", ".join(r["effects"])}', r['effects_lpm']))
     lines += [f'    {label:38s} {value:10.4f}' for label, value in rows]
     lines.append(f'  status: {r["status"]}')
     lines += [f'  warning: {note}' for note in r['warnings']]
