@@ -145,3 +145,23 @@ def test_every_parameter_file_exists_and_is_installed(launch):
         source = _installed_path(text)
         assert source.is_file(), f'{path.name}: {text} is {source}, which does not exist'
         assert source.suffix == '.yaml'
+
+
+def test_make_run_deletes_nothing_the_demo_did_not_write():
+    """Issue 21: `make run` left out/demo to the demo's own rule (replace only its own)."""
+    text = (ROOT / 'Makefile').read_text(encoding='utf-8')
+    recipe = re.search(r'^run:.*\n((?:\t.*\n)+)', text, re.MULTILINE)
+    assert recipe, 'no run target'
+    lines = recipe.group(1).splitlines()
+    assert not [line for line in lines if re.search(r'\brm\b', line)], lines
+    assert any('satmotor demo --out out/demo' in line for line in lines), lines
+
+
+def test_every_parameter_file_addresses_the_node_that_reads_it(launch):
+    import yaml
+    path, root = launch
+    for node in root.iter('node'):
+        for param in node.iter('param'):
+            if param.get('from'):
+                keys = yaml.safe_load(_installed_path(param.get('from')).read_text('utf-8'))
+                assert f'/**/{node.get("name")}' in keys, (path.name, param.get('from'))
