@@ -11,12 +11,15 @@ message of several lines, a non-finite number with an OK status, a user's file t
 with an AssertionError that names the input.
 """
 
+from collections.abc import Iterator
 import contextlib
 import copy
 import io
 import json
 import math
 from pathlib import Path
+import signal
+import threading
 
 from hypothesis import strategies as st
 import numpy as np
@@ -59,6 +62,27 @@ ODD_VALUES = ('', 'x', 'nan', '1e400', None, True, [], {}, [1.0, 2.0], {'dp': 1.
 ID_ALPHABET = 'dpn^.*0123456789:@ -_abcegikrt'
 POINTS = ((20 * LPM, 10 * MPA), (0.5 * LPM, 24 * MPA), (-20 * LPM, 10 * MPA),
           (20 * LPM, -10 * MPA), (0.0, 0.0), (60 * LPM, 0.1 * MPA))
+
+
+SECONDS = 120
+"""Longest one input may take; past it the input hangs (a FIFO read, a runaway fit), [s]."""
+
+
+@contextlib.contextmanager
+def bounded(what: str, seconds: int = SECONDS) -> Iterator[None]:
+    """Fail an input that takes longer than `seconds` (SIGALRM; the main thread only)."""
+    def hang(signum: int, frame: object) -> None:
+        raise AssertionError((what, f'no end within {seconds} s'))
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGALRM, hang)
+    signal.alarm(seconds)
+    try:
+        yield
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, previous)
 
 
 def one_line(message: str, what: str) -> None:
@@ -132,7 +156,8 @@ def _status_ok(status: int, values: tuple[float, ...], what: str) -> bool:
 def check_motor(path: Path, what: str) -> str:
     """Load a motor file as the nodes and the CLI do; evaluate a few points; the outcome."""
     try:
-        model = MotorOptions(liquid='oil', motor_file=str(path)).build_model()
+        with bounded(what):
+            model = MotorOptions(liquid='oil', motor_file=str(path)).build_model()
     except ModelError as err:
         one_line(str(err), what)
         return 'one line'
@@ -148,9 +173,10 @@ def check_motor(path: Path, what: str) -> str:
 
 
 def run_cli(argv: list[str]) -> tuple[int, str, str]:
-    """Run ``satmotor`` in this process; return its code, stdout and stderr."""
+    """Run ``satmotor`` in this process, bounded in time; return its code, stdout and stderr."""
     out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err), \
+            bounded(' '.join(map(str, argv))):
         code = main([str(a) for a in argv])
     return code, out.getvalue(), err.getvalue()
 
@@ -296,7 +322,8 @@ def mappings(draw: st.DrawFn, names: list[str]) -> dict:
 def check_log(path: Path, doc: dict, what: str) -> str:
     """Read a log through a mapping: an SI table (perhaps with notes) or one line."""
     try:
-        table = read_log(path, mapping_from_dict(doc, 'mapping.yaml'))
+        with bounded(what):
+            table = read_log(path, mapping_from_dict(doc, 'mapping.yaml'))
     except DataError as err:
         one_line(str(err), what)
         return 'one line'
@@ -341,6 +368,6 @@ def check_command(command: str, log: Path, mapping: Path, out: Path, what: str) 
     return 'flagged' if 'warning: ' in err or 'WARNING' in stdout else 'value'
 
 
-__all__ = ['EFFECTS', 'OUTCOMES', 'check_command', 'check_log', 'check_motor',
-           'check_operating_point', 'effect_blocks', 'logs', 'mappings', 'motor_doc',
+__all__ = ['EFFECTS', 'OUTCOMES', 'SECONDS', 'bounded', 'check_command', 'check_log',
+           'check_motor', 'check_operating_point', 'effect_blocks', 'logs', 'mappings', 'motor_doc',
            'one_line', 'run_cli', 'snapshot', 'user_dir']
