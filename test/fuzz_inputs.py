@@ -369,5 +369,5 @@ def check_command(command: str, log: Path, mapping: Path, out: Path, what: str) 
 
 
 __all__ = ['EFFECTS', 'OUTCOMES', 'SECONDS', 'bounded', 'check_command', 'check_log',
-           'check_motor', 'check_operating_point', 'effect_blocks', 'logs', 'mappings', 'motor_doc',
-           'one_line', 'run_cli', 'snapshot', 'user_dir']
+           'check_motor', 'check_operating_point', 'effect_blocks', 'logs', 'mappings',
+           'motor_doc', 'one_line', 'run_cli', 'snapshot', 'user_dir']
