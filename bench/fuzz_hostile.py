@@ -19,8 +19,9 @@ import time
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / 'test'))
 
-from fuzz_inputs import (check_command, check_log, check_motor,  # noqa: E402
-                         check_operating_point, effect_blocks, logs, mappings, motor_doc)
+from fuzz_inputs import (check_characteristics, check_command, check_log,  # noqa: E402
+                         check_motor, check_operating_point, effect_blocks, logs, mappings,
+                         motor_doc)
 from hypothesis import given, HealthCheck, seed, settings, strategies as st  # noqa: E402
 import yaml  # noqa: E402
 
@@ -78,7 +79,7 @@ def main() -> int:
     work = Path(tempfile.mkdtemp(prefix='satmotor-fuzz-'))
     tallies = {name: Tally(name, args.seconds, args.megabytes) for name in
                ('effect file (model loading, as the nodes)', 'operating-point',
-                'log through a mapping', 'calibrate', 'validate')}
+                'characteristics', 'log through a mapping', 'calibrate', 'validate')}
     quiet = settings(max_examples=args.examples, deadline=None, database=None,
                      suppress_health_check=list(HealthCheck))
 
@@ -113,6 +114,15 @@ def main() -> int:
 
     @seed(args.seed)
     @settings(quiet, max_examples=args.cli_examples)
+    @given(effects=effect_blocks())
+    def curves(effects):
+        where = fresh()
+        (where / 'motor.yaml').write_text(yaml.safe_dump(motor_doc(effects)))
+        tallies['characteristics'].run(lambda: check_characteristics(
+            where / 'motor.yaml', where / 'curves', repr(effects)), repr(effects))
+
+    @seed(args.seed)
+    @settings(quiet, max_examples=args.cli_examples)
     @given(data=st.data())
     def commands(data):
         text, names = data.draw(logs())
@@ -127,7 +137,7 @@ def main() -> int:
                 what), what)
 
     started = time.monotonic()
-    for run in (motors, text_logs, commands):
+    for run in (motors, text_logs, curves, commands):
         run()
     failures = [f for t in tallies.values() for f in t.failures]
     for tally in tallies.values():

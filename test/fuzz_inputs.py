@@ -208,6 +208,18 @@ def check_operating_point(path: Path, channels: tuple[str, ...] | None, what: st
     return 'flagged'
 
 
+def check_characteristics(path: Path, out: Path, what: str) -> str:
+    """``satmotor characteristics`` on a motor file: the curves (NaN where flagged) or one line."""
+    code, stdout, err = run_cli(['characteristics', '--motor', path, '--points', '40',
+                                 '--out', out])
+    if code != 0:
+        assert code == 1 and not out.exists(), (what, code, err)
+        one_line(err, what)
+        return 'one line'
+    assert out.is_dir() and any(out.glob('*.png')), (what, stdout, err)
+    return 'value'
+
+
 HEADER_NAMES = ('time', 'RPM', 'Spd', 'Flow', 'Up', 'Low', 'Case', 'T', 'Pos', 'x y', '')
 HEADER_UNITS = ('', '(s)', '(rpm)', '(in/s)', '(l/min)', '(psig)', '(psia)', '[MPa]', '(bar)',
                 '(V)', '(degC)', '[', '(()')
@@ -368,6 +380,6 @@ def check_command(command: str, log: Path, mapping: Path, out: Path, what: str) 
     return 'flagged' if 'warning: ' in err or 'WARNING' in stdout else 'value'
 
 
-__all__ = ['EFFECTS', 'OUTCOMES', 'SECONDS', 'bounded', 'check_command', 'check_log',
-           'check_motor', 'check_operating_point', 'effect_blocks', 'logs', 'mappings',
-           'motor_doc', 'one_line', 'run_cli', 'snapshot', 'user_dir']
+__all__ = ['EFFECTS', 'OUTCOMES', 'SECONDS', 'bounded', 'check_characteristics',
+           'check_command', 'check_log', 'check_motor', 'check_operating_point', 'effect_blocks',
+           'logs', 'mappings', 'motor_doc', 'one_line', 'run_cli', 'snapshot', 'user_dir']
