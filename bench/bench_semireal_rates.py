@@ -77,19 +77,27 @@ def _residual(case) -> np.ndarray:
 
 
 def _detectable(trajectory, effects, kind_index: int, noise, seed: int, full) -> bool:
-    """Return whether an oracle knowing the effect's column and the noise finds it."""
+    """
+    Return whether an oracle knowing the effect's column and the noise finds it (t > 3.3).
+
+    The column is what the effect changes in Q - q_t n; the base model's own loss is partialled
+    out (a calibration rescales it); the error is the case's noise, jitter and bad row, with a
+    heteroscedastic (sandwich) variance inflated by the noise's correlation.
+    """
     others = [e for i, e in enumerate(effects) if i != kind_index]
     without = build_case(trajectory, others, noise=None, seed=seed)
     column = _residual(full) - _residual(without)
     error = (full.flow - full.noiseless) / LPM
+    base = (full.base_flow - full.displacement * trajectory.speed_state) / LPM
+    nuisance = np.column_stack([base, np.ones_like(base)])
+    column = column - nuisance @ np.linalg.lstsq(nuisance, column, rcond=None)[0]
+    norm = float(column @ column)
+    if norm < 1e-12:
+        return False
     step = float(np.median(np.diff(full.time)))
     inflation = max(1.0, 2.0 * np.sqrt(np.pi) * noise.correlation_s / step)  # sum of the ACF
-    norm = float(column @ column)
-    if norm == 0.0:
-        return False
-    beta = 1.0 + float(column @ error) / norm
-    sigma = float(np.std(error))
-    return abs(beta) / (sigma * np.sqrt(inflation / norm)) > 3.3
+    se = np.sqrt(inflation * float(np.sum(column ** 2 * error ** 2))) / norm
+    return abs(1.0 + float(column @ error) / norm) / se > 3.3
 
 
 def _named(kind: str, effect, found: dict) -> tuple[bool, bool | None]:
