@@ -36,7 +36,8 @@ def test_a_signal_while_the_bag_is_written_leaves_the_earlier_output(bag, signum
     (earlier / '.satmotor-output.json').write_text(json.dumps({'command': 'replay'}))
     (earlier / 'keep').write_text('earlier')
     proc = subprocess.Popen(
-        [sys.executable, '-m', 'satmotor_ros.cli', 'replay', str(bag), '--topic-map',
+        [sys.executable, '-m', 'satmotor_ros.cli', 'replay', str(bag), '--liquid', 'oil',
+         '--topic-map',
          '/flow_measured:=flow_command', '--no-plot', '--out-bag', str(earlier)],
         env=_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:

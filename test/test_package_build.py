@@ -605,12 +605,12 @@ def _rows(path):
 def test_wheel_alone_replays_a_zstd_compressed_bag(clean_venv, tmp_path, capsys):
     """``satmotor replay`` of the wheel reads a file-compressed bag as the source tree does."""
     _zstd_bag(tmp_path / 'bag', 200)
-    argv = [clean_venv['bin'] / 'satmotor', 'replay', tmp_path / 'bag', '--no-plot',
-            '--out', tmp_path / 'wheel.csv']
+    argv = [clean_venv['bin'] / 'satmotor', 'replay', tmp_path / 'bag', '--liquid', 'oil',
+            '--no-plot', '--out', tmp_path / 'wheel.csv']
     proc = _run(argv, clean_venv['env'], tmp_path)
     assert proc.returncode == 0, proc.stdout + proc.stderr
     assert '200 driving messages, 200 predictions' in proc.stdout
-    assert main(['replay', str(tmp_path / 'bag'), '--no-plot',
+    assert main(['replay', str(tmp_path / 'bag'), '--liquid', 'oil', '--no-plot',
                  '--out', str(tmp_path / 'source.csv')]) == 0
     capsys.readouterr()
     wheel_rows = _rows(tmp_path / 'wheel.csv')

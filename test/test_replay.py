@@ -50,7 +50,8 @@ def _rows(path):
 def test_replay_writes_csv_bag_and_plot_equal_to_the_model(tmp_path, capsys):
     data = _bag(tmp_path / 'bag')
     out, out_bag, png = tmp_path / 'p.csv', tmp_path / 'out_bag', tmp_path / 'speed.png'
-    assert main(['replay', str(tmp_path / 'bag'), '--out', str(out), '--out-bag',
+    assert main(['replay', str(tmp_path / 'bag'), '--liquid', 'oil',
+                 '--out', str(out), '--out-bag',
                  str(out_bag), '--plot', str(png)]) == 0
     printed = capsys.readouterr().out
     assert '300 driving messages, 300 predictions (0 with a warning), 0 rejected' in printed
@@ -83,7 +84,8 @@ def test_replay_writes_csv_bag_and_plot_equal_to_the_model(tmp_path, capsys):
 
 def test_replay_without_measured_speed_reports_no_residual_and_no_plot(tmp_path, capsys):
     _bag(tmp_path / 'bag', joint=False)
-    assert main(['replay', str(tmp_path / 'bag'), '--out', str(tmp_path / 'p.csv')]) == 0
+    assert main(['replay', str(tmp_path / 'bag'), '--liquid', 'oil',
+                 '--out', str(tmp_path / 'p.csv')]) == 0
     assert 'no measured speed (joint_states): no residual' in capsys.readouterr().out
     assert 'residual [rpm]' not in _rows(tmp_path / 'p.csv')[0]
     assert not list(tmp_path.glob('*.png'))
@@ -91,7 +93,8 @@ def test_replay_without_measured_speed_reports_no_residual_and_no_plot(tmp_path,
 
 def test_replay_marks_rejected_rows_and_counts_them(tmp_path, capsys):
     _bag(tmp_path / 'bag', bad_from=200)
-    assert main(['replay', str(tmp_path / 'bag'), '--out', str(tmp_path / 'p.csv'),
+    assert main(['replay', str(tmp_path / 'bag'), '--liquid', 'oil',
+                 '--out', str(tmp_path / 'p.csv'),
                  '--no-plot']) == 0
     printed = capsys.readouterr().out
     assert '200 predictions (0 with a warning), 100 rejected' in printed
@@ -104,7 +107,7 @@ def test_replay_marks_rejected_rows_and_counts_them(tmp_path, capsys):
 
 def test_replay_with_no_usable_prediction_fails_with_one_line(tmp_path, capsys):
     _bag(tmp_path / 'bag', bad_from=0)
-    assert main(['replay', str(tmp_path / 'bag')]) == 1
+    assert main(['replay', str(tmp_path / 'bag'), '--liquid', 'oil']) == 1
     err = capsys.readouterr().err
     assert err.count('\n') == 1 and 'none of 300 predictions could be made' in err
 
@@ -112,11 +115,12 @@ def test_replay_with_no_usable_prediction_fails_with_one_line(tmp_path, capsys):
 def test_replay_topic_map_renames_bag_topics(tmp_path, capsys):
     _bag(tmp_path / 'bag', prefix='/', joint=False,
          names={'p_in': '/rig/p1', 'p_out': '/rig/p2'})
-    assert main(['replay', str(tmp_path / 'bag')]) == 1
+    assert main(['replay', str(tmp_path / 'bag'), '--liquid', 'oil']) == 1
     err = capsys.readouterr().err
     assert 'no messages on inlet_pressure, outlet_pressure (the bag has: ' in err
     assert '/rig/p1 sensor_msgs/msg/FluidPressure (300)' in err
-    assert main(['replay', str(tmp_path / 'bag'), '--topic-map', '/rig/p1:=inlet_pressure',
+    assert main(['replay', str(tmp_path / 'bag'), '--liquid', 'oil',
+                 '--topic-map', '/rig/p1:=inlet_pressure',
                  '--topic-map', '/rig/p2:=outlet_pressure']) == 0
 
 
@@ -133,14 +137,15 @@ def test_replay_topic_map_renames_bag_topics(tmp_path, capsys):
 def test_replay_bad_options_exit_1_with_one_line(tmp_path, capsys, args, text):
     _bag(tmp_path / 'bag')
     args = [a.replace('{tmp}', str(tmp_path)) for a in args]
-    assert main(['replay', str(tmp_path / 'bag'), '--no-plot', *args]) == 1
+    assert main(['replay', str(tmp_path / 'bag'), '--liquid', 'oil', '--no-plot', *args]) == 1
     err = capsys.readouterr().err
     assert err.count('\n') == 1 and text in err, err
 
 
 def test_replay_rate_mode_predicts_on_ticks(tmp_path, capsys):
     _bag(tmp_path / 'bag', joint=False)
-    assert main(['replay', str(tmp_path / 'bag'), '--mode', 'rate', '--rate', '20',
+    assert main(['replay', str(tmp_path / 'bag'), '--liquid', 'oil',
+                 '--mode', 'rate', '--rate', '20',
                  '--out', str(tmp_path / 'p.csv')]) == 0
     rows = _rows(tmp_path / 'p.csv')
     times = np.array([float(r['time [s]']) for r in rows])
@@ -152,7 +157,7 @@ def test_replay_rate_mode_predicts_on_ticks(tmp_path, capsys):
 @pytest.mark.parametrize('name', FOREIGN_BAGS)
 def test_replay_of_every_foreign_bag_fails_cleanly_with_one_line(name, capsys):
     """None of them holds the motor's topics: exit 1, one line naming what is missing."""
-    assert main(['replay', str(foreign_bag(name)), '--no-plot']) == 1
+    assert main(['replay', str(foreign_bag(name)), '--liquid', 'oil', '--no-plot']) == 1
     captured = capsys.readouterr()
     assert captured.out == '' and captured.err.count('\n') == 1
     assert 'Traceback' not in captured.err
@@ -163,7 +168,8 @@ def test_replay_of_every_foreign_bag_fails_cleanly_with_one_line(name, capsys):
 def test_replay_replaces_only_its_own_outputs(tmp_path, capsys):
     _bag(tmp_path / 'bag')
     csv, png, bag_out = tmp_path / 'run.csv', tmp_path / 'run_speed.png', tmp_path / 'out_bag'
-    argv = ['replay', str(tmp_path / 'bag'), '--out', str(csv), '--out-bag', str(bag_out)]
+    argv = ['replay', str(tmp_path / 'bag'), '--liquid', 'oil',
+            '--out', str(csv), '--out-bag', str(bag_out)]
     assert main(argv) == 0
     first = csv.read_bytes(), png.read_bytes()
     assert main(argv) == 0  # its own earlier outputs are replaced
@@ -184,14 +190,16 @@ def test_rate_mode_over_a_long_gap_is_refused_at_the_cap(tmp_path, capsys, monke
     from satmotor_ros.prediction import rule
     _bag(tmp_path / 'bag')
     monkeypatch.setattr(rule, 'RATE_MAX_PREDICTIONS', 100)
-    assert main(['replay', str(tmp_path / 'bag'), '--no-plot', '--mode', 'rate']) == 1
+    assert main(['replay', str(tmp_path / 'bag'), '--liquid', 'oil',
+                 '--no-plot', '--mode', 'rate']) == 1
     err = capsys.readouterr().err
     assert err.count('\n') == 1 and 'predictions, more than 100' in err, err
 
 
 def test_plot_must_be_a_png(tmp_path, capsys):
     _bag(tmp_path / 'bag')
-    assert main(['replay', str(tmp_path / 'bag'), '--plot', str(tmp_path / 'x.yaml')]) == 1
+    assert main(['replay', str(tmp_path / 'bag'), '--liquid', 'oil',
+                 '--plot', str(tmp_path / 'x.yaml')]) == 1
     err = capsys.readouterr().err
     assert err.count('\n') == 1 and "x.yaml': a plot is written as PNG" in err, err
     assert not (tmp_path / 'x.yaml').exists()

@@ -73,7 +73,8 @@ def test_live_run_recorded_and_replayed_gives_identical_predictions(harness, tmp
     assert len(live) == steps - 2  # steps 7 and 8 (p_out < 0 absolute) are rejected
     recorder.write(tmp_path / 'live')
     out = tmp_path / 'replay.csv'
-    assert main(['replay', str(tmp_path / 'live'), '--out', str(out), '--no-plot']) == 0
+    assert main(['replay', str(tmp_path / 'live'), '--liquid', 'oil',
+                 '--out', str(out), '--no-plot']) == 0
     with open(out, newline='') as stream:
         rows = list(csv.DictReader(stream))
     published = [r for r in rows if r['level'] != 'ERROR']

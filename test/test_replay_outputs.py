@@ -29,7 +29,7 @@ def _names(path):
 def test_clashing_or_unwritable_outputs_are_refused_before_any_is_written(
         bag, tmp_path, capsys, monkeypatch, args, text):
     monkeypatch.chdir(tmp_path)
-    assert main(['replay', str(bag), *args]) == 1
+    assert main(['replay', str(bag), '--liquid', 'oil', *args]) == 1
     err = capsys.readouterr().err
     assert err.count('\n') == 1 and text in err, err
     assert _names(tmp_path) == ['bag']
@@ -39,7 +39,8 @@ def test_a_failing_plot_leaves_no_new_csv_nor_bag(bag, tmp_path, capsys, monkeyp
     def broken(path, *args):
         raise OSError(28, 'No space left on device', str(path))
     monkeypatch.setattr(replay, 'plot_speed', broken)
-    assert main(['replay', str(bag), '--out', str(tmp_path / 'r.csv'), '--out-bag',
+    assert main(['replay', str(bag), '--liquid', 'oil',
+                 '--out', str(tmp_path / 'r.csv'), '--out-bag',
                  str(tmp_path / 'ob')]) == 1
     assert 'No space left on device' in capsys.readouterr().err
     assert _names(tmp_path) == ['bag']
@@ -47,9 +48,11 @@ def test_a_failing_plot_leaves_no_new_csv_nor_bag(bag, tmp_path, capsys, monkeyp
 
 def test_the_csv_written_in_pieces_equals_the_csv_written_at_once(
         bag, tmp_path, capsys, monkeypatch):
-    assert main(['replay', str(bag), '--out', str(tmp_path / 'whole.csv'), '--no-plot']) == 0
+    assert main(['replay', str(bag), '--liquid', 'oil',
+                 '--out', str(tmp_path / 'whole.csv'), '--no-plot']) == 0
     monkeypatch.setattr(replay, 'CSV_CHUNK_ROWS', 7)
-    assert main(['replay', str(bag), '--out', str(tmp_path / 'pieces.csv'), '--no-plot']) == 0
+    assert main(['replay', str(bag), '--liquid', 'oil',
+                 '--out', str(tmp_path / 'pieces.csv'), '--no-plot']) == 0
     whole = (tmp_path / 'whole.csv').read_bytes()
     assert whole.count(b'\n') == 301 and (tmp_path / 'pieces.csv').read_bytes() == whole
 
@@ -80,7 +83,7 @@ def test_memory_and_interrupts_anywhere_are_one_line(capsys, monkeypatch, error,
 def test_the_out_bag_has_ordinary_names_that_its_metadata_names(bag, tmp_path, capsys):
     """Issue 21: the bag's files are not left under the hidden temporary name."""
     out = tmp_path / 'predicted'
-    assert main(['replay', str(bag), '--out-bag', str(out), '--no-plot']) == 0
+    assert main(['replay', str(bag), '--liquid', 'oil', '--out-bag', str(out), '--no-plot']) == 0
     visible = sorted(p.name for p in out.iterdir() if not p.name.startswith('.'))
     assert visible == ['metadata.yaml', 'predicted.mcap'], sorted(out.iterdir())
     assert 'partial' not in ''.join(p.name for p in out.iterdir())

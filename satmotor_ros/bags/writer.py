@@ -9,7 +9,7 @@ refuses a damaged chunk rather than return altered numbers.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import cast, NamedTuple, TYPE_CHECKING
 
@@ -71,7 +71,7 @@ class _McapStorage:
 
 
 def write_bag(path: str | Path, topics: Sequence[OutTopic], storage: str = 'mcap',
-              name: str = '') -> int:
+              name: str = '', custom_data: Mapping[str, str] | None = None) -> int:
     """
     Write topics into a new bag, every message in log-time order.
 
@@ -87,6 +87,8 @@ def write_bag(path: str | Path, topics: Sequence[OutTopic], storage: str = 'mcap
         The bag's final directory name, which names its storage file (``NAME.mcap``) when
         `path` is a temporary name that is renamed to it once written; '' for `path`'s own
         name (the only choice for sqlite3), [-]
+    custom_data : mapping of str to str, optional
+        Recorded in metadata.yaml's ``custom_data`` (:mod:`satmotor_ros.bags.custom`), [-]
 
     Returns
     -------
@@ -128,6 +130,8 @@ def write_bag(path: str | Path, topics: Sequence[OutTopic], storage: str = 'mcap
     order = np.argsort(stamps, kind='stable')
     try:
         writer = McapWriter(path, version=9, storage_plugin=plugins[storage])
+        for key, value in (custom_data or {}).items():
+            writer.set_custom_data(key, value)
         writer.open()
         try:
             connections = [writer.add_connection(t.name, t.msgtype, typestore=typestore)

@@ -66,7 +66,7 @@ class _ExamplesFormatter(argparse.HelpFormatter):
         return super()._fill_text(text, width, indent)
 
 
-def add_motor_options(parser: argparse.ArgumentParser, *, liquid_required: bool = False,
+def add_motor_options(parser: argparse.ArgumentParser, *, liquid_from_data: bool = False,
                       model_options: bool = True) -> None:
     """
     Add the motor options; the command receives them as one ``options`` :class:`MotorOptions`.
@@ -75,20 +75,22 @@ def add_motor_options(parser: argparse.ArgumentParser, *, liquid_required: bool 
     ----------
     parser : argparse.ArgumentParser
         The subcommand's parser, [-]
-    liquid_required : bool
-        ``--liquid`` has no default, [-]
+    liquid_from_data : bool
+        ``--liquid`` has no default: '' when not given, and the command takes the liquid
+        the data record or refuses (:func:`satmotor_ros.cli._liquid.settle_liquid`), [-]
     model_options : bool
         Also ``--law`` and the user-liquid properties (not for a calibration, which fits
         the set's own liquid), [-]
 
     """
     group = parser.add_argument_group('motor and liquid')
-    group.add_argument('--liquid', dest=_PREFIX + 'liquid', required=liquid_required,
-                       default=None if liquid_required else MotorOptions.liquid,
+    group.add_argument('--liquid', dest=_PREFIX + 'liquid',
+                       default='' if liquid_from_data else MotorOptions.liquid,
                        metavar='NAME',
                        help="coefficient set and its liquid: 'oil' or 'water' for the packaged "
                             'SM-0,75/25, or any set in --motor'
-                            + ('' if liquid_required else ' (default: oil)'))
+                            + (' (default: the liquid the bag records; data that record none '
+                               'need it)' if liquid_from_data else ' (default: oil)'))
     group.add_argument('--motor', dest=_PREFIX + 'motor_file', default='', metavar='YAML',
                        help='motor specification or calibrated coefficients file (default: '
                             'the packaged SM-0,75/25)')

@@ -34,7 +34,7 @@ class RunResult(NamedTuple):
 
 
 def write_run_bag(path: Path, messages: dict[str, list[tuple[int, bytes]]],
-                  types: dict[str, str]) -> int:
+                  types: dict[str, str], custom: dict[str, str] | None = None) -> int:
     """
     Write the recorded messages to an MCAP rosbag2, in log-time order.
 
@@ -46,6 +46,8 @@ def write_run_bag(path: Path, messages: dict[str, list[tuple[int, bytes]]],
         Topic -> list of (log time [ns], CDR bytes), [-]
     types : dict
         Topic -> message type, [-]
+    custom : dict, optional
+        What the bag records of its run (:mod:`satmotor_ros.bags.custom`: liquid, motor), [-]
 
     Returns
     -------
@@ -57,7 +59,7 @@ def write_run_bag(path: Path, messages: dict[str, list[tuple[int, bytes]]],
     topics = [OutTopic(topic, types[topic], np.array([t for t, _ in items], dtype=np.int64),
                        [data for _, data in items])
               for topic, items in messages.items() if items]
-    return write_bag(path, topics, storage='mcap')
+    return write_bag(path, topics, storage='mcap', custom_data=custom)
 
 
 def hold(t_from: np.ndarray, v_from: np.ndarray, t_to: np.ndarray) -> np.ndarray:

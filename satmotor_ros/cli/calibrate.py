@@ -4,11 +4,13 @@
 from __future__ import annotations
 
 import argparse
+from dataclasses import replace
 from pathlib import Path
 import sys
 
 from satmotor_ros.cli._bench import add_data_arguments, load_data, run_bench_command
 from satmotor_ros.cli._common import add_motor_options
+from satmotor_ros.cli._liquid import settle_liquid
 from satmotor_ros.cli._output import check_target, output_dir, written_by
 from satmotor_ros.identify import calibrate, Options
 from satmotor_ros.identify.output import write_json, write_yaml
@@ -32,7 +34,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help='family-wise significance level of the effect test (default 0.05)')
     parser.add_argument('--folds', type=int, default=5,
                         help='cross-validation folds (default 5)')
-    add_motor_options(parser, liquid_required=True, model_options=False)
+    add_motor_options(parser, liquid_from_data=True, model_options=False)
 
 
 def command(data: str, out: str, mode: Mode, alpha: float, folds: int,
@@ -70,8 +72,12 @@ def _calibrate(data: str, out: str, mode: Mode, alpha: float, folds: int,
     """Calibrate, write the outputs and return the summary line."""
     inputs = [name for name in (data, options.motor_file, columns) if name]
     check_target('--out', Path(out), inputs, force, written_by('calibrate'), 'calibrate')
+    settled = settle_liquid(options, data, 'calibrate')
+    options = settled.options
     spec = options.spec()
     table = load_data(data, columns, spec.geometry.displacement)
+    table = replace(table, notes=table.notes + (f'liquid: {settled.source}',)
+                    + ((f'WARNING: {settled.warning}',) if settled.warning else ()))
     cal = calibrate(table, options.liquid, spec, Options(alpha=alpha, n_folds=folds, mode=mode,
                                                          compare_families=not options.family))
     warnings = cal.warnings().get('warnings', [])
@@ -86,6 +92,7 @@ def _calibrate(data: str, out: str, mode: Mode, alpha: float, folds: int,
     before, after = summary['error_before']['rmse_lpm'], summary['error_after']['rmse_lpm']
     kinds = [k for k in (IMPLAUSIBLE, AT_BOUND) if any(w.startswith(k) for w in warnings)]
     line = (f'WARNING {" and ".join(kinds)} (see report.md); ' if kinds else '') + \
+        (f'WARNING: {settled.warning}; ' if settled.warning else '') + \
         f'effect: {effect}'
     if effect != 'none':
         line += (f' ({summary["regressor"]}, coefficient {summary["coefficient"]:.4g} '
@@ -100,6 +107,7 @@ def _calibrate(data: str, out: str, mode: Mode, alpha: float, folds: int,
     if tie:
         other = next(f for f in tie['families'] if f != summary['family'])
         line += f' (near tie with {other})'
+    line += f'; liquid {settled.source}'
     if summary['outliers']:
         line += f'; {len(summary["outliers"])} outlier(s) left out'
     rows = f'{summary["n_points"]} points'

@@ -21,8 +21,10 @@ import numpy as np
 from satmotor_ros.bags import (BagError, describe_topics, encode_many, FLOAT64, JOINT_STATE,
                                list_topics, missing_topics, OutTopic, parse_topic_map,
                                read_series, Series, write_bag)
+from satmotor_ros.bags.custom import LIQUID_KEY, MOTOR_KEY
 from satmotor_ros.cli import _fastcsv as fastcsv
 from satmotor_ros.cli._common import add_motor_options, CliError, fail
+from satmotor_ros.cli._liquid import settle_liquid
 from satmotor_ros.cli._output import (check_target, MARKER, output_file, png_by, png_metadata,
                                       resolve, written_by)
 from satmotor_ros.interface import (CHANNELS, JOINT_NAME, LOSS_COMPONENTS, LOSSES_PREFIX,
@@ -83,7 +85,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--joint', default=JOINT_NAME, metavar='NAME',
                         help='joint of the measured speed in joint_states (default '
                              f'{JOINT_NAME})')
-    add_motor_options(parser)
+    add_motor_options(parser, liquid_from_data=True)
 
 
 def command(bag: str, out: str | None, out_bag: str | None, plot: str | None, no_plot: bool,
@@ -142,11 +144,13 @@ def command(bag: str, out: str | None, out_bag: str | None, plot: str | None, no
         figure = _plot_path(bag, out, plot, no_plot)
         written = {'--out-bag': out_bag, '--out': out, '--plot': figure}
         _refuse_clashes({option: Path(p) for option, p in written.items() if p is not None})
-        model = options.build_model()
         renames = parse_topic_map(topic_map)
         series = read_series(bag, [TOPICS[name] for name in INPUTS], renames, joint,
                              keep_raw=out_bag is not None)
         _require(bag, series, renames)
+        settled = settle_liquid(options, bag, COMMAND)
+        options = settled.options
+        model = options.build_model()
         batch = _predict(model, rule, series)
         if not batch.valid.any():
             raise CliError(f'{bag}: none of {len(batch)} predictions could be made; the '
@@ -157,7 +161,8 @@ def command(bag: str, out: str | None, out_bag: str | None, plot: str | None, no
             if out_bag is not None:
                 tmp = outputs.enter_context(output_file('--out-bag', out_bag, COMMAND,
                                                         written_by(COMMAND), inputs, force))
-                _write_bag(tmp, series, batch, joint, Path(out_bag).name)
+                _write_bag(tmp, series, batch, joint, Path(out_bag).name,
+                           {LIQUID_KEY: options.liquid, MOTOR_KEY: model.name})
                 (tmp / MARKER).write_text(json.dumps({'command': COMMAND}) + '\n',
                                           encoding='utf-8')
             if out is not None:
@@ -168,12 +173,16 @@ def command(bag: str, out: str | None, out_bag: str | None, plot: str | None, no
                 tmp = outputs.enter_context(output_file('--plot', picture, COMMAND,
                                                         png_by(COMMAND), inputs, force))
                 plot_speed(tmp, batch, f'{Path(bag).name}: {model.liquid.name}, '
-                                       f'{model.displacement_law}')
+                                       f'{model.displacement_law}'
+                                       + (' (WARNING: not the recorded liquid)'
+                                          if settled.warning else ''))
     except (BagError, CliError, ModelError) as err:
         return fail(err)
     except OSError as err:
         return fail(CliError(f'{err.filename}: {err.strerror}'))
     print(summary(bag, batch, time.perf_counter() - started))
+    print(f'  liquid {settled.source}'
+          + (f'; WARNING: {settled.warning}' if settled.warning else ''))
     for path in (out, out_bag, picture):
         if path is not None:
             print(f'wrote {path}')
@@ -385,13 +394,14 @@ def write_csv(path: Path, batch: PredictionBatch) -> None:
 
 
 def _write_bag(path: Path, series: dict[str, Series], batch: PredictionBatch,
-               joint: str, name: str) -> None:
+               joint: str, name: str, custom: dict[str, str]) -> None:
     """
     Write the recorded inputs and the predictions (what the node publishes) to a bag.
 
     `path` is the hidden temporary directory renamed to the bag once every output is made;
     its storage file is named after the bag's final name `name` (``NAME.mcap``), so that
-    ls, globs and clean-up scripts see an ordinary file.
+    ls, globs and clean-up scripts see an ordinary file. The bag records `custom`
+    (:mod:`satmotor_ros.bags.custom`: the liquid and motor of the prediction).
     """
     flow_topic = series[TOPICS['flow']].topic
     flow = CHANNELS['flow'].topic
@@ -412,7 +422,7 @@ def _write_bag(path: Path, series: dict[str, Series], batch: PredictionBatch,
         topics.append(OutTopic(prefix + SPEED_RESIDUAL, FLOAT64,
                                batch.snapshots.stamp_ns[has],
                                encode_many(FLOAT64, {'data': residual[has]})))
-    write_bag(path, topics, name=name)
+    write_bag(path, topics, name=name, custom_data=custom)
 
 
 def _plot_path(bag: str, out: str | None, plot: str | None, no_plot: bool) -> Path | None:

@@ -4,10 +4,12 @@
 from __future__ import annotations
 
 import argparse
+from dataclasses import replace
 from pathlib import Path
 
 from satmotor_ros.cli._bench import add_data_arguments, load_data, run_bench_command
 from satmotor_ros.cli._common import add_motor_options
+from satmotor_ros.cli._liquid import settle_liquid
 from satmotor_ros.cli._output import check_target, output_dir, written_by
 from satmotor_ros.identify.coverage import calibrated_envelope
 from satmotor_ros.identify.pipeline import Mode, MODES
@@ -25,7 +27,7 @@ DESCRIPTION = ('Hold a model (the packaged one, a motor file or a calibrated coe
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Add the options of ``satmotor validate``."""
     add_data_arguments(parser, MODES)
-    add_motor_options(parser, liquid_required=True)
+    add_motor_options(parser, liquid_from_data=True)
 
 
 def command(data: str, out: str, mode: Mode, options: MotorOptions, columns: str = '',
@@ -57,8 +59,12 @@ def _validate(data: str, out: str, mode: Mode, options: MotorOptions, columns: s
     """Validate, write the outputs and return the summary line."""
     inputs = [name for name in (data, options.motor_file, columns) if name]
     check_target('--out', Path(out), inputs, force, written_by('validate'), 'validate')
+    settled = settle_liquid(options, data, 'validate')
+    options = settled.options
     model = options.build_model()
     table = load_data(data, columns, model.geometry.displacement)
+    table = replace(table, notes=table.notes + (f'liquid: {settled.source}',)
+                    + ((f'WARNING: {settled.warning}',) if settled.warning else ()))
     calibrated = calibrated_envelope(options.motor_file) if options.motor_file else None
     result = validate(table, model, options.liquid, mode, calibrated=calibrated)
     with output_dir('--out', out, 'validate', inputs, force) as tmp:
@@ -71,7 +77,8 @@ def _validate(data: str, out: str, mode: Mode, options: MotorOptions, columns: s
     if beyond['share']:
         flagged += (f'; {100 * beyond["share"]:.0f} % of the samples outside the calibrated '
                     'envelope')
-    return (f'{model.name}, set {options.liquid}, effects: {result.describe_effects()}; '
+    return ((f'WARNING: {settled.warning}; ' if settled.warning else '')
+            + f'{model.name}, set {settled.source}, effects: {result.describe_effects()}; '
             f'RMSE of Q_vl {error["rmse_lpm"]:.4g} l/min, mean {error["mean_abs_pct"]:.3g} %, '
             f'max {error["max_abs_lpm"]:.4g} l/min over {summary["n_points"]} points{flagged}, '
             f'nothing refitted; wrote {target}/validation.json, report.md, residuals.png')

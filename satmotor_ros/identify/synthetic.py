@@ -511,7 +511,8 @@ def generate_transient(plan: Plan, injection: Injection | Sequence[Injection],
 
 
 def write_bag_of(path: str | Path, table: BenchTable, storage: str = 'mcap',
-                 flow_topic: str = 'flow_measured') -> None:
+                 flow_topic: str = 'flow_measured',
+                 custom_data: dict[str, str] | None = None) -> None:
     """
     Record a generated time series as a rosbag2 bag of the DESIGN.md topics.
 
@@ -525,6 +526,8 @@ def write_bag_of(path: str | Path, table: BenchTable, storage: str = 'mcap',
         Storage plugin, [-]
     flow_topic : str
         Topic of the flow: ``flow_measured`` or ``flow_command``, [-]
+    custom_data : dict, optional
+        What the bag records of itself (:mod:`satmotor_ros.bags.custom`), [-]
 
     """
     from satmotor_ros.bags import (encode_many, FLOAT64, FLUID_PRESSURE, JOINT_STATE,
@@ -549,7 +552,7 @@ def write_bag_of(path: str | Path, table: BenchTable, storage: str = 'mcap',
         if name not in ('time', 'revolutions', 'temperature', 'p_case'):
             topics.append(OutTopic(f'/{name}', FLOAT64, t_ns + 4000,
                                    encode_many(FLOAT64, {'data': values})))
-    write_bag(path, topics, storage)
+    write_bag(path, topics, storage, custom_data=custom_data)
 
 
 def to_columns(table: BenchTable) -> dict[str, tuple[str, FloatArray]]:
