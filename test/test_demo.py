@@ -34,6 +34,7 @@ def test_demo_writes_a_report_with_its_plots(demo_run):
     assert '| water | model |' in report and '| water | none (PI alone) |' in report
     assert 'Prediction from the motor_model node' in report
     assert '## Closing the loop' in report  # 6 s may be too short to calibrate: it says so
+    assert 'points held 1 s each' in report  # 1.5 x 6 s over nine points, as it ran
     # the injected leakage takes k p_case / q_t = 0.55 rpm the model does not know about
     bias = float(re.search(r'has a median of (-?[0-9.]+) rpm', report).group(1))
     assert -1.0 < bias < -0.3
@@ -84,14 +85,20 @@ def test_demo_closes_the_loop_on_its_own_recording(tmp_path):
     assert command(liquid='water', duration='24', effect=[], out=str(out), quiet=True) == 0
     report = (out / 'report.md').read_text()
     section = report[report.index('## Closing the loop'):]
-    assert '`external_leakage = 2e-11`' in section and 'It named the injected effect.' in section
+    assert '`external_leakage = 2e-11`' in section and 'points held 4 s each' in section
     assert '](loop/report.md)' in section and '](loop/residuals.png)' in section
     assert 'Data: `bags/water_model_loop`' in (out / 'loop' / 'report.md').read_text()
     result = json.loads((out / 'loop' / 'calibration.json').read_text())
     first = result['effects'][0]
     assert first['effect'] == 'external_leakage'
-    assert first['ci95'][0] < 2e-11 < first['ci95'][1]
-    assert result['error_after']['rmse_lpm'] < result['error_before']['rmse_lpm']
+    assert abs(first['coefficient'] / 2e-11 - 1.0) < 0.05
+    covered = first['ci95'][0] <= 2e-11 <= first['ci95'][1]
+    assert ('It named the injected `external_leakage`' in section) == covered
+    assert ('does not cover the injected 2e-11: not named' in section) == (not covered)
+    # the case pressure steps separate the leak from the speed-driven losses
+    r = float(re.search(r'with `\w+`: r = ([-+0-9.]+) \(separated\)', section).group(1))
+    assert abs(r) < 0.95
+    assert result['error_after']['rmse_lpm'] < 0.3 * result['error_before']['rmse_lpm']
     assert (out / 'loop' / 'residuals.png').read_bytes().startswith(PNG)
     assert (out / 'bags' / 'water_model_loop' / 'metadata.yaml').is_file()
 

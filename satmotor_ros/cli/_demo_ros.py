@@ -17,6 +17,7 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock
+from satmotor_ros.bags.custom import LIQUID_KEY, MOTOR_KEY
 from satmotor_ros.cli._common import CliError
 from satmotor_ros.cli._demo_report import RunResult, write_run_bag
 from satmotor_ros.cli._safe_signals import signals_at_safe_points
@@ -56,16 +57,22 @@ RECORDED = (  # topic relative to the run's namespace, type, reliable publisher?
 class Script(Node):
     """Publish the cycle's speed set-point and load torque on simulated time."""
 
-    def __init__(self, cycle: Cycle, **kwargs: Any) -> None:
-        """Start the timer on the node clock (use_sim_time)."""
+    def __init__(self, cycle: Cycle, motor: Node | None = None, **kwargs: Any) -> None:
+        """Start the timer on the node clock (use_sim_time); `motor` takes the case offsets."""
         super().__init__('demo_script', **kwargs)
         self.cycle = cycle
+        self._motor = motor
+        self._case_offset: float | None = None
         self._setpoint = self.create_publisher(Float64, 'speed_setpoint', 10)
         self._load = self.create_publisher(Float64, CHANNELS['torque'].topic, 10)
         self.create_timer(1.0 / CONTROL_RATE, self._tick)
 
     def _tick(self) -> None:
         segment = self.cycle.at(self.get_clock().now().nanoseconds * 1e-9)
+        offset = segment.case_offset
+        if self._motor is not None and offset is not None and offset != self._case_offset:
+            self._motor.set_parameters([Parameter('case.offset', value=offset)])
+            self._case_offset = offset
         self._setpoint.publish(Float64(data=segment.setpoint))
         self._load.publish(Float64(data=segment.load))
 
@@ -230,7 +237,8 @@ def run_cycle(liquid: str, feedforward: str, cycle: Cycle, effects: dict[str, An
                                                  Parameter('rate', value=CONTROL_RATE)])
             predictor = MotorModelNode(context=context, namespace=namespace, parameter_overrides=[
                 *sim, Parameter('liquid', value=liquid)])
-            script = Script(cycle, context=context, namespace=namespace, parameter_overrides=sim)
+            script = Script(cycle, motor, context=context, namespace=namespace,
+                            parameter_overrides=sim)
             recorder = Recorder(list(RECORDED), context=context, namespace=namespace)
             nodes = [recorder, script, controller, predictor, motor]
             for node in nodes:
@@ -258,6 +266,7 @@ def run_cycle(liquid: str, feedforward: str, cycle: Cycle, effects: dict[str, An
     if progress is not None:
         progress.run_done(sim_seconds)
     messages = recorder.until(round(cycle.duration * 1e9))
-    write_run_bag(bag, messages, recorder.types)
+    write_run_bag(bag, messages, recorder.types,
+                  {LIQUID_KEY: liquid, MOTOR_KEY: plant.model.name})
     return RunResult(liquid, feedforward, bag, messages, recorder.types, wall, sim_seconds,
                      unanswered)

@@ -30,6 +30,9 @@ FEEDFORWARDS = ('model', 'none')
 LOOP_EFFECT = 'external_leakage=2e-11'
 """The default effect of the closing-the-loop run: a leak to the case, k * p_case [m^3/(s*Pa)]."""
 
+LOOP_SCALE = 1.5
+"""The loop run's length per second of --duration: its nine points hold 1.5 * duration / 9 s."""
+
 BENCH_SENSORS = {'sensors.flow.noise': 0.05 * LPM, 'sensors.speed.noise': 0.5 * RPM,
                  'sensors.inlet_pressure.noise': 0.01 * MPA,
                  'sensors.outlet_pressure.noise': 0.01 * MPA,
@@ -164,7 +167,7 @@ def command(liquid: str, duration: str, effect: list[str], out: str, quiet: bool
         from satmotor_ros.cli._demo_ros import run_cycle
         runs: list[report.RunResult] = []
         loop_runs: list[report.RunResult] = []
-        steps = (len(liquids) * len(FEEDFORWARDS) + 1.5 * (loop is not None)) * cycle.duration
+        steps = (len(liquids) * len(FEEDFORWARDS) + LOOP_SCALE * (loop is not None)) * seconds
         progress = None if quiet else Progress(steps)
         with output_dir('--out', out, 'demo', (), force) as out_dir:
             for q in liquids:
@@ -175,10 +178,10 @@ def command(liquid: str, duration: str, effect: list[str], out: str, quiet: bool
             if loop is not None:
                 from satmotor_ros.cli._demo_loop import close_loop
                 bag = out_dir / 'bags' / f'{liquids[0]}_model_loop'
-                loop_runs.append(run_cycle(liquids[0], 'model',
-                                           identification_cycle().scaled(1.5 * seconds),
-                                           loop, bag, progress))
-                section = close_loop(bag, liquids[0], loop, out_dir)
+                loop_cycle = identification_cycle().scaled(LOOP_SCALE * seconds)
+                loop_runs.append(run_cycle(liquids[0], 'model', loop_cycle, loop, bag,
+                                           progress))
+                section = close_loop(bag, liquids[0], loop, out_dir, loop_cycle)
             if progress is not None:
                 progress.done()
             report.write_report(out_dir, runs, cycle, effects, section)

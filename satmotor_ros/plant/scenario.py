@@ -11,14 +11,14 @@ ROS, for tests and for a reference to compare the ROS demo against.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 import math
 from typing import NamedTuple
 
 import numpy as np
 
 from satmotor_ros.model import MotorModel
-from satmotor_ros.model.units import RPM
+from satmotor_ros.model.units import MPA, RPM
 from satmotor_ros.plant.controller import ControllerParams, SpeedController
 from satmotor_ros.plant.load import ConstantLoad
 from satmotor_ros.plant.params import PlantParams
@@ -32,6 +32,7 @@ class Segment:
     duration: float  # [s]
     setpoint: float  # speed set-point [rad/s]
     load: float  # load torque (a brake) [N*m]
+    case_offset: float | None = None  # case pressure above tank at zero p_out [Pa]; None: kept
 
 
 @dataclass(frozen=True)
@@ -83,7 +84,7 @@ class Cycle:
 
         """
         k = duration / self.duration
-        return Cycle(tuple(Segment(s.duration * k, s.setpoint, s.load) for s in self.segments))
+        return Cycle(tuple(replace(s, duration=s.duration * k) for s in self.segments))
 
 
 def default_cycle() -> Cycle:
@@ -101,13 +102,21 @@ def default_cycle() -> Cycle:
     return Cycle(tuple(Segment(d, n * RPM, load) for d, n, load in rows))
 
 
+CASE_OFFSETS = (0.05 * MPA, 0.2 * MPA, 0.4 * MPA)
+"""The identification cycle's three case pressures (the drain throttled), above tank [Pa]."""
+
+
 def identification_cycle() -> Cycle:
     """
     Give a bench's identification cycle: 9 steady points, 300-1200 rpm by 20-80 N*m, 36 s.
 
     Each speed is held while the load steps up, so every point of the grid is a steady
     window of its own: what a calibration needs to tell the losses apart, where the
-    tracking cycle of :func:`default_cycle` has too few distinct points.
+    tracking cycle of :func:`default_cycle` has too few distinct points. The case drain
+    is throttled to one of :data:`CASE_OFFSETS` per point, in a Latin square over speed
+    and load: otherwise the case pressure follows the outlet pressure, hence the speed,
+    and a leak to the case looks like the speed-driven losses (the inertia loss of
+    eq. 14 above all).
 
     Returns
     -------
@@ -115,8 +124,9 @@ def identification_cycle() -> Cycle:
         The cycle.
 
     """
-    return Cycle(tuple(Segment(4.0, n * RPM, load) for n in (300.0, 750.0, 1200.0)
-                       for load in (20.0, 50.0, 80.0)))
+    return Cycle(tuple(Segment(4.0, n * RPM, load, CASE_OFFSETS[(i + j) % 3])
+                       for i, n in enumerate((300.0, 750.0, 1200.0))
+                       for j, load in enumerate((20.0, 50.0, 80.0))))
 
 
 class StepMetrics(NamedTuple):
