@@ -12,6 +12,7 @@ from satmotor_ros.cli.main import main
 from satmotor_ros.identify import DataError
 from satmotor_ros.identify.columns import load_mapping, mapping_from_dict, read_log
 from satmotor_ros.model import load_motor
+from satmotor_ros.model.config import default_config_path
 from satmotor_ros.model.families import FAMILY_NAMES
 from satmotor_ros.model.units import INCH, LPM, MPA, PSI, RPM
 from vendored_data import data_path
@@ -170,7 +171,9 @@ def test_packaged_mapping_is_found_by_name_and_by_path():
     by_name = load_mapping('mbari_pto')
     assert by_name.fields['flow'].sign == -1.0
     assert by_name.fields['flow'].area == pytest.approx(1.375 * INCH ** 2)
-    assert load_mapping(by_name.source).fields == by_name.fields
+    assert by_name.source == 'mbari_pto (packaged)'  # not the installed path (issue 21)
+    by_path = load_mapping(str(default_config_path('mbari_pto.columns.yaml')))
+    assert by_path.fields == by_name.fields
 
 
 @pytest.fixture(scope='module')

@@ -229,7 +229,8 @@ def load_mapping(name: str | Path) -> ColumnMapping:
     except YamlLimitError as err:
         msg = f'{path}: {err}'
         raise DataError(msg) from None
-    return mapping_from_dict(doc, str(path))
+    # a packaged mapping by its name: its installed path is of this machine, not of the data
+    return mapping_from_dict(doc, str(path) if path == Path(name) else f'{name} (packaged)')
 
 
 def _locate(source: Source, header: tuple[str, ...] | None, width: int,

@@ -15,6 +15,8 @@ import numpy as np
 from satmotor_ros.identify.output import effect_block, fitted_coefficients
 from satmotor_ros.identify.parts import LossParts
 from satmotor_ros.identify.pipeline import AT_BOUND, Calibration
+from satmotor_ros.identify.plot_tools import (draw_beyond, MARK_STYLES, portable,
+                                              residual_colors, robust_limits, unique_legend)
 from satmotor_ros.identify.residual_map import coverage_section, plot_residual_map
 from satmotor_ros.identify.selection import at_bound, Errors
 from satmotor_ros.identify.table import BenchTable
@@ -28,7 +30,8 @@ UNSEPARABLE = 0.95
 """|correlation| of two fitted parameters beyond which the data cannot tell them apart."""
 
 _UNITS = {'time': ('s', 1.0), 'revolutions': ('rev', 1.0), 'temperature': ('degC', 1.0),
-          'p_case': ('MPa', MPA), 'p_out': ('MPa', MPA), 'p_in': ('MPa', MPA)}
+          'p_case': ('MPa', MPA), 'p_out': ('MPa', MPA), 'p_in': ('MPa', MPA),
+          'speed_setpoint': ('rpm', RPM)}  # the demo's set-point topic, SI (rad/s)
 
 
 def pyplot() -> ModuleType:
@@ -62,7 +65,8 @@ def channel_axes(parts: LossParts, table: BenchTable) -> dict[str, FloatArray]:
     out = {'n [rpm]': table.speed / RPM, 'dp [MPa]': table.dp / MPA,
            'flow [l/min]': table.flow / LPM, 'p_out [MPa]': table.p_out / MPA}
     for name, x in table.channels.items():
-        unit, scale = _UNITS.get(name, (table.units.get(name, '') or '-', 1.0))
+        # '?' where nothing says the unit: '-' would claim the channel dimensionless
+        unit, scale = _UNITS.get(name, (table.units.get(name, '') or '?', 1.0))
         if np.all(np.isfinite(x)):
             out[f'{name} [{unit}]'] = x / scale
     return out
@@ -97,12 +101,16 @@ def short_label(label: str) -> str:
 
 
 def plot_residual_grid(axes_data: dict[str, FloatArray], residuals: dict[str, FloatArray],
-                       title: str, path: Path) -> None:
+                       title: str, path: Path,
+                       marks: dict[str, np.ndarray] | None = None) -> None:
     """
     Plot residuals of Q_vl against each quantity, one panel per quantity, three a row.
 
     Only the first :data:`~satmotor_ros.limits.PLOT_MAX_PANELS` quantities are plotted
-    (:func:`grid_note` says so in the report).
+    (:func:`grid_note` says so in the report). With several residuals the first (before)
+    is drawn small and grey and the last on top in a strong colour, so that what an effect
+    changed shows. The residual axis ends where :func:`robust_limits` says: points beyond
+    are drawn at the edge as triangles and counted in the panel.
 
     Parameters
     ----------
@@ -114,17 +122,41 @@ def plot_residual_grid(axes_data: dict[str, FloatArray], residuals: dict[str, Fl
         The figure's title, [-]
     path : pathlib.Path
         PNG file to write, [-]
+    marks : dict, optional
+        Legend label to a boolean mask of the points to ring (e.g. outliers, points flagged
+        EXTRAPOLATED), ringed at the last residual; empty masks are left out, [-]
 
     """
     plt = pyplot()
     axes_data = dict(list(axes_data.items())[:PLOT_MAX_PANELS])
+    marks = {k: m for k, m in (marks or {}).items() if np.any(m)}
     cols = 3
     rows = int(np.ceil(len(axes_data) / cols))
     height = 3.0 * rows  # [inch]
     fig, axes = plt.subplots(rows, cols, figsize=(12, height), squeeze=False)
+    series = [(name, r / LPM) for name, r in residuals.items()]
+    limits = robust_limits(np.concatenate([y for _, y in series]))
+    several = len(series) > 1
+    colors = residual_colors(len(series))
+    handles: dict[str, Any] = {}
     for ax, (label, x) in zip(axes.flat, axes_data.items()):
-        for name, residual in residuals.items():
-            ax.plot(x, residual / LPM, 'o', ms=3, alpha=0.6, label=name)
+        beyond = np.zeros(len(x), dtype=bool)
+        for k, ((name, y), color) in enumerate(zip(series, colors)):
+            faint = several and k == 0
+            (line,) = ax.plot(x, np.clip(y, *limits), 'o', ms=2.5 if faint else 3.5,
+                              alpha=0.5 if faint else 0.85, color=color, zorder=2 + k,
+                              mec='none', label=name)
+            handles.setdefault(name, line)
+            beyond |= draw_beyond(ax, x, y, limits, color)
+        last = series[-1][1]
+        for (name, mask), style in zip(marks.items(), MARK_STYLES):
+            (ring,) = ax.plot(x[mask], np.clip(last[mask], *limits), ls='none', zorder=6,
+                              label=name, **style)
+            handles.setdefault(name, ring)
+        if beyond.any():
+            ax.text(0.98, 0.97, f'{int(beyond.sum())} beyond the axis (drawn at its edge)',
+                    transform=ax.transAxes, ha='right', va='top', fontsize=7, color='0.3')
+        ax.set_ylim(*limits)
         ax.axhline(0.0, color='k', lw=0.8)
         ax.set_xlabel(short_label(label))
         ax.set_ylabel('residual of Q_vl [l/min]')
@@ -133,10 +165,10 @@ def plot_residual_grid(axes_data: dict[str, FloatArray], residuals: dict[str, Fl
         ax.set_visible(False)
     # one legend for the figure, between the title and the panels: a long label (several
     # effects) inside a panel would cover its points and run past the figure's edge
-    ncol = min(len(residuals), 2)
-    legend_rows = int(np.ceil(len(residuals) / ncol))
+    ncol = min(len(handles), 2)
+    legend_rows = int(np.ceil(len(handles) / ncol))
     fig.suptitle(title, y=1 - 0.1 / height, va='top')
-    fig.legend(*axes.flat[0].get_legend_handles_labels(), loc='upper center', ncol=ncol,
+    fig.legend(list(handles.values()), list(handles), loc='upper center', ncol=ncol,
                fontsize=8, frameon=False, bbox_to_anchor=(0.5, 1 - 0.4 / height))
     fig.subplots_adjust(left=0.07, right=0.98, bottom=0.6 / height,
                         top=1 - (0.65 + 0.2 * legend_rows) / height, hspace=0.45, wspace=0.3)
@@ -161,7 +193,8 @@ def _plot_residuals(cal: Calibration, path: Path) -> None:
         labels.append(score.label)
         residuals[f'after {" + ".join(labels)}'] = score.cv_error
     plot_residual_grid(channel_axes(cal.parts, cal.table), residuals, 'Out-of-sample residual '
-                       'of the volumetric losses against each regressor', path)
+                       'of the volumetric losses against each regressor', path,
+                       {'outlier (left out of the fit and the errors)': cal.forward.outliers})
 
 
 QUADRANT_MARKERS = {'motor, forward': 'o', 'motor, reverse': 's', 'pump, forward': '^',
@@ -227,11 +260,21 @@ def _plot_characteristics(cal: Calibration, path: Path) -> None:
         for name, marker in QUADRANT_MARKERS.items():
             if (quadrant == name).any():
                 left.plot([], [], marker, ms=4, color='0.35', label=name)
+    outlier = cal.forward.outliers
+    limits = robust_limits(parts.loss / LPM)
+    if outlier.any():
+        left.plot(parts.dp_i[outlier] / MPA, np.clip(parts.loss[outlier] / LPM, *limits),
+                  ls='none', label='outlier (left out)', clip_on=False, **MARK_STYLES[0])
+    left.set_ylim(*limits)
+    beyond = int(draw_beyond(left, parts.dp_i / MPA, parts.loss / LPM, limits, '0.3').sum())
+    if beyond:
+        left.text(0.98, 0.03, f'{beyond} beyond the axis (drawn at its edge)',
+                  transform=left.transAxes, ha='right', va='bottom', fontsize=7, color='0.3')
     left.set_xlabel(f'chamber pressure drop {"|dp_i|" if signed else "dp_i"} [MPa]')
     left.set_ylabel('volumetric losses Q_vl = ' + ('sign(dp) (Q - q_t n)' if signed
                                                    else 'Q - q_t n') + ' [l/min]')
     left.set_title('dashed: packaged model; solid: fitted (without effect)', fontsize=9)
-    left.legend(fontsize=7)
+    unique_legend(left, fontsize=7)
     left.grid(alpha=0.3)
     measured = parts.loss / LPM
     before = measured - cal.selection.baseline.cv_error / LPM
@@ -240,11 +283,22 @@ def _plot_characteristics(cal: Calibration, path: Path) -> None:
         after = measured - cal.forward.final.cv_error / LPM
         right.plot(measured, after, 'o', ms=3, alpha=0.6,  # several effects: several lines
                    label=textwrap.fill(f'after ({" + ".join(s.label for s in cal.found)})', 48))
-    lim = [min(measured.min(), before.min()), max(measured.max(), before.max())]
+    lim = robust_limits(np.concatenate([measured, before]))
+    if outlier.any():
+        right.plot(np.clip(measured[outlier], *lim), np.clip(before[outlier], *lim), ls='none',
+                   label='outlier (left out)', clip_on=False, **MARK_STYLES[0])
     right.plot(lim, lim, 'k-', lw=0.8)
+    right.set_xlim(*lim)
+    right.set_ylim(*lim)
+    far = (measured < lim[0]) | (measured > lim[1]) | (before < lim[0]) | (before > lim[1])
+    if far.any():
+        right.plot(np.clip(measured[far], *lim), np.clip(before[far], *lim), 'D', ms=6,
+                   color='0.3', clip_on=False, zorder=5,
+                   label=f'{int(far.sum())} beyond the axes (drawn at the edge)')
     right.set_xlabel('measured Q_vl [l/min]')
     right.set_ylabel('predicted Q_vl, out of sample [l/min]')
-    right.legend(fontsize=8, loc='lower right')  # the points run from lower left to upper right
+    # the points run from lower left to upper right
+    unique_legend(right, fontsize=8, loc='lower right')
     right.grid(alpha=0.3)
     fig.subplots_adjust(left=0.07, right=0.98, bottom=0.12, top=0.93, wspace=0.22)
     fig.savefig(path, dpi=80)
@@ -427,7 +481,8 @@ def write_report(cal: Calibration, out: Path, summary: dict[str, object]) -> Pat
     data = (f'{len(cal.parts)} rows of {cal.samples.n_samples} samples'
             if cal.samples is not None else f'{len(cal.parts)} steady operating points')
     lines = [f'# Calibration of {cal.spec.name} on {cal.liquid}', '',
-             f'Data: `{cal.table.source}`, {data}. Mode `{cal.mode}`: {cal.mode_reason}.']
+             f'Data: `{portable(cal.table.source)}`, {data}. '
+             f'Mode `{cal.mode}`: {cal.mode_reason}.']
     lines += [f'- {note}' for note in cal.table.notes]
     lines += [f'- **{note}**' for note in cal.warnings().get('warnings', [])
               if note.startswith(AT_BOUND)]

@@ -51,6 +51,7 @@ class Validation:
     extrapolated: int = 0  # points (rows) kept that the model flags EXTRAPOLATED [-]
     coverage: dict[str, Any] = field(default_factory=dict)  # the rows' Rows.coverage
     outside: dict[str, Any] | None = None  # samples outside the calibrated envelope
+    flagged: np.ndarray | None = None  # which of the points are flagged EXTRAPOLATED [-]
 
     def describe_effects(self) -> str:
         """Return the effects' names, comma-separated, or ``'none'``."""
@@ -154,7 +155,7 @@ def validate(table: BenchTable, model: MotorModel, liquid: str, mode: Mode = 'au
     residual = parts.flow - predicted
     return Validation(liquid, model, points, parts, residual, Errors.of(residual, parts.loss),
                       tuple(evaluated.describe()), int(flagged.sum()), int(extrapolated.sum()),
-                      read.coverage, _outside(calibrated, points))
+                      read.coverage, _outside(calibrated, points), flagged=extrapolated)
 
 
 def _outside(calibrated: dict[str, Any] | None, rows: BenchTable) -> dict[str, Any] | None:
@@ -228,7 +229,8 @@ def _validate_samples(samples: Samples, model: MotorModel, liquid: str) -> Valid
             'the transient terms (' + ', '.join(parts.nuisance) + ') fitted to the residual: '
             'they describe the bench, not the model',))
     return Validation(liquid, model, points, parts, residual, Errors.of(residual, parts.loss),
-                      tuple(calibrated.describe()), int((~good).sum()), int(outside.sum()))
+                      tuple(calibrated.describe()), int((~good).sum()), int(outside.sum()),
+                      flagged=outside)
 
 
 __all__ = ['Validation', 'validate']

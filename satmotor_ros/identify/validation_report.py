@@ -7,6 +7,7 @@ import json
 from pathlib import Path
 from typing import Any
 
+from satmotor_ros.identify.plot_tools import portable
 from satmotor_ros.identify.report import channel_axes, grid_note, plot_residual_grid
 from satmotor_ros.identify.validate import Validation
 
@@ -19,7 +20,10 @@ def _plot_residuals(val: Validation, path: Path) -> None:
     plot_residual_grid(channel_axes(val.parts, val.table),
                        {f'{val.model.name} on {val.liquid}': val.residual},
                        f'Residual of the volumetric losses, nothing refitted (RMSE '
-                       f'{val.error.rmse_lpm:.4g} l/min)', path)
+                       f'{val.error.rmse_lpm:.4g} l/min)', path,
+                       {} if val.flagged is None else
+                       {'flagged EXTRAPOLATED (outside the validated or fitted range)':
+                        val.flagged})
 
 
 def _coverage_lines(summary: dict[str, Any]) -> list[str]:
@@ -45,7 +49,7 @@ def _report(val: Validation, summary: dict[str, Any]) -> str:
     """Return ``report.md``'s text."""
     err = val.error
     lines = [f'# Validation of {val.model.name} on {val.liquid}', '',
-             f'Data: `{val.table.source}`, {len(val.parts)} steady operating points. '
+             f'Data: `{portable(val.table.source)}`, {len(val.parts)} steady operating points. '
              f'Effects in the model: {val.describe_effects()}.']
     lines += [f'- {note}' for note in val.table.notes]
     lines += ['', '## Error', '',
