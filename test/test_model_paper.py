@@ -11,7 +11,7 @@ from satmotor_ros.model import MotorModel
 from satmotor_ros.model.units import LPM, MPA, RPM
 
 DATA = Path(__file__).resolve().parent / 'data'  # reference grids (test/data/README.md)
-GRID_TOLERANCE = 1e-3  # PAPER_MODEL.md: an implementation should agree to better than 0.1 %
+GRID_TOLERANCE = 1e-3  # doc/PAPER_MODEL.md: an implementation should agree to better than 0.1 %
 
 
 def _grid(liquid):

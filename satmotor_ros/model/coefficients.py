@@ -4,7 +4,7 @@ Liquids, motor geometry and loss coefficients as frozen, validated records.
 
 Geometry and liquids are SI. The loss coefficients are the empirical fits of
 Śliwiński (2017), Table 1, and only mean something in the unit system they
-were fitted in; each field states that system (PAPER_MODEL.md, "Units"). The
+were fitted in; each field states that system (doc/PAPER_MODEL.md, "Units"). The
 equation functions in :mod:`satmotor_ros.model.losses` take SI arrays and do
 the conversion, so no caller ever sees the paper's units.
 """
@@ -134,7 +134,7 @@ class MotorGeometry:
 
         The paper evaluates m^2*H with m and H in mm and reads the number as
         cm^3 (0.75^2 * 25 = 14.0625 "cm^3"); the fitted C and C_id only
-        reproduce its results that way (PAPER_MODEL.md, "Units").
+        reproduce its results that way (doc/PAPER_MODEL.md, "Units").
         """
         return (self.module * 1.0e3) ** 2 * (self.height * 1.0e3)
 
@@ -149,7 +149,7 @@ class LossCoefficients:
     """
     Coefficients of the volumetric-loss model for one motor and one liquid.
 
-    Units are the paper's fitting units (PAPER_MODEL.md): pressure in MPa,
+    Units are the paper's fitting units (doc/PAPER_MODEL.md): pressure in MPa,
     speed in rpm, flow in l/min, lengths in mm and um, viscosity in cSt.
     """
 
