@@ -89,8 +89,9 @@ def test_what_a_killed_run_left_is_cleaned_at_the_next_run_and_nothing_else(tmp_
 def test_kill_9_mid_write_leaves_a_partial_that_the_next_run_removes(bag):
     work = bag.parent / 'killed'
     work.mkdir()
-    argv = [sys.executable, '-m', 'satmotor_ros.cli', 'replay', str(bag), '--topic-map',
-            '/flow_measured:=flow_command', '--no-plot', '--out-bag', str(work / 'out')]
+    argv = [sys.executable, '-m', 'satmotor_ros.cli', 'replay', str(bag), '--liquid', 'oil',
+            '--topic-map', '/flow_measured:=flow_command', '--no-plot', '--out-bag',
+            str(work / 'out')]
     proc = subprocess.Popen(argv, env=_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     try:
         deadline = time.monotonic() + 60
