@@ -123,3 +123,15 @@ def test_a_report_shows_no_directory_of_this_machine(tmp_path, monkeypatch):
     assert str(tmp_path) not in before_json and str(log.parent) not in before_json
     assert portable('rel/x.csv') == 'rel/x.csv'
     assert portable(str(tmp_path / 'a' / 'b.csv')) == 'a/b.csv'
+
+
+def test_the_demo_prediction_residual_axis_shows_the_steady_bias_not_the_spikes():
+    from satmotor_ros.cli._demo_report import _residual_limits, RESIDUAL_FLOOR
+    residual = np.full(1000, -0.55)
+    residual[::100] = 500.0  # the transient at each step
+    quiet = residual < 1.0
+    lo, hi = _residual_limits(residual, quiet)
+    assert lo < -0.55 < 0.0 < hi and hi == pytest.approx(max(RESIDUAL_FLOOR, 5.5))
+    small = np.linspace(-0.3, 0.2, 50)
+    lo, hi = _residual_limits(small, np.ones(50, dtype=bool))
+    assert lo <= -0.3 and hi >= 0.2 and hi < 1.0  # nothing cut: the whole range

@@ -10,6 +10,7 @@ import matplotlib
 import numpy as np
 
 from satmotor_ros.bags import OutTopic, read_series, write_bag
+from satmotor_ros.identify.plot_tools import robust_limits
 from satmotor_ros.interface import (CHANNELS, LOSS_COMPONENTS, LOSSES_PREFIX,
                                     PREDICTED_JOINT_STATE, VALUE_FIELD)
 from satmotor_ros.model import MotorModel
@@ -246,6 +247,24 @@ def predicted(tr: Tracking) -> tuple[np.ndarray, dict[str, np.ndarray], str]:
     return op.speed, op.losses.as_dict(), 'the model library on the recorded flow and pressures'
 
 
+RESIDUAL_SPAN = 10.0
+"""The prediction plot's residual axis spans this many times the settled samples' RMS (at least
+RESIDUAL_FLOOR): the transients at the steps, hundreds of rpm, would hide the steady bias."""
+
+RESIDUAL_FLOOR = 2.0
+"""Least half-height of that axis, [rpm]."""
+
+
+def _residual_limits(residual: np.ndarray, quiet: np.ndarray) -> tuple[float, float]:
+    """Give the residual axis: the whole range, or +-RESIDUAL_SPAN x the settled RMS."""
+    whole = float(np.nanmin(residual)), float(np.nanmax(residual))
+    rms = float(np.sqrt(np.nanmean(residual[quiet] ** 2))) if quiet.any() else np.nan
+    half = max(RESIDUAL_SPAN * rms, RESIDUAL_FLOOR) if np.isfinite(rms) else np.inf
+    if not (np.all(np.isfinite(whole)) and max(abs(whole[0]), abs(whole[1])) > half):
+        return robust_limits(residual)
+    return -half, half
+
+
 def _plot_prediction(out: Path, liquid: str, tr: Tracking,
                      after: float) -> tuple[str, str, str, tuple[float, float]]:
     n_pred, losses, source = predicted(tr)
@@ -258,7 +277,14 @@ def _plot_prediction(out: Path, liquid: str, tr: Tracking,
     top.legend(loc='lower right')
     top.grid(alpha=0.3)
     residual = (tr.speed - n_pred) / RPM
-    bottom.plot(tr.t, residual, 'C2', lw=0.8)
+    limits = _residual_limits(residual, settled(tr, after))
+    bottom.plot(tr.t, np.clip(residual, *limits), 'C2', lw=0.8)
+    bottom.set_ylim(*limits)
+    beyond = int(np.sum((residual < limits[0]) | (residual > limits[1])))
+    if beyond:
+        bottom.text(0.99, 0.95, f'{beyond} samples beyond the axis (transients at the steps), '
+                    'cut at its edge', transform=bottom.transAxes, ha='right', va='top',
+                    fontsize=8, color='0.3')
     bottom.set_ylabel('measured - predicted [rpm]')
     bottom.set_xlabel('simulated time [s]')
     bottom.grid(alpha=0.3)
