@@ -190,6 +190,14 @@ def test_sensor_effects_convert_readings_only():
     ({'term:dp^1.2.3': {'coefficient': 1.0}}, "term 'dp\\^1.2.3' is not a product"),
     ({'term:n^11': {'coefficient': 1.0}}, 'at most 10'),
     ({'term:dp^0': {'coefficient': 1.0}}, 'each power above 0'),
+    ({'threshold:dp': {'coefficient': 1.0, 'reference': 1e7, 'exponent': 272}},
+     'exponent = 272.0: must be > 0 and at most 10'),
+    ({'viscosity_temperature': {'coefficient': 3.0, 'law': 'walther', 'reference_temperature':
+                                -708.0, 'reference_viscosity': 4e-5}},
+     r'reference_temperature = -708.0: must be from -273 to 10000'),
+    ({'viscosity_temperature': {'coefficient': 3.0, 'law': 'walther', 'reference_temperature':
+                                40.0, 'reference_viscosity': 0.0}},
+     r'reference_viscosity = 0.0: must be from 1e-08 to 1'),
     ({'term:dp^2': {'coefficient': 1.0, 'exponents': {'dp': 3.0}}}, "the id says 'dp\\^2'"),
     ({'threshold:dp': {'coefficient': 1.0}}, 'missing key.*reference'),
     ({'threshold:n': {'coefficient': 1.0, 'reference': 1e7}}, 'use threshold:dp'),

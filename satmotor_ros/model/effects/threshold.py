@@ -19,6 +19,7 @@ from satmotor_ros.model.effects._base import (Candidate, CandidateData, DIRECTIO
                                               EffectKind, finite, Loss, Modifier,
                                               negative_rows, PlantParameter, Shape, Synthetic,
                                               two_sided)
+from satmotor_ros.model.effects.term import MAX_EXPONENT
 from satmotor_ros.model.errors import ConfigError
 
 MIN_ABOVE = {'both': (0.15, 4), 'positive': (0.01, 8), 'negative': (0.01, 8)}
@@ -87,8 +88,8 @@ class Threshold(EffectKind):
         """Read k, the cracking drop and the exponent (default 1, > 0)."""
         regressor = self.regressor(name.partition(':')[2], doc.get('regressor'), where)
         exponent = finite(doc.get('exponent', 1.0), f'{where}.exponent')
-        if exponent <= 0.0:
-            msg = f'{where}.exponent = {exponent!r}: must be > 0'
+        if not 0.0 < exponent <= MAX_EXPONENT:  # past it the flow overflows at bench drops
+            msg = f'{where}.exponent = {exponent!r}: must be > 0 and at most {MAX_EXPONENT:g}'
             raise ConfigError(msg)
         return Effect(name, finite(doc['coefficient'], f'{where}.coefficient'), regressor,
                       finite(doc['reference'], f'{where}.reference'),

@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from satmotor_ros.model.coefficients import LIQUID_RANGES
 from satmotor_ros.model.effects._base import (Candidate, CandidateData, Conditions, Effect,
                                               EffectKind, finite, Modifier, PlantParameter,
                                               Synthetic)
@@ -23,6 +24,12 @@ from satmotor_ros.model.viscosity import LAWS, ViscosityLaw
 
 MIN_SPAN = 1.0
 """Temperature span the data must cover for the effect to be offered, [K]."""
+
+
+_RANGES = {'reference_temperature': (-273.0, 1.0e4),
+           'reference_viscosity': LIQUID_RANGES['kinematic_viscosity']}
+"""The reference a law is pinned at: a temperature above absolute zero [degC] and a liquid's
+viscosity [m^2/s]."""
 
 
 def law_of(effect: Effect) -> ViscosityLaw:
@@ -59,6 +66,10 @@ class ViscosityTemperature(EffectKind):
             raise ConfigError(msg)
         values: dict[str, Any] = {k: finite(doc[k], f'{where}.{k}') for k in self.keys
                                   if k in doc and k not in ('regressor', 'law')}
+        for key, (low, high) in _RANGES.items():  # past them the law's logarithms fail
+            if key in values and not low <= values[key] <= high:
+                msg = f'{where}.{key} = {values[key]!r}: must be from {low:g} to {high:g}'
+                raise ConfigError(msg)
         return Effect(name, regressor=self.regressor('', doc.get('regressor'), where), law=law,
                       **values)
 
