@@ -184,6 +184,7 @@ def _probe(option: str, target: Path) -> None:
     if not target.parent.is_dir():
         return  # made when the output is written; an error then is still one line
     probe = _temporary(target)
+    blocked = _block_interrupts()  # a signal between making and removing it left it behind
     try:
         probe.open('x').close()
     except FileExistsError:
@@ -191,7 +192,10 @@ def _probe(option: str, target: Path) -> None:
     except OSError as err:
         raise CliError(f'{option} {str(target)!r}: cannot write there ({err.strerror})') \
             from None
-    probe.unlink(missing_ok=True)
+    else:
+        probe.unlink(missing_ok=True)
+    finally:
+        _unblock_interrupts(blocked)
 
 
 def _empty_dir(path: Path) -> bool:
