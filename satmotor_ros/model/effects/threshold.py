@@ -104,8 +104,11 @@ class Threshold(EffectKind):
         """Return (n, dp) -> k max(0, |dp| - x_c)^e, dp the port drop (a bypass kind)."""
         k, x_c, e = effect.coefficient, effect.reference, effect.option('exponent', 1.0)
 
-        def loss(n: Real, dp_i: Real) -> Real:
-            return k * np.maximum(abs(dp_i) - x_c, 0.0) ** e
+        def loss(n: Real, dp: Real) -> Real:
+            if type(dp) is float:  # the point path: Python floats, no numpy scalar
+                over = abs(dp) - x_c
+                return k * over ** e if over > 0.0 else 0.0
+            return k * np.maximum(abs(dp) - x_c, 0.0) ** e
         return loss
 
     def reads(self, effect: Effect) -> tuple[str, ...]:
