@@ -9,17 +9,21 @@ import pytest
 
 from satmotor_ros.cli import validate as validate_cli
 from satmotor_ros.identify import calibrate, write_csv
+from satmotor_ros.identify.columns import load_mapping, read_log
 from satmotor_ros.identify.coverage import (calibrated_envelope, envelope, envelope_share,
                                             outside)
 from satmotor_ros.identify.errors import DataError
 from satmotor_ros.identify.output import write_yaml
 from satmotor_ros.identify.synthetic import (generate, generate_transient, Injection, Plan,
                                              REALISTIC_DYNAMICS)
-from satmotor_ros.identify.transient import transient_samples
+from satmotor_ros.identify.transient import segments, spikes, transient_samples
 from satmotor_ros.interface import MotorOptions
 from satmotor_ros.model import MotorModel
 from satmotor_ros.model.units import LPM, MPA, RPM
+from vendored_data import data_path
 import yaml
+
+MBARI = ('2021.07.26T10.51.44.exp', 'FrictionIDMovesWithBiasCurr.exp')
 
 
 def test_the_envelope_is_given_per_direction_of_the_drop():
@@ -99,3 +103,43 @@ def test_the_samples_left_out_of_every_row_are_counted_by_reason():
     note = samples.table.notes[-1]
     assert 'left out: 7 without a finite reading' in note
     assert samples.n_samples < len(table) - 6
+
+
+def _spiked(duration_s, seed=3):
+    table = generate_transient(Plan(liquid='oil'), Injection(), REALISTIC_DYNAMICS, seed=seed,
+                               duration_s=duration_s)
+    return table, len(table) // 2
+
+
+def test_a_one_sample_spike_of_the_flow_is_left_out_and_a_step_is_not():
+    table, at = _spiked(20.0)
+    first = np.zeros(len(table), dtype=bool)
+    first[0] = True
+    spiked = table.flow.copy()
+    spiked[at] += 2.0 * LPM
+    flagged, departure, _ = spikes(spiked, first)
+    assert flagged[at] and flagged.sum() <= 2
+    assert departure[at] == pytest.approx(2.0 * LPM, rel=0.1)
+    stepped = table.flow.copy()
+    stepped[at:] += 2.0 * LPM
+    assert not spikes(stepped, first)[0][at - 3:at + 3].any()
+    samples = transient_samples(MotorModel.default('oil'), replace(table, flow=spiked))
+    assert at in samples.spikes and not samples.usable[at]
+    assert 'isolated spikes of the flow reading' in samples.table.notes[-1]
+
+
+def test_a_spike_is_listed_among_the_outliers_by_its_time():
+    table, at = _spiked(30.0, seed=5)
+    flow = table.flow.copy()
+    flow[at] -= 2.0 * LPM
+    cal = calibrate(replace(table, flow=flow), 'oil')
+    listed = [o for o in cal.summary()['outliers'] if o.get('sample') == at]
+    assert listed and listed[0]['time'] == pytest.approx(table.channels['time'][at])
+    assert listed[0]['residual_lpm'] == pytest.approx(-2.0, rel=0.1)
+
+
+@pytest.mark.parametrize('name', MBARI)
+def test_the_real_logs_fast_transients_are_not_spikes(name):
+    table = read_log(data_path('real', 'mbari_pto', name), load_mapping('mbari_pto'))
+    first, _ = segments(table.channels['time'], 3.0)
+    assert spikes(table.flow, first)[0].sum() <= 2  # of some 20 000 samples

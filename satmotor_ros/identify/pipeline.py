@@ -180,7 +180,26 @@ class Calibration:
                        residual_lpm=written(residual[i] / LPM),
                        noise_sd=written(abs(residual[i]) / self.forward.sigma[i]))
             out.append(row)
-        return out
+        return out + self.spike_rows()
+
+    def spike_rows(self) -> list[dict[str, Any]]:
+        """
+        Return each sample left out as a spike of the flow reading (a time series' only).
+
+        Returns
+        -------
+        list of dict
+            time, sample (its index in the time-ordered data), flow_lpm, residual_lpm (its
+            departure from its neighbours' local fit) and noise_sd (that departure in
+            robust standard deviations of all departures).
+        """
+        s = self.samples
+        if s is None or not s.spikes.size:
+            return []
+        time, flow = s.samples.channels['time'], s.samples.flow
+        return [{'time': written(time[j]), 'sample': int(j), 'flow_lpm': written(flow[j] / LPM),
+                 'residual_lpm': written(d / LPM), 'noise_sd': written(abs(d) / s.spike_scale)}
+                for j, d in zip(s.spikes, s.spike_size)]
 
     def missed_regions(self) -> list[dict[str, Any]]:
         """

@@ -34,17 +34,19 @@ and the intervals use the variance inflation of :func:`variance_inflation`.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, field, fields, replace
 from typing import Any
 
 import numpy as np
 from satmotor_ros.identify.errors import DataError, IdentificationError
 from satmotor_ros.identify.fit import FitReport, written
+from satmotor_ros.identify.noise import MAD
 from satmotor_ros.identify.parts import loss_parts, LossParts, NO_EFFECT
 from satmotor_ros.identify.table import BenchTable
 from satmotor_ros.model import MotorModel
 from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.revolutions import sampled_revolutions
+from scipy import special
 
 BIN_SECONDS = 0.2
 """
@@ -125,6 +127,11 @@ class Samples:
     usable: np.ndarray  # which of them the model can use [-]
     bounds: tuple[np.ndarray, np.ndarray]  # first and last sample of each row [-]
     in_bins: np.ndarray  # which of the raw samples a row holds [-]
+    spikes: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))  # samples
+    # left out as isolated spikes of the flow reading (:func:`spikes`) [-]
+    spike_size: np.ndarray = field(default_factory=lambda: np.zeros(0))  # their departure
+    # from the neighbours' local fit [m^3/s]
+    spike_scale: float = 0.0  # the robust scale of those departures [m^3/s]
 
     guard = 1
     """Rows a test fold keeps out of training on each side: neighbours share a sample."""
@@ -405,6 +412,10 @@ def transient_samples(model: MotorModel, table: BenchTable,
         channels['revolutions'] = sampled_revolutions(table.speed, time)
     table = replace(table, channels=channels, units={**table.units, 'revolutions': 'rev'})
     all_parts, usable = loss_parts(model, table)
+    spike, departure, scale = spikes(table.flow, first)
+    if (spike & usable).any():  # a bad sample decides nothing: left out like an unusable one
+        all_parts = parts_at(all_parts, ~spike[usable])
+        usable = usable & ~spike
     size = max(1, int(round(options.bin_seconds / step)) if step > 0.0 else 1)
     size = max(size, int(np.ceil(int(usable.sum()) / options.max_rows)))
     where = np.flatnonzero(usable)  # parts are at the usable samples only
@@ -452,16 +463,88 @@ def transient_samples(model: MotorModel, table: BenchTable,
     note = (f'all samples: {n_samples} of {len(table)} ({100.0 * n_samples / len(table):.0f} %) '
             f'in {n_segments} stretch(es) without a gap, step {step:.4g} s, averaged over '
             f'bins of {size} steps ({size * step:.3g} s, {a.size} rows)'
-            + left_out_samples(model, table, usable, held))
+            + left_out_samples(model, table, usable | spike, held, int(spike.sum())))
     rows = replace(rows, notes=rows.notes + (note,))
     lags = [nuisance[name] for name in ('speed_lag', 'flow_lag') if name in nuisance]
     correlation = float(np.corrcoef(lags[0], lags[1])[0, 1]) if len(lags) == 2 else np.nan
     return Samples(rows, parts, n_samples, size, step, n_segments, tuple(left_out),
-                   correlation, table, usable, (a, b), held)
+                   correlation, table, usable, (a, b), held, np.flatnonzero(spike),
+                   departure[spike], scale)
+
+
+SPIKE_HALF = 3
+"""Samples on each side of a sample whose local quadratic fit predicts it, [-]."""
+
+SPIKE_LIMIT = 5.0
+"""Least departure of a spike from its neighbours' fit, in robust standard deviations, [-]."""
+
+SPIKE_NEIGHBOUR = 0.8
+"""Largest departure of a spike's two neighbours, as a share of its own (a step's are alike)."""
+
+
+def spikes(x: FloatArray, first: np.ndarray) -> tuple[np.ndarray, FloatArray, float]:
+    r"""
+    Flag the isolated spikes of a sampled reading: one sample far off its neighbours' curve.
+
+    Each sample is predicted by a quadratic through the :data:`SPIKE_HALF` samples on each
+    side (itself left out), a linear filter (per stretch without a gap; the ends are never
+    flagged). A sample is a spike when its departure from that prediction exceeds
+    :data:`SPIKE_LIMIT` robust standard deviations of all departures (or the Gaussian
+    quantile that a clean series of N samples exceeds with chance 5 %, if larger), is the
+    largest within :data:`SPIKE_HALF` samples, and both neighbours depart the other way by
+    at most :data:`SPIKE_NEIGHBOUR` of it (a spike pulls its neighbours' predictions by 0.43
+    of its size; at a step both sides depart alike). A bad reading of one sample is thus
+    found before the samples are averaged into rows, where it would be diluted below the
+    rows' outlier limit, while a fast but smooth transient is not.
+
+    Parameters
+    ----------
+    x : ndarray
+        The samples, [any]
+    first : ndarray of bool
+        First sample of each stretch without a gap, [-]
+
+    Returns
+    -------
+    ndarray of bool
+        True at a spike.
+    ndarray
+        Each sample's departure from its neighbours' fit (0 at the ends), [unit of x]
+    float
+        The robust standard deviation of the departures, [unit of x]
+
+    """
+    m = SPIKE_HALF
+    k = np.array([j for j in range(-m, m + 1) if j], dtype=float)
+    design = np.column_stack([np.ones_like(k), k, k * k])
+    weight = np.linalg.pinv(design)[0]  # the quadratic's value at 0 from the others
+    kernel = np.concatenate((weight[:m], [0.0], weight[m:]))
+    departure = np.zeros(x.size)
+    starts = np.flatnonzero(first)
+    for lo, hi in zip(starts, np.append(starts[1:], x.size)):
+        if hi - lo > 2 * m:
+            departure[lo + m:hi - m] = x[lo + m:hi - m] - np.convolve(
+                x[lo:hi], kernel[::-1], 'valid')
+    departure[~np.isfinite(departure)] = 0.0
+    flagged = np.zeros(x.size, dtype=bool)
+    moved = np.abs(departure[departure != 0.0])  # a quantised reading rests on exact zeros
+    scale = float(MAD * np.median(moved)) if moved.size else 0.0
+    if not scale > 0.0:
+        return flagged, departure, scale
+    limit = max(SPIKE_LIMIT, float(special.ndtri(1.0 - 0.025 / max(x.size, 1)))) * scale
+    size = np.abs(departure)
+    for i in np.flatnonzero(size > limit):
+        if i < m or i + m >= x.size:
+            continue
+        near = departure[i - 1], departure[i + 1]
+        flagged[i] = (size[i] >= size[i - m:i + m + 1].max()
+                      and all(np.sign(d) == -np.sign(departure[i])
+                              and abs(d) <= SPIKE_NEIGHBOUR * size[i] for d in near))
+    return flagged, departure, scale
 
 
 def left_out_samples(model: MotorModel, table: BenchTable, usable: np.ndarray,
-                     held: np.ndarray) -> str:
+                     held: np.ndarray, n_spikes: int = 0) -> str:
     """
     Say why samples are in no row: which the model cannot use, and which no bin holds.
 
@@ -472,9 +555,12 @@ def left_out_samples(model: MotorModel, table: BenchTable, usable: np.ndarray,
     table : BenchTable
         The samples in time order, [-]
     usable : ndarray of bool
-        Which the model can use (:func:`~satmotor_ros.identify.parts.loss_parts`), [-]
+        Which the model can use (:func:`~satmotor_ros.identify.parts.loss_parts`), the
+        spikes among them, [-]
     held : ndarray of bool
         Which a row holds, [-]
+    n_spikes : int
+        Samples left out as spikes (:func:`spikes`), [-]
 
     Returns
     -------
@@ -492,7 +578,9 @@ def left_out_samples(model: MotorModel, table: BenchTable, usable: np.ndarray,
                 'that turns with the drop and no flow that way)'),
                (int((finite & ~no_flow & ~usable).sum()), 'with a chamber drop outside 0 to '
                 f'{model.dp_limit / 1e6:.3g} MPa'),
-               (int((usable & ~held).sum()), 'in runs of usable samples too short for a bin')]
+               (n_spikes, 'isolated spikes of the flow reading (listed as outliers)'),
+               (int((usable & ~held).sum()) - n_spikes,
+                'in runs of usable samples too short for a bin')]
     said = [f'{k} {why}' for k, why in reasons if k]
     return '; left out: ' + ', '.join(said) if said else ''
 
