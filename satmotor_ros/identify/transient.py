@@ -46,7 +46,7 @@ from satmotor_ros.identify.table import BenchTable
 from satmotor_ros.model import MotorModel
 from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.revolutions import sampled_revolutions
-from scipy import special
+from scipy import ndimage, special
 
 BIN_SECONDS = 0.2
 """
@@ -478,8 +478,19 @@ SPIKE_HALF = 3
 SPIKE_LIMIT = 5.0
 """Least departure of a spike from its neighbours' fit, in robust standard deviations, [-]."""
 
-SPIKE_NEIGHBOUR = 0.8
-"""Largest departure of a spike's two neighbours, as a share of its own (a step's are alike)."""
+SPIKE_SCALE_HALF = 50
+"""Samples on each side whose departures give a sample's local noise scale, [-]."""
+
+SPIKE_SIDES = 0.5
+"""Least departure of a spike from the lines through the samples on each side, as a share of
+its departure from the quadratic through both, [-]."""
+
+
+def _extrapolated(before: FloatArray) -> float:
+    """Return the value one step past samples in order, on the line through them."""
+    k = np.arange(before.size, dtype=float)
+    slope, intercept = np.polyfit(k, before, 1)
+    return float(intercept + slope * before.size)
 
 
 def spikes(x: FloatArray, first: np.ndarray) -> tuple[np.ndarray, FloatArray, float]:
@@ -489,13 +500,16 @@ def spikes(x: FloatArray, first: np.ndarray) -> tuple[np.ndarray, FloatArray, fl
     Each sample is predicted by a quadratic through the :data:`SPIKE_HALF` samples on each
     side (itself left out), a linear filter (per stretch without a gap; the ends are never
     flagged). A sample is a spike when its departure from that prediction exceeds
-    :data:`SPIKE_LIMIT` robust standard deviations of all departures (or the Gaussian
-    quantile that a clean series of N samples exceeds with chance 5 %, if larger), is the
-    largest within :data:`SPIKE_HALF` samples, and both neighbours depart the other way by
-    at most :data:`SPIKE_NEIGHBOUR` of it (a spike pulls its neighbours' predictions by 0.43
-    of its size; at a step both sides depart alike). A bad reading of one sample is thus
-    found before the samples are averaged into rows, where it would be diluted below the
-    rows' outlier limit, while a fast but smooth transient is not.
+    :data:`SPIKE_LIMIT` standard deviations of the departures within
+    :data:`SPIKE_SCALE_HALF` samples (from their mean magnitude, at least the robust one of
+    all departures; or the Gaussian quantile that a clean series of N samples exceeds with
+    chance 5 %, if larger), is the largest within :data:`SPIKE_HALF` samples, and departs
+    the same way by at least :data:`SPIKE_SIDES` of it from the line through the samples
+    before it and from the line through those after it (a kink, where a transient starts,
+    lies on both lines; a step on one; a curve departs from the quadratic by little). A
+    bad reading of one sample is thus found before the samples are averaged into rows,
+    where it would be diluted below the rows' outlier limit, while a fast but smooth
+    transient is not.
 
     Parameters
     ----------
@@ -531,15 +545,22 @@ def spikes(x: FloatArray, first: np.ndarray) -> tuple[np.ndarray, FloatArray, fl
     scale = float(MAD * np.median(moved)) if moved.size else 0.0
     if not scale > 0.0:
         return flagged, departure, scale
-    limit = max(SPIKE_LIMIT, float(special.ndtri(1.0 - 0.025 / max(x.size, 1)))) * scale
     size = np.abs(departure)
+    # the noise may grow with the reading: each sample is judged by its neighbourhood's
+    # scale (never below the whole series' robust
+    # scale, by the mean |departure| there: a median of a quantised reading's departures
+    # rests on its resolution)
+    local = np.maximum(np.sqrt(np.pi / 2.0) * ndimage.uniform_filter1d(
+        size, 2 * SPIKE_SCALE_HALF + 1, mode='nearest'), scale)
+    limit = max(SPIKE_LIMIT, float(special.ndtri(1.0 - 0.025 / max(x.size, 1)))) * local
     for i in np.flatnonzero(size > limit):
-        if i < m or i + m >= x.size:
+        if i < m or i + m >= x.size or size[i] < size[i - m:i + m + 1].max():
             continue
-        near = departure[i - 1], departure[i + 1]
-        flagged[i] = (size[i] >= size[i - m:i + m + 1].max()
-                      and all(np.sign(d) == -np.sign(departure[i])
-                              and abs(d) <= SPIKE_NEIGHBOUR * size[i] for d in near))
+        # a spike departs alike from the line through the samples before and after it; a
+        # kink or the start of a transient (on both lines) and a step (on one) do not
+        sides = [_extrapolated(x[i - m:i]) - x[i], _extrapolated(x[i + m:i:-1]) - x[i]]
+        flagged[i] = all(np.sign(-d) == np.sign(departure[i])
+                         and abs(d) >= SPIKE_SIDES * size[i] for d in sides)
     return flagged, departure, scale
 
 
