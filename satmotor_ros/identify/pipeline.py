@@ -637,7 +637,21 @@ def _selector(options: Options, points: BenchTable,
               samples: Samples | None) -> CrossValidatedSelector:
     return CrossValidatedSelector(options.alpha, options.n_folds, options.min_gain, options.tie,
                                   'time' in points.channels, options.seed, options.max_effects,
-                                  samples.guard if samples else 0, samples is not None)
+                                  samples.guard if samples else 0, samples is not None,
+                                  _block(samples))
+
+
+BLOCK_SECONDS = 2.0
+"""Length of a cross-validation block of a time series' rows, [s]: a few correlation
+times of the residuals (a transient's 0.05-0.5 s), short against the recording."""
+
+
+def _block(samples: Samples | None) -> int:
+    """Return the rows of a cross-validation block of a time series (0: steady points)."""
+    if samples is None:
+        return 0
+    seconds = samples.bin_size * samples.step
+    return max(2 * samples.guard + 1, int(np.ceil(BLOCK_SECONDS / seconds)) if seconds > 0 else 1)
 
 
 def _family_and_rows(spec: MotorSpec, liquid: str, table: BenchTable,

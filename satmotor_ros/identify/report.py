@@ -359,7 +359,11 @@ def _steps(cal: Calibration) -> list[str]:
     return lines + ['', _table(rows, header), '',
                     'Errors are of the volumetric losses Q_vl = Q - q_t n, out of sample '
                     f'({min(cal.n_folds, len(cal.parts))}-fold cross-validation), at the points '
-                    'that are not outliers.']
+                    'that are not outliers: the plain figures a user reads. The selection '
+                    'chooses by another figure, the cross-validated error of the residuals '
+                    "weighted by the noise model and passed through Huber's loss (the "
+                    "candidates' table below), and keeps an effect only if the plain RMSE "
+                    'falls too.']
 
 
 def _outliers(cal: Calibration, summary: dict[str, Any]) -> list[str]:

@@ -9,7 +9,9 @@ otherwise). The best candidate is accepted only if it passes two tests
 against the step's baseline (the model with the effects found so far): a
 nested-model F-test at the significance ``alpha``, Bonferroni-corrected for
 the number of candidates tried, and a cut of the cross-validated error by at
-least ``min_gain``. The loop stops at the first step whose best candidate
+least ``min_gain``; and its plain (unweighted) out-of-sample RMSE over the
+step's rows, the figure the report gives, must fall too: an effect that the
+noise-weighted figure prefers while the error a user reads rises is not kept. The loop stops at the first step whose best candidate
 fails; the answer is then the effects found, or ``none``. A runner-up that
 passes the same tests is reported as a near tie when its cross-validated
 error is within ``tie`` of the winner's, or when it removes all but ``tie``
@@ -40,8 +42,11 @@ the operating space or in time (:mod:`.regions`) are structure, not bad rows:
 they stay in every fit, where a candidate may explain them, and those the
 final model still misses are named as regions.
 
-Rows of a time series (:mod:`.transient`) have correlated residuals: a test
-fold then also keeps ``guard`` rows on each side out of its training, and the
+Rows of a time series (:mod:`.transient`) have correlated residuals: the folds
+are then blocks of about two seconds of rows dealt to the folds in turn (so that
+every fold's training holds rows of each event the recording repeats, a valve
+that opens at the top of each stroke), each block's ``guard`` rows on each side
+are kept out of its fold's training, and the
 F-test divides the statistic and the number of rows by the variance inflation
 of the baseline's residuals or of the candidate's, whichever is larger (a
 candidate that bends to slow noise whitens its own residuals).
@@ -115,6 +120,7 @@ class Score:
     cv_error: FloatArray  # out-of-sample error of Q_vl at every point [m^3/s]
     cv_rmse: float  # noise-weighted, robust cross-validated error [m^3/s]
     p_value: float  # F-test against the step's baseline (1 for the baseline) [-]
+    rmse: float = np.nan  # plain out-of-sample RMSE over the rows fitted [m^3/s]
 
     @property
     def label(self) -> str:
@@ -205,7 +211,8 @@ def determined(fit: LossFit) -> bool:
     return True
 
 
-def folds(n: int, k: int, time_ordered: bool, seed: int = 0) -> list[np.ndarray]:
+def folds(n: int, k: int, time_ordered: bool, seed: int = 0,
+          block: int = 0) -> list[np.ndarray]:
     """
     Split point indices into K folds.
 
@@ -219,6 +226,10 @@ def folds(n: int, k: int, time_ordered: bool, seed: int = 0) -> list[np.ndarray]
         Contiguous blocks in order (time series) rather than shuffled, [-]
     seed : int
         Seed of the shuffle, [-]
+    block : int
+        Rows of a block (> 0, time order only): the rows are cut into blocks in time
+        order, dealt to the folds in turn, so that every fold's training holds rows of
+        every stretch the recording visits more than once; 0: K contiguous folds, [-]
 
     Returns
     -------
@@ -226,8 +237,12 @@ def folds(n: int, k: int, time_ordered: bool, seed: int = 0) -> list[np.ndarray]
         Test indices of each fold.
 
     """
+    k = min(k, n)
+    if time_ordered and block > 0 and n >= 2 * k * block:
+        dealt = (np.arange(n) // block) % k
+        return [np.flatnonzero(dealt == j) for j in range(k)]
     order = np.arange(n) if time_ordered else np.random.default_rng(seed).permutation(n)
-    return [np.sort(part) for part in np.array_split(order, min(k, n))]
+    return [np.sort(part) for part in np.array_split(order, k)]
 
 
 class CrossValidatedSelector:
@@ -257,12 +272,16 @@ class CrossValidatedSelector:
     correlated : bool
         Whether neighbouring residuals are correlated (a time series' rows): the
         F-test then uses the variance inflation, [-]
+    block : int
+        Rows per block of blocked-interleaved folds (:func:`folds`); 0 for K contiguous
+        folds, [-]
 
     """
 
     def __init__(self, alpha: float = 0.05, n_folds: int = 5, min_gain: float = 0.05,
                  tie: float = 0.05, time_ordered: bool = False, seed: int = 0,
-                 max_effects: int = 4, guard: int = 0, correlated: bool = False) -> None:
+                 max_effects: int = 4, guard: int = 0, correlated: bool = False,
+                 block: int = 0) -> None:
         """Validate and store the hyperparameters."""
         if not 0.0 < alpha < 1.0:
             msg = f'alpha = {alpha!r}: must be in (0, 1)'
@@ -277,6 +296,7 @@ class CrossValidatedSelector:
         self.alpha, self.n_folds, self.min_gain, self.tie = alpha, n_folds, min_gain, tie
         self.time_ordered, self.seed, self.max_effects = time_ordered, seed, max_effects
         self.guard = guard if time_ordered else 0
+        self.block = block if time_ordered else 0
         self.correlated = correlated
         self._tried: dict[int, FloatArray] = {}  # candidate id -> its parameters last fitted
         self._space: Space | None = None  # where the rows lie, for clusters of outliers
@@ -310,7 +330,7 @@ class CrossValidatedSelector:
         """
         full = LossFit(effects, sigma, HUBER).fit(parts, index, start)
         error = parts.flow - full.predict(parts)  # out of sample where not fitted
-        for test in folds(index.size, self.n_folds, self.time_ordered, self.seed):
+        for test in folds(index.size, self.n_folds, self.time_ordered, self.seed, self.block):
             u = full.without(_guarded(test, self.guard, index.size))
             error[index[test]] = parts.flow[index[test]] - full.predict(parts, index[test], u)
         z = error[index] / sigma[index]
@@ -331,7 +351,9 @@ class CrossValidatedSelector:
                                                      - full.n_params, 1), f))
             elif drop > 0.0:
                 p_value = 0.0
-        return Score(effects[-1] if baseline is not None else None, full, error, cv, p_value)
+        rmse = float(np.sqrt(np.mean(error[index] ** 2)))
+        return Score(effects[-1] if baseline is not None else None, full, error, cv, p_value,
+                     rmse)
 
     def inflation(self, parts: LossParts, fit: LossFit, sigma: FloatArray,
                   index: np.ndarray) -> float:
@@ -361,8 +383,10 @@ class CrossValidatedSelector:
                                   / sigma[index])
 
     def _significant(self, score: Score, baseline: Score, m: int) -> bool:
+        # the weighted figure chooses; the plain error the report gives must fall too
         return (score.p_value < self.alpha / m
                 and score.cv_rmse < (1.0 - self.min_gain) * baseline.cv_rmse
+                and not score.rmse >= baseline.rmse
                 and determined(score.fit))
 
     def _passes(self, score: Score, baseline: Score, m: int) -> bool:
@@ -463,7 +487,8 @@ class CrossValidatedSelector:
                 f'{"none" if not found else "no further effect"}: the best candidate, '
                 f'{top.label}, cuts the cross-validated error by {100 * gain:.1f} % (need > '
                 f'{100 * self.min_gain:.0f} %) with p = {top.p_value:.2g} (need < '
-                f'{self.alpha:g}/{m})' + _at_bound(refused)))
+                f'{self.alpha:g}/{m}), its plain RMSE {_plain(baseline, top)} (must fall)'
+                + _at_bound(refused)))
         removed = baseline.cv_rmse - top.cv_rmse
         close = [s for s in ranking if self._passes(s, baseline, m) and (
             s.cv_rmse <= (1.0 + self.tie) * top.cv_rmse
@@ -483,7 +508,8 @@ class CrossValidatedSelector:
         runner = others[0] if others else None
         gain = 1.0 - best.cv_rmse / baseline.cv_rmse
         verdict = (f'{best.label}: cuts the cross-validated error by {100 * gain:.1f} %, '
-                   f'p = {best.p_value:.2g} < {self.alpha:g}/{m}')
+                   f'p = {best.p_value:.2g} < {self.alpha:g}/{m}, plain RMSE '
+                   f'{_plain(baseline, best)}')
         if runner is not None:
             verdict += _tie(best, runner, baseline)
         if top is not best and priority(top.effect) == 2 and (runner is None
@@ -539,10 +565,18 @@ class CrossValidatedSelector:
 
 
 def _guarded(test: np.ndarray, guard: int, n: int) -> np.ndarray:
-    """Return a contiguous test fold widened by `guard` positions on each side."""
+    """Return a test fold with each of its contiguous runs widened by `guard` positions."""
     if not guard:
         return test
-    return np.arange(max(int(test[0]) - guard, 0), min(int(test[-1]) + guard + 1, n))
+    kept = np.zeros(n, dtype=bool)
+    for step in range(-guard, guard + 1):
+        kept[np.clip(test + step, 0, n - 1)] = True
+    return np.flatnonzero(kept)
+
+
+def _plain(baseline: Score, score: Score) -> str:
+    """Say how a candidate moves the plain out-of-sample RMSE, [l/min]."""
+    return f'{baseline.rmse / LPM:.4g} -> {score.rmse / LPM:.4g} l/min'
 
 
 def _with_verdict(step: Selection, verdict: str) -> Selection:
