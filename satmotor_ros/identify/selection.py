@@ -13,8 +13,8 @@ least ``min_gain``; and its plain (unweighted) out-of-sample RMSE over the
 step's rows, the figure the report gives, must fall too: an effect that the
 noise-weighted figure prefers while the error a user reads rises is not kept.
 The loop stops at the first step whose best candidate fails; the answer is
-then the effects found, or ``none``. A runner-up that passes the same tests is reported as a near tie when its cross-validated
-error is within ``tie`` of the winner's, or when it removes all but ``tie``
+then the effects found, or ``none``. A runner-up that passes the same tests
+is reported as a near tie when its cross-validated error is within ``tie`` of the winner's, or when it removes all but ``tie``
 of the error the winner removes (on data with little noise both errors left
 are tiny, and their ratio means nothing); among the first kind a named
 physical effect goes before ``channel:``, ``term:`` and ``threshold:``, and
