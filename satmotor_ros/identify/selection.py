@@ -2,24 +2,25 @@
 """
 Model selection: which candidate effects, if any, the data ask for, one after the other.
 
-Forward selection: each step refits every candidate not yet found on top of
-the effects found so far and scores it by its K-fold cross-validated error
+Forward selection: each step refits every candidate not yet found on top of the
+effects found so far and scores it by its K-fold cross-validated error
 (contiguous, time-ordered folds for data in time order, seeded shuffled folds
-otherwise). The best candidate is accepted only if it passes two tests
-against the step's baseline (the model with the effects found so far): a
-nested-model F-test at the significance ``alpha``, Bonferroni-corrected for
-the number of candidates tried, and a cut of the cross-validated error by at
-least ``min_gain``; and its plain (unweighted) out-of-sample RMSE over the
-step's rows, the figure the report gives, must fall too: an effect that the
-noise-weighted figure prefers while the error a user reads rises is not kept.
-The loop stops at the first step whose best candidate fails; the answer is
-then the effects found, or ``none``. A runner-up that passes the same tests
-is reported as a near tie when its cross-validated error is within ``tie`` of the winner's, or when it removes all but ``tie``
-of the error the winner removes (on data with little noise both errors left
-are tiny, and their ratio means nothing); among the first kind a named
-physical effect goes before ``channel:``, ``term:`` and ``threshold:``, and
-before a fitted form that beats it by less than :data:`FORM_TIE` of the error
-removed (a form with free exponents bends towards anything).
+otherwise). The best candidate is accepted only if it passes two tests against
+the step's baseline (the model with the effects found so far): a nested-model
+F-test at the significance ``alpha``, Bonferroni-corrected for the number of
+candidates tried, and a cut of the cross-validated error by at least
+``min_gain``; and its plain (unweighted) out-of-sample RMSE over the step's
+rows, the figure the report gives, must fall too: an effect that the noise-
+weighted figure prefers while the error a user reads rises is not kept. The
+loop stops at the first step whose best candidate fails; the answer is then the
+effects found, or ``none``. A runner-up that passes the same tests is reported
+as a near tie when its cross-validated error is within ``tie`` of the winner's,
+or when it removes all but ``tie`` of the error the winner removes (on data
+with little noise both errors left are tiny, and their ratio means nothing);
+among the first kind a named physical effect goes before ``channel:``,
+``term:`` and ``threshold:``, and before a fitted form that beats it by less
+than :data:`FORM_TIE` of the error removed (a form with free exponents bends
+towards anything).
 
 A candidate whose fit leaves an effect's parameter on a bound of its range (a
 sensor gain at -0.5, an exponent at its limit) is never accepted: the data ask
