@@ -51,9 +51,14 @@ def robust_scale(residual: FloatArray, n_params: int = 0) -> float:
 
 
 def noise_model(residual: FloatArray, flow: FloatArray, n_params: int,
-                floor: float) -> FloatArray:
+                floor: float, rate: FloatArray | None = None) -> FloatArray:
     """
-    Estimate each point's noise from the residuals of a fit: sigma^2 = a + b Q^2.
+    Estimate each point's noise from the residuals of a fit: sigma^2 = a + b Q^2 (+ c Q'^2).
+
+    With the rate of change of the flow (a time series' rows), a third term c (dQ/dt)^2
+    carries the error of readings that are off in time by a varying amount (timing
+    jitter: the spread grows with how fast the flow changes); it is not capped by
+    :data:`MAX_RATIO`, and is kept only where the data ask for it (c >= 0).
 
     Parameters
     ----------
@@ -65,6 +70,8 @@ def noise_model(residual: FloatArray, flow: FloatArray, n_params: int,
         Parameters of the fit, [-]
     floor : float
         Least noise (noise-free data), [m^3/s]
+    rate : ndarray, optional
+        Rate of change of the flow at each point, [m^3/s^2]
 
     Returns
     -------
@@ -76,14 +83,16 @@ def noise_model(residual: FloatArray, flow: FloatArray, n_params: int,
     sigma = np.full(residual.size, scale)
     if residual.size >= MIN_HETERO_POINTS:
         x2 = (flow / max(float(np.max(np.abs(flow))), 1e-300)) ** 2
+        r2 = np.zeros_like(x2) if rate is None else (
+            rate / max(float(np.max(np.abs(rate))), 1e-300)) ** 2
         for _ in range(3):  # the band follows the noise model as it forms
             inside = np.abs(residual) <= 4.0 * sigma
-            design = np.column_stack([np.ones(int(inside.sum())), x2[inside]])
-            (a, b), _ = optimize.nnls(design, residual[inside] ** 2)
+            design = np.column_stack([np.ones(int(inside.sum())), x2[inside], r2[inside]])
+            (a, b, c), _ = optimize.nnls(design, residual[inside] ** 2)
             if not a + b > 0.0:
                 break
             a = max(a, (a + b) / MAX_RATIO ** 2)
-            sigma = np.sqrt(a + b * x2)
+            sigma = np.sqrt(a + b * x2 + c * r2)
     ratio = np.abs(residual) / sigma
     sigma = sigma * MAD * float(np.median(ratio)) * np.sqrt(
         residual.size / max(residual.size - n_params, 1))

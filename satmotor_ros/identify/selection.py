@@ -416,7 +416,9 @@ class CrossValidatedSelector:
             for c in pool]
         best = min([base, *fits], key=lambda f: f.objective_)
         residual = parts.flow - best.predict(parts)
-        sigma = noise_model(residual, parts.flow, best.n_params, floor)
+        # a time series' rows: the noise may grow with how fast the flow changes (timing)
+        sigma = noise_model(residual, parts.flow, best.n_params, floor,
+                            parts.nuisance.get('flow_lag'))
         left_out = self._isolated(parts, residual, sigma)
         for fit in fits:  # an outlier only if it stays one under each candidate's model
             if not left_out.any():
