@@ -192,6 +192,7 @@ class Calibration:
             time, sample (its index in the time-ordered data), flow_lpm, residual_lpm (its
             departure from its neighbours' local fit) and noise_sd (that departure in
             robust standard deviations of all departures).
+
         """
         s = self.samples
         if s is None or not s.spikes.size:
