@@ -80,24 +80,29 @@ def _detectable(trajectory, effects, kind_index: int, noise, seed: int, full) ->
     """
     Return whether an oracle knowing the effect's column and the noise finds it (t > 3.3).
 
-    The column is what the effect changes in Q - q_t n; the base model's own loss is partialled
-    out (a calibration rescales it); the error is the case's noise, jitter and bad row, with a
-    heteroscedastic (sandwich) variance inflated by the noise's correlation.
+    The column is what the effect changes in Q - q_t n; the base model's own loss and a
+    constant are partialled out (a calibration rescales the one and may offset); the fit is
+    weighted by the noise's known variance per sample (its jitter part grows with |dQ/dt|), and
+    the variance inflated by the noise's correlation.
     """
     others = [e for i, e in enumerate(effects) if i != kind_index]
     without = build_case(trajectory, others, noise=None, seed=seed)
     column = _residual(full) - _residual(without)
     error = (full.flow - full.noiseless) / LPM
+    rate = np.gradient(full.noiseless, full.time) / LPM
+    weight = 1.0 / (noise.colored_lpm ** 2 + noise.white_lpm ** 2
+                    + (noise.jitter_s * rate) ** 2)
+    root = np.sqrt(weight)
     base = (full.base_flow - full.displacement * trajectory.speed_state) / LPM
-    nuisance = np.column_stack([base, np.ones_like(base)])
+    nuisance = root[:, None] * np.column_stack([base, np.ones_like(base)])
+    column, error = root * column, root * error
     column = column - nuisance @ np.linalg.lstsq(nuisance, column, rcond=None)[0]
     norm = float(column @ column)
     if norm < 1e-12:
         return False
     step = float(np.median(np.diff(full.time)))
     inflation = max(1.0, 2.0 * np.sqrt(np.pi) * noise.correlation_s / step)  # sum of the ACF
-    se = np.sqrt(inflation * float(np.sum(column ** 2 * error ** 2))) / norm
-    return abs(1.0 + float(column @ error) / norm) / se > 3.3
+    return abs(1.0 + float(column @ error) / norm) * np.sqrt(norm / inflation) > 3.3
 
 
 def _named(kind: str, effect, found: dict) -> tuple[bool, bool | None]:
