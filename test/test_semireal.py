@@ -236,10 +236,11 @@ def _named(kind, result, effect=None):
 # here; the others (issue 20: a clean case with the real noise, a bad row listed, a valve on
 # the BIAS log's positive side, wear, the gains, a lag under the real noise, pairs, every
 # sample used) are on the board for loop and effects, to be added as they pass.
-CLEAN = [('steady', STEPPED)]
+CLEAN = [('steady', STEPPED), ('real', BIAS)]
 EFFECTS = [('steady', BIAS, ('external_leakage',), -1), ('steady', STEPPED, ('flow_lag',), -1),
-           ('real', STEPPED, ('relief',), -1)]
-VALVES = [('real', STEPPED, -1)]
+           ('steady', BIAS, ('external_leakage', 'clearance_wear'), -1),
+           ('real', STEPPED, ('relief',), -1), ('real', STEPPED, ('relief', 'flow_sensor_gain'), -1)]
+VALVES = [('steady', STEPPED, -1), ('real', STEPPED, -1)]
 
 
 @pytest.mark.parametrize(('noise', 'name'), CLEAN)
