@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """``satmotor calibrate``: exact JSON fields, a loadable YAML, real plots, one-line errors."""
 
+from dataclasses import replace
 import json
 
 import numpy as np
@@ -99,6 +100,25 @@ def test_calibrate_clean_data_exits_zero_with_effect_none(tmp_path, capsys):
     assert result['effect'] == 'none' and result['coefficient'] is None
     assert any(c['effect'] == 'channel:strain' for c in result['candidates'])
     assert 'effects:' not in (tmp_path / 'o' / 'coefficients.yaml').read_text()
+
+
+def test_calibrate_line_counts_the_rows_its_error_is_over_and_gives_it_with_outliers(
+        tmp_path, capsys):
+    table = generate(Plan(liquid='oil'), Injection(), seed=3)
+    flow = table.flow.copy()
+    flow[5] += 3.0 * LPM
+    data = _csv(tmp_path / 'bad_row.csv', replace(table, flow=flow))
+    code, out, _ = _run(capsys, 'calibrate', data, '--liquid', 'oil', '--out', tmp_path / 'o')
+    result = json.loads((tmp_path / 'o' / 'calibration.json').read_text())
+    n, left_out = result['n_points'], len(result['outliers'])
+    assert code == 0 and left_out == 1
+    # the first figure leaves the outlier out: the line counts the rows it is really over
+    assert f'l/min over {n - left_out} of {n} points' in out
+    with_them = (f'{result["error_before_with_outliers"]["rmse_lpm"]:.4g} -> '
+                 f'{result["error_after_with_outliers"]["rmse_lpm"]:.4g} l/min')
+    assert f'with them {with_them}' in out
+    assert result['error_after_with_outliers']['rmse_lpm'] > 3 * result['error_after'][
+        'rmse_lpm']
 
 
 def test_calibrate_line_names_a_near_tie(tmp_path, capsys):

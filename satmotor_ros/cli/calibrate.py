@@ -7,6 +7,7 @@ import argparse
 from dataclasses import replace
 from pathlib import Path
 import sys
+from typing import Any
 
 from satmotor_ros.cli._bench import add_data_arguments, load_data, run_bench_command
 from satmotor_ros.cli._common import add_motor_options
@@ -89,7 +90,6 @@ def _calibrate(data: str, out: str, mode: Mode, alpha: float, folds: int,
         write_report(cal, tmp, summary)
     target = Path(out)
     effect = summary['effect']
-    before, after = summary['error_before']['rmse_lpm'], summary['error_after']['rmse_lpm']
     kinds = [k for k in (IMPLAUSIBLE, AT_BOUND) if any(w.startswith(k) for w in warnings)]
     line = (f'WARNING {" and ".join(kinds)} (see report.md); ' if kinds else '') + \
         (f'WARNING: {settled.warning}; ' if settled.warning else '') + \
@@ -108,11 +108,22 @@ def _calibrate(data: str, out: str, mode: Mode, alpha: float, folds: int,
         other = next(f for f in tie['families'] if f != summary['family'])
         line += f' (near tie with {other})'
     line += f'; liquid {settled.source}'
-    if summary['outliers']:
-        line += f'; {len(summary["outliers"])} outlier(s) left out'
-    rows = f'{summary["n_points"]} points'
-    if cal.samples is not None:
-        rows = (f'{summary["n_points"]} rows of {summary["n_samples"]} samples (mode '
-                'transient: every usable sample, with the transient terms)')
-    return (f'{line}; out-of-sample RMSE of Q_vl {before:.4g} -> {after:.4g} l/min over '
-            f'{rows}; wrote {target}/calibration.json, coefficients.yaml, report.md')
+    return (f'{line}; {_errors(summary, cal.samples is not None)}; '
+            f'wrote {target}/calibration.json, coefficients.yaml, report.md')
+
+
+def _errors(summary: dict[str, Any], series: bool) -> str:
+    """Say the errors before and after and the rows they are over, outliers named apart."""
+    before, after = summary['error_before']['rmse_lpm'], summary['error_after']['rmse_lpm']
+    n, left_out = summary['n_points'], len(summary['outliers'])
+    unit = 'rows' if series else 'points'
+    rows = f'{n - left_out} of {n} {unit}' if left_out else f'{n} {unit}'
+    if series:
+        rows += (f' of {summary["n_samples"]} samples (mode transient: every usable sample, '
+                 'with the transient terms)')
+    text = f'out-of-sample RMSE of Q_vl {before:.4g} -> {after:.4g} l/min over {rows}'
+    if left_out:
+        text += (f'; {left_out} isolated outlier(s) left out of it, with them '
+                 f'{summary["error_before_with_outliers"]["rmse_lpm"]:.4g} -> '
+                 f'{summary["error_after_with_outliers"]["rmse_lpm"]:.4g} l/min')
+    return text
