@@ -192,6 +192,9 @@ def test_sensor_effects_convert_readings_only():
     ({'term:dp^0': {'coefficient': 1.0}}, 'each power above 0'),
     ({'threshold:dp': {'coefficient': 1.0, 'reference': 1e7, 'exponent': 272}},
      'exponent = 272.0: must be > 0 and at most 10'),
+    ({'threshold:dp': {'coefficient': -1e-11, 'reference': 1e7}}, r'coefficient = -1e-11: must'),
+    ({'threshold:dp@negative': {'coefficient': 1e-11, 'reference': -5e6,
+                                'direction': 'negative'}}, r'reference = -5000000.0: must be'),
     ({'viscosity_temperature': {'coefficient': 3.0, 'law': 'walther', 'reference_temperature':
                                 -708.0, 'reference_viscosity': 4e-5}},
      r'reference_temperature = -708.0: must be from -273 to 10000'),

@@ -85,15 +85,19 @@ class Threshold(EffectKind):
         return suffix
 
     def parse(self, name: str, doc: Mapping[str, Any], where: str) -> Effect:
-        """Read k, the cracking drop and the exponent (default 1, > 0)."""
+        """Read k >= 0, the cracking drop >= 0 and the exponent (default 1, > 0)."""
         regressor = self.regressor(name.partition(':')[2], doc.get('regressor'), where)
         exponent = finite(doc.get('exponent', 1.0), f'{where}.exponent')
         if not 0.0 < exponent <= MAX_EXPONENT:  # past it the flow overflows at bench drops
             msg = f'{where}.exponent = {exponent!r}: must be > 0 and at most {MAX_EXPONENT:g}'
             raise ConfigError(msg)
-        return Effect(name, finite(doc['coefficient'], f'{where}.coefficient'), regressor,
-                      finite(doc['reference'], f'{where}.reference'),
-                      options=(('exponent', exponent),))
+        coefficient = finite(doc['coefficient'], f'{where}.coefficient')
+        reference = finite(doc['reference'], f'{where}.reference')
+        for key, value in (('coefficient', coefficient), ('reference', reference)):
+            if value < 0.0:  # a valve passes flow from the high- to the low-pressure port
+                msg = f'{where}.{key} = {value!r}: must be >= 0 (a valve that cracks open)'
+                raise ConfigError(msg)
+        return Effect(name, coefficient, regressor, reference, options=(('exponent', exponent),))
 
     def to_mapping(self, effect: Effect) -> dict[str, Any]:
         """Write k, the cracking drop and the exponent."""
