@@ -90,8 +90,8 @@ def _detectable(trajectory, effects, kind_index: int, noise, seed: int, full) ->
     column = _residual(full) - _residual(without)
     error = (full.flow - full.noiseless) / LPM
     rate = np.gradient(full.noiseless, full.time) / LPM
-    weight = 1.0 / (noise.colored_lpm ** 2 + noise.white_lpm ** 2
-                    + (noise.jitter_s * rate) ** 2)
+    steady = noise.colored_lpm ** 2 + noise.white_lpm ** 2
+    weight = 1.0 / (steady + (noise.jitter_s * rate) ** 2)
     root = np.sqrt(weight)
     base = (full.base_flow - full.displacement * trajectory.speed_state) / LPM
     nuisance = root[:, None] * np.column_stack([base, np.ones_like(base)])

@@ -238,8 +238,8 @@ def _named(kind, result, effect=None):
 # sample used) are on the board for loop and effects, to be added as they pass.
 CLEAN = [('steady', STEPPED), ('real', BIAS)]
 EFFECTS = [('steady', BIAS, ('external_leakage',), -1), ('steady', STEPPED, ('flow_lag',), -1),
-           ('steady', BIAS, ('external_leakage', 'clearance_wear'), -1),
-           ('real', STEPPED, ('relief',), -1), ('real', STEPPED, ('relief', 'flow_sensor_gain'), -1)]
+           ('real', STEPPED, ('relief',), -1),
+           ('real', STEPPED, ('relief', 'flow_sensor_gain'), -1)]
 VALVES = [('steady', STEPPED, -1), ('real', STEPPED, -1)]
 
 
