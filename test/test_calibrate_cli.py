@@ -121,6 +121,18 @@ def test_calibrate_line_counts_the_rows_its_error_is_over_and_gives_it_with_outl
         'rmse_lpm']
 
 
+def test_calibrate_line_says_how_many_samples_the_error_is_not_over(tmp_path, capsys):
+    table = generate(Plan(liquid='oil'), Injection(), seed=3)
+    p_in = table.p_in.copy()
+    p_in[:30] = table.p_out[:30] + 0.05 * MPA  # less than the channels take: no prediction
+    data = _csv(tmp_path / 'low.csv', replace(table, p_in=p_in))
+    code, out, _ = _run(capsys, 'calibrate', data, '--liquid', 'oil', '--out', tmp_path / 'o')
+    coverage = json.loads((tmp_path / 'o' / 'calibration.json').read_text())['coverage']
+    left_out = coverage['samples_total'] - coverage['samples_used']
+    assert code == 0 and left_out >= 25 and coverage['samples_total'] == len(table)
+    assert f'points; {left_out} of {len(table)} samples left out, the error is not over' in out
+
+
 def test_calibrate_line_names_a_near_tie(tmp_path, capsys):
     table = generate(Plan(liquid='oil'), Injection.realistic('flow_sensor_gain'), seed=2)
     data = _csv(tmp_path / 'gain.csv', table)

@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """``satmotor validate``: a calibration's own error on its data, a second log, whole outputs."""
 
+from dataclasses import replace
 import json
 import os
 import subprocess
@@ -136,6 +137,19 @@ def leak_file(tmp_path_factory):
                      Injection.realistic('external_leakage', 1.0, 'water'), seed=7)
     write_yaml(calibrate(table, 'water'), tmp / 'coefficients.yaml')
     return tmp, table
+
+
+def test_the_line_says_how_many_samples_the_error_is_not_over(leak_file, tmp_path, capsys):
+    tmp, table = leak_file
+    p_in = table.p_in.copy()
+    p_in[:30] = table.p_out[:30] + 0.05 * MPA  # less than the channels take: no prediction
+    data = _csv(tmp_path / 'low.csv', replace(table, p_in=p_in))
+    code, result, stdout, _ = _validate(capsys, data, tmp_path / 'v', 'water',
+                                        tmp / 'coefficients.yaml')
+    left_out = len(table) - result['n_points']
+    assert code == 0 and left_out >= 25 and result['coverage']['samples_total'] == len(table)
+    assert f'over {result["n_points"]} points' in stdout
+    assert f'{left_out} of {len(table)} samples left out, the error is not over them' in stdout
 
 
 @pytest.mark.parametrize('case, message', [

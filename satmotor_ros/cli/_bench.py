@@ -7,6 +7,7 @@ import argparse
 from collections.abc import Callable
 from pathlib import Path
 import sys
+from typing import Any
 
 from satmotor_ros.cli._common import CliError, fail
 from satmotor_ros.identify import BenchTable, DataError, IdentificationError, read_csv
@@ -131,4 +132,19 @@ def run_bench_command(out: str, run: Callable[[], str]) -> int:
     return 0
 
 
-__all__ = ['add_data_arguments', 'load_data', 'run_bench_command']
+def samples_left_out(coverage: dict[str, Any]) -> str:
+    """
+    Say how many of the data's samples no figure of the summary line is over, or ''.
+
+    The errors are over the samples the model could be evaluated at; the others (no flow
+    the model can give, a chamber drop out of range, too few for a bin) are where it may
+    miss most, so the line says they were left out.
+    """
+    used, total = coverage['samples_used'], coverage['samples_total']
+    if used >= total:
+        return ''
+    return (f'; {total - used} of {total} samples left out, the error is not over them '
+            '(why: report.md)')
+
+
+__all__ = ['add_data_arguments', 'load_data', 'run_bench_command', 'samples_left_out']

@@ -9,7 +9,8 @@ from pathlib import Path
 import sys
 from typing import Any
 
-from satmotor_ros.cli._bench import add_data_arguments, load_data, run_bench_command
+from satmotor_ros.cli._bench import (add_data_arguments, load_data, run_bench_command,
+                                     samples_left_out)
 from satmotor_ros.cli._common import add_motor_options
 from satmotor_ros.cli._liquid import settle_liquid
 from satmotor_ros.cli._output import check_target, output_dir, written_by
@@ -121,7 +122,8 @@ def _errors(summary: dict[str, Any], series: bool) -> str:
     if series:
         rows += (f' of {summary["n_samples"]} samples (mode transient: every usable sample, '
                  'with the transient terms)')
-    text = f'out-of-sample RMSE of Q_vl {before:.4g} -> {after:.4g} l/min over {rows}'
+    text = (f'out-of-sample RMSE of Q_vl {before:.4g} -> {after:.4g} l/min over {rows}'
+            + samples_left_out(summary['coverage']))
     if left_out:
         text += (f'; {left_out} isolated outlier(s) left out of it, with them '
                  f'{summary["error_before_with_outliers"]["rmse_lpm"]:.4g} -> '

@@ -7,7 +7,8 @@ import argparse
 from dataclasses import replace
 from pathlib import Path
 
-from satmotor_ros.cli._bench import add_data_arguments, load_data, run_bench_command
+from satmotor_ros.cli._bench import (add_data_arguments, load_data, run_bench_command,
+                                     samples_left_out)
 from satmotor_ros.cli._common import add_motor_options
 from satmotor_ros.cli._liquid import settle_liquid
 from satmotor_ros.cli._output import check_target, output_dir, written_by
@@ -73,6 +74,9 @@ def _validate(data: str, out: str, mode: Mode, options: MotorOptions, columns: s
     error = summary['error']
     outside = summary['n_extrapolated']
     flagged = f' ({outside} flagged EXTRAPOLATED)' if outside else ''
+    if summary['n_invalid']:
+        flagged += f'; {summary["n_invalid"]} left out where the model flags them invalid'
+    flagged += samples_left_out(summary['coverage'])
     beyond = summary['outside_calibrated_envelope']
     if beyond['share']:
         flagged += (f'; {100 * beyond["share"]:.0f} % of the samples outside the calibrated '
