@@ -125,9 +125,15 @@ def test_a_recording_is_read_as_calibrate_reads_it(tmp_path, capsys):
     assert code == 0, stderr
     assert 3 <= result['n_points'] < 6000  # steady windows, not samples
     assert result['error']['rmse_lpm'] < 0.2
-    code, samples, _, _ = _validate(capsys, str(tmp_path / 'bag'), tmp_path / 'rows', 'oil',
-                                    mode='points')
+    code, samples, stdout, _ = _validate(capsys, str(tmp_path / 'bag'), tmp_path / 'rows',
+                                         'oil', mode='points')
     assert code == 0 and samples['n_points'] > 1000
+    assert 'nothing refitted' in stdout
+    # every sample with the transient terms: those are fitted on the data validated, said so
+    _, rows, stdout, _ = _validate(capsys, str(tmp_path / 'bag'), tmp_path / 'transient',
+                                   'oil', mode='transient')
+    assert 'nothing refitted' not in stdout
+    assert 'transient terms (' in stdout and 'fitted on these data, in sample' in stdout
 
 
 @pytest.fixture(scope='module')

@@ -4,8 +4,10 @@
 from __future__ import annotations
 
 import argparse
+from collections.abc import Mapping
 from dataclasses import replace
 from pathlib import Path
+from typing import Any
 
 from satmotor_ros.cli._bench import (add_data_arguments, load_data, run_bench_command,
                                      samples_left_out)
@@ -85,4 +87,13 @@ def _validate(data: str, out: str, mode: Mode, options: MotorOptions, columns: s
             + f'{model.name}, set {settled.source}, effects: {result.describe_effects()}; '
             f'RMSE of Q_vl {error["rmse_lpm"]:.4g} l/min, mean {error["mean_abs_pct"]:.3g} %, '
             f'max {error["max_abs_lpm"]:.4g} l/min over {summary["n_points"]} points{flagged}, '
-            f'nothing refitted; wrote {target}/validation.json, report.md, residuals.png')
+            f'{_refitted(result.parts.nuisance)}; wrote {target}/validation.json, report.md, '
+            'residuals.png')
+
+
+def _refitted(nuisance: Mapping[str, Any]) -> str:
+    """Say what was fitted on the data validated: nothing, or the transient terms."""
+    if not nuisance:
+        return 'nothing refitted'
+    return (f'the model not refitted, but the transient terms ({", ".join(nuisance)}) fitted '
+            'on these data, in sample')
