@@ -130,7 +130,7 @@ def test_calibrate_line_says_how_many_samples_the_error_is_not_over(tmp_path, ca
     coverage = json.loads((tmp_path / 'o' / 'calibration.json').read_text())['coverage']
     left_out = coverage['samples_total'] - coverage['samples_used']
     assert code == 0 and left_out >= 25 and coverage['samples_total'] == len(table)
-    assert f'points; {left_out} of {len(table)} samples left out, the error is not over' in out
+    assert f'; {left_out} of {len(table)} samples left out, the error is not over them' in out
 
 
 def test_calibrate_line_names_a_near_tie(tmp_path, capsys):

@@ -122,10 +122,9 @@ def _errors(summary: dict[str, Any], series: bool) -> str:
     if series:
         rows += (f' of {summary["n_samples"]} samples (mode transient: every usable sample, '
                  'with the transient terms)')
-    text = (f'out-of-sample RMSE of Q_vl {before:.4g} -> {after:.4g} l/min over {rows}'
-            + samples_left_out(summary['coverage']))
+    text = f'out-of-sample RMSE of Q_vl {before:.4g} -> {after:.4g} l/min over {rows}'
     if left_out:
         text += (f'; {left_out} isolated outlier(s) left out of it, with them '
                  f'{summary["error_before_with_outliers"]["rmse_lpm"]:.4g} -> '
                  f'{summary["error_after_with_outliers"]["rmse_lpm"]:.4g} l/min')
-    return text
+    return text + samples_left_out(summary['coverage'])
