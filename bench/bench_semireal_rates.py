@@ -139,8 +139,9 @@ def _case(spec) -> dict:
     direction = int(rng.choice([-1, 1]))
     effects = [realistic(k, trajectory, scale, direction=direction,
                          crack_fraction=float(rng.uniform(0.6, 0.85))) for k in kinds]
-    case = build_case(trajectory, effects, noise=noise, seed=seed, bad_rows=1)
-    shown = [_detectable(trajectory, effects, i, noise, seed, case) for i in range(len(kinds))]
+    drawn = 1000 * seed + int(100 * scale)  # each case its own noise, clean ones too
+    case = build_case(trajectory, effects, noise=noise, seed=drawn, bad_rows=1)
+    shown = [_detectable(trajectory, effects, i, noise, drawn, case) for i in range(len(kinds))]
     with tempfile.TemporaryDirectory() as tmp:
         path = write_mbari_log(Path(tmp) / 'case.exp', case)
         begin = time.perf_counter()
