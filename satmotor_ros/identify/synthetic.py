@@ -614,7 +614,9 @@ def parse_injection(text: str, liquid: str) -> Injection:
             return Injection(name, float(size) * LPM)
         if name == 'threshold:dp' and '@' in size:
             loss, _, crack = size.partition('@')
-            return Injection(name, float(loss) * LPM, shape=(('reference', float(crack) * MPA),))
+            if float(crack) >= 0.0:  # a valve cracks at a drop; below zero it is never shut
+                return Injection(name, float(loss) * LPM,
+                                 shape=(('reference', float(crack) * MPA),))
         effect, _, scale = text.partition('*')
         if effect in REALISTIC and not size:
             return Injection.realistic(effect, float(scale or 1.0), liquid)
@@ -623,6 +625,18 @@ def parse_injection(text: str, liquid: str) -> Injection:
     msg = (f'--effect {text!r}: use NAME or NAME*SCALE (NAME one of {", ".join(REALISTIC)}), '
            'term:EXPR=LPM (e.g. term:dp^0.76=0.8) or threshold:dp=LPM@MPA')
     raise ValueError(msg)
+
+
+def _replaceable(path: Path, columns: dict[str, tuple[str, FloatArray]]) -> bool:
+    """Whether `path` is free or a table this command wrote (the same header line)."""
+    if not (path.exists() or path.is_symlink()):
+        return True
+    header = ','.join(f'{name} [{unit}]' for name, (unit, _) in columns.items())
+    try:
+        with path.open('rb') as file:
+            return path.is_file() and file.readline().rstrip(b'\r\n') == header.encode()
+    except OSError:
+        return False
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -637,7 +651,8 @@ def main(argv: list[str] | None = None) -> int:
     Returns
     -------
     int
-        0, or 2 with one line on stderr for a bad ``--effect`` or ``--outlier``.
+        0, or 2 with one line on stderr for a bad option, a model that cannot be built or
+        an ``--out`` that exists and was not written by this command (``--force`` replaces it).
 
     """
     import argparse
@@ -653,16 +668,22 @@ def main(argv: list[str] | None = None) -> int:
                         help='add LPM l/min to the flow of row ROW (repeatable)')
     parser.add_argument('--seed', type=int, default=0)
     parser.add_argument('--points', type=int, default=100)
-    parser.add_argument('--series', type=int, default=0, metavar='SAMPLES',
+    parser.add_argument('--series', type=int, default=None, metavar='SAMPLES',
                         help='write a 100 Hz time series of this many samples instead')
-    parser.add_argument('--transient', type=float, default=0.0, metavar='SECONDS',
+    parser.add_argument('--transient', type=float, default=None, metavar='SECONDS',
                         help='write a 100 Hz recording of this length whose set-points change '
                              'every 0.6-1.5 s, with a line volume and sensor lags '
                              '(REALISTIC_DYNAMICS) instead')
     parser.add_argument('--bag', choices=('mcap', 'sqlite3'), default=None,
                         help='write the time series as a rosbag2 bag (directory --out)')
     parser.add_argument('--out', required=True, help='CSV file (or bag directory) to write')
+    parser.add_argument('--force', action='store_true',
+                        help='replace an existing --out CSV that this command did not write')
     args = parser.parse_args(argv)
+    for option, value, least in (('--points', args.points, 2), ('--series', args.series, 2),
+                                 ('--transient', args.transient, 0.1)):
+        if value is not None and not value >= least:
+            parser.error(f'{option} {value!r}: must be at least {least:g}')
     plan = Plan(liquid=args.liquid, n_points=args.points)
     try:
         injections = [parse_injection(e, args.liquid) for e in args.effect] or [Injection()]
@@ -671,20 +692,29 @@ def main(argv: list[str] | None = None) -> int:
     except ValueError as err:
         parser.error(str(err) if str(err).startswith('--') else
                      f'--outlier {args.outlier!r}: use ROW:LPM, e.g. 7:1.5')
-    if args.transient:
-        table = generate_transient(plan, injections, REALISTIC_DYNAMICS, args.seed,
-                                   duration_s=args.transient)
-    elif args.series:
-        table = generate_series(plan, injections, args.seed, samples=args.series)
-    else:
-        table = generate(plan, injections, args.seed)
-    if rows:
-        table = with_outliers(table, rows, sizes)
-    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    if args.bag:
-        write_bag_of(args.out, table, args.bag)
-    else:
-        write_csv(args.out, to_columns(table))
+    try:
+        if args.transient is not None:
+            table = generate_transient(plan, injections, REALISTIC_DYNAMICS, args.seed,
+                                       duration_s=args.transient)
+        elif args.series is not None:
+            table = generate_series(plan, injections, args.seed, samples=args.series)
+        else:
+            table = generate(plan, injections, args.seed)
+        if any(not 0 <= row < len(table) for row in rows):
+            parser.error(f'--outlier {args.outlier!r}: a row from 0 to {len(table) - 1}')
+        if rows:
+            table = with_outliers(table, rows, sizes)
+        Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+        if args.bag:
+            write_bag_of(args.out, table, args.bag)
+        else:
+            columns = to_columns(table)
+            if not (args.force or _replaceable(Path(args.out), columns)):
+                parser.error(f'--out {args.out!r} exists and is not a table this command wrote; '
+                             'choose a new path or pass --force to replace it')
+            write_csv(args.out, columns)
+    except (ValueError, OSError) as err:  # a model or bag error, a path that cannot be written
+        parser.error(f'{err}' if str(err) else f'--out {args.out!r}: {err!r}')
     described = ', '.join(f'{i.effect} (magnitude {i.magnitude:.4g})' for i in injections)
     print(f'wrote {args.out}: {len(table)} rows, {args.liquid}, {described}'
           + (f', outliers at rows {", ".join(map(str, rows))}' if rows else ''))
