@@ -80,6 +80,12 @@ def test_calibrated_yaml_loads_and_its_model_explains_the_data(leak_run):
     assert rms(table.flow - before) > 2 * rms(table.flow - fitted)
 
 
+def test_calibrated_yaml_names_its_data_without_the_machines_directories(leak_run):
+    _, out, _ = leak_run
+    head = (out / 'coefficients.yaml').read_text().splitlines()[0]
+    assert 'calibrated on bench.csv (' in head and str(out.parent) not in head
+
+
 def test_calibrate_report_has_real_plots(leak_run):
     _, out, _ = leak_run
     report = (out / 'report.md').read_text()

@@ -31,6 +31,7 @@ from typing import Any
 
 import numpy as np
 from satmotor_ros.identify.pipeline import Calibration
+from satmotor_ros.identify.plot_tools import portable
 from satmotor_ros.model.effects import effect_to_mapping, kind_of
 from satmotor_ros.model.families.defaults import DEFAULTS_NOTE
 import yaml
@@ -164,8 +165,8 @@ def write_yaml(cal: Calibration, path: str | Path) -> None:
     """
     factors = ', '.join(f'{c.part} ({c.describes}) x{v:.4g}' for c, v in
                         zip(cal.parts.components, cal.final.values))
-    head = (f'# {cal.spec.name} calibrated on {cal.table.source} ({len(cal.parts)} points), '
-            f'liquid {cal.liquid}.\n'
+    head = (f'# {cal.spec.name} calibrated on {portable(cal.table.source)} '
+            f'({len(cal.parts)} points), liquid {cal.liquid}.\n'
             f'# Fitted factors on the packaged values: {factors}.\n'
             "# Plain numbers are SI (temperature degC); loss coefficients in the paper's "
             'fitting units.\n')
