@@ -191,3 +191,18 @@ def test_calibrate_replaces_its_own_output_but_no_user_file_and_no_input(leak_ru
     code, _, err = _run(capsys, 'calibrate', data, '--liquid', 'water', '--out', data)
     assert code == 1 and 'is or contains the input' in err
     assert data.read_bytes().startswith(b'time [s]')
+
+
+@pytest.mark.parametrize('option, value, match', [
+    ('--folds', '0', "argument --folds: '0': must be at least 2"),
+    ('--folds', 'x', "argument --folds: 'x': not a whole number"),
+    ('--alpha', 'nan', "argument --alpha: 'nan': must be between 0 and 1"),
+    ('--alpha', '2', "argument --alpha: '2': must be between 0 and 1"),
+])
+def test_calibrate_options_out_of_range_are_one_line_naming_the_option(option, value, match,
+                                                                       tmp_path, capsys):
+    with pytest.raises(SystemExit) as info:
+        main(['calibrate', 'x.csv', '--liquid', 'oil', option, value, '--out',
+              str(tmp_path / 'o')])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert info.value.code == 2 and match in err[-1]

@@ -32,11 +32,34 @@ DESCRIPTION = ('Fit the loss model to a bench table (CSV with "name [unit]" head
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Add the options of ``satmotor calibrate``."""
     add_data_arguments(parser, MODES)
-    parser.add_argument('--alpha', type=float, default=0.05,
-                        help='family-wise significance level of the effect test (default 0.05)')
-    parser.add_argument('--folds', type=int, default=5,
-                        help='cross-validation folds (default 5)')
+    parser.add_argument('--alpha', type=_alpha, default=0.05,
+                        help='family-wise significance level of the effect test, between 0 '
+                             'and 1 (default 0.05)')
+    parser.add_argument('--folds', type=_folds, default=5,
+                        help='cross-validation folds, at least 2 (default 5)')
     add_motor_options(parser, liquid_from_data=True, model_options=False)
+
+
+def _alpha(text: str) -> float:
+    """Read ``--alpha``: a level strictly between 0 and 1."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f'{text!r}: not a number') from None
+    if not 0.0 < value < 1.0:
+        raise argparse.ArgumentTypeError(f'{text!r}: must be between 0 and 1')
+    return value
+
+
+def _folds(text: str) -> int:
+    """Read ``--folds``: a whole number of at least 2."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f'{text!r}: not a whole number') from None
+    if value < 2:
+        raise argparse.ArgumentTypeError(f'{text!r}: must be at least 2')
+    return value
 
 
 def command(data: str, out: str, mode: Mode, alpha: float, folds: int,
