@@ -3,6 +3,7 @@
 # Mutation-test the model (mutmut 3) in a scratch copy of the committed tree, from a venv of its
 # own: nothing is installed into .venv and the worktree stays untouched.
 #   bench/mutation.sh [FILE...]   default: every module of satmotor_ros/model
+#   TESTS='test/test_a.py test/test_b.py' bench/mutation.sh FILE...   other tests than the model's
 # Results: `cd /tmp/satmotor_mutation && /tmp/mut/bin/mutmut results`.
 set -eu
 work=/tmp/satmotor_mutation
@@ -20,7 +21,7 @@ files=${*:-$(ls satmotor_ros/model/*.py | grep -v __init__)}
     printf '\n[mutmut]\nsource_paths=satmotor_ros/\nalso_copy=\n    config/\nonly_mutate=\n'
     for f in $files; do printf '    %s\n' "$f"; done
     printf 'pytest_add_cli_args_test_selection=\n'
-    for t in test/test_model_*.py; do printf '    %s\n' "$t"; done
+    for t in ${TESTS:-test/test_model_*.py}; do printf '    %s\n' "$t"; done
 } >> setup.cfg
 export ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST
 /tmp/mut/bin/mutmut run --max-children 2
