@@ -66,4 +66,3 @@ def test_the_channels_reach_the_motor_inside_the_valve_paths(sign):
             assert point.speed == pytest.approx(n, rel=1e-7)
         shifted = both.speed_point(forward.flow, dp_i=forward.dp_i, channels={'p_case': 0.0})
         assert shifted.speed > n if sign > 0 else shifted.speed < n  # less leak, more speed
-
