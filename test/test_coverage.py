@@ -70,14 +70,15 @@ def test_validate_gives_the_share_of_samples_outside_the_calibrated_envelope(tmp
     written = yaml.safe_load((tmp_path / 'coefficients.yaml').read_text())
     assert written['coverage'] == cal.summary()['coverage']
     assert calibrated_envelope(tmp_path / 'coefficients.yaml') == written['coverage']['envelope']
-    for table, name, low, high in ((narrow, 'own', 0.0, 0.0), (wide, 'wide', 0.4, 0.6)):
+    # every sample counts: on its own data, the few rows the calibration left out may be beyond
+    for table, name, low, high in ((narrow, 'own', 0.0, 0.02), (wide, 'wide', 0.4, 0.6)):
         out = tmp_path / name
         code = validate_cli.command(_csv(tmp_path / f'{name}.csv', table), str(out), 'auto',
                                     MotorOptions('oil', str(tmp_path / 'coefficients.yaml')))
         assert code == 0, capsys.readouterr().err
         result = json.loads((out / 'validation.json').read_text())
         beyond = result['outside_calibrated_envelope']
-        assert low <= beyond['share'] <= high and beyond['of'] == result['n_points']
+        assert low <= beyond['share'] <= high and beyond['of'] == len(table)  # every sample
         assert result['coverage']['samples_used'] == result['n_points'] >= len(table) - 2
         report = (out / 'report.md').read_text()
         assert 'outside the envelope the model was calibrated on' in report

@@ -14,7 +14,10 @@ from satmotor_ros.cli import validate as validate_cli
 from satmotor_ros.cli._output import MARKER
 from satmotor_ros.identify import calibrate, Errors, write_csv
 from satmotor_ros.identify.output import write_yaml
-from satmotor_ros.identify.synthetic import generate, Injection, Plan
+from satmotor_ros.identify.pipeline import Options
+from satmotor_ros.identify.synthetic import (generate, generate_transient, Injection, Plan,
+                                             REALISTIC_DYNAMICS)
+from satmotor_ros.identify.validate import calibrated_dynamics
 from satmotor_ros.interface import MotorOptions
 from satmotor_ros.model.units import LPM, MPA, RPM
 
@@ -129,11 +132,76 @@ def test_a_recording_is_read_as_calibrate_reads_it(tmp_path, capsys):
                                          'oil', mode='points')
     assert code == 0 and samples['n_points'] > 1000
     assert 'nothing refitted' in stdout
-    # every sample with the transient terms: those are fitted on the data validated, said so
+    # every sample, a motor file without transient terms: the headline has none; the terms
+    # fitted on the data validated are only a second figure, labelled in sample
     _, rows, stdout, _ = _validate(capsys, str(tmp_path / 'bag'), tmp_path / 'transient',
                                    'oil', mode='transient')
-    assert 'nothing refitted' not in stdout
-    assert 'transient terms (' in stdout and 'fitted on these data, in sample' in stdout
+    assert 'nothing refitted (no transient terms' in stdout
+    assert 'in sample, with the transient terms fitted on these data' in stdout
+    assert rows['transient_terms']['applied'] == {}
+    second = rows['error_transient_fitted_in_sample']['rmse_lpm']
+    assert second <= rows['error']['rmse_lpm']
+    assert 'In sample, not a validation' in (tmp_path / 'transient' / 'report.md').read_text()
+
+
+@pytest.fixture(scope='module')
+def transient_file(tmp_path_factory):
+    """Calibrate on every sample of a recording with a bench's dynamics; give another day."""
+    tmp = tmp_path_factory.mktemp('transient')
+
+    def recording(seed):
+        return generate_transient(Plan(liquid='oil'), Injection(), REALISTIC_DYNAMICS,
+                                  seed=seed, duration_s=60.0)
+    cal = calibrate(recording(3), 'oil', options=Options(mode='transient'))
+    write_yaml(cal, tmp / 'coefficients.yaml')
+    today = recording(4)
+    data = _csv(tmp / 'today.csv', replace(today, channels={
+        **today.channels, 'temperature': np.full(len(today), 40.0),
+        'p_case': np.zeros(len(today))}))
+    return tmp, cal, data
+
+
+def _with_dynamics(source, target, dynamics):
+    text = source.read_text().split('\ndynamics:')[0]
+    lines = [f'  {name}: {value!r}' for name, value in (dynamics or {}).items()]
+    target.write_text(text + ('\ndynamics:\n' + '\n'.join(lines) if dynamics else '') + '\n')
+    return target
+
+
+def test_validate_applies_the_calibrations_transient_terms_unchanged(
+        transient_file, tmp_path, capsys):
+    tmp, cal, data = transient_file
+    fitted = {d['term']: d['coefficient'] for d in cal.summary()['dynamics']
+              if 'coefficient' in d}
+    assert calibrated_dynamics(tmp / 'coefficients.yaml') == fitted
+    assert fitted['flow_lag'] == pytest.approx(REALISTIC_DYNAMICS.flow_lag, rel=0.2)
+    runs = {}
+    for name, dynamics in (('own', fitted), ('spoilt', {**fitted, 'flow_lag': 0.0}),
+                           ('none', None)):
+        motor = _with_dynamics(tmp / 'coefficients.yaml', tmp_path / f'{name}.yaml', dynamics)
+        code, runs[name], stdout, stderr = _validate(capsys, data, tmp_path / name, 'oil',
+                                                     motor, mode='transient')
+        assert code == 0, stderr
+    own, spoilt, none = runs['own'], runs['spoilt'], runs['none']
+    assert own['transient_terms']['applied'] == fitted
+    assert 'applied unchanged (out of sample)' in own['transient_terms']['error']
+    # out of sample: the headline follows the file's terms; the in-sample figure does not
+    assert own['error']['rmse_lpm'] < 0.8 * spoilt['error']['rmse_lpm']
+    assert none['error']['rmse_lpm'] > 1.2 * own['error']['rmse_lpm']
+    second = {name: run['error_transient_fitted_in_sample'] for name, run in runs.items()}
+    assert second['own'] == second['spoilt'] == second['none']
+    assert second['own']['rmse_lpm'] <= own['error']['rmse_lpm']
+    assert 'no transient terms' in none['transient_terms']['error']
+    assert "calibration's transient terms" in (tmp_path / 'own' / 'report.md').read_text()
+
+
+def test_a_malformed_dynamics_block_is_refused_in_one_line(transient_file, tmp_path, capsys):
+    tmp, _, data = transient_file
+    motor = _with_dynamics(tmp / 'coefficients.yaml', tmp_path / 'bad.yaml', {'flow_lag': 'x'})
+    code, _, stdout, stderr = _validate(capsys, data, tmp_path / 'out', 'oil', motor,
+                                        mode='transient')
+    assert code == 1 and stdout == '' and len(stderr.strip().splitlines()) == 1
+    assert "dynamics.flow_lag = 'x'" in stderr
 
 
 @pytest.fixture(scope='module')
@@ -156,6 +224,10 @@ def test_the_line_says_how_many_samples_the_error_is_not_over(leak_file, tmp_pat
     assert code == 0 and left_out >= 25 and result['coverage']['samples_total'] == len(table)
     assert f'over {result["n_points"]} points' in stdout
     assert f'{left_out} of {len(table)} samples left out, the error is not over them' in stdout
+    # those rows lie outside the calibrated envelope (a 0.05 MPa drop): counted with the rest
+    beyond = result['outside_calibrated_envelope']
+    assert beyond['of'] == len(table) and beyond['samples'] >= 30
+    assert f'{beyond["samples"]} of {len(table)} samples' in stdout
 
 
 @pytest.mark.parametrize('case, message', [

@@ -16,7 +16,7 @@ from satmotor_ros.cli._liquid import settle_liquid
 from satmotor_ros.cli._output import check_target, output_dir, written_by
 from satmotor_ros.identify.coverage import calibrated_envelope
 from satmotor_ros.identify.pipeline import Mode, MODES
-from satmotor_ros.identify.validate import validate
+from satmotor_ros.identify.validate import calibrated_dynamics, validate
 from satmotor_ros.identify.validation_report import write_validation
 from satmotor_ros.interface import MotorOptions
 
@@ -68,8 +68,10 @@ def _validate(data: str, out: str, mode: Mode, options: MotorOptions, columns: s
     table = load_data(data, columns, model.geometry.displacement)
     table = replace(table, notes=table.notes + (f'liquid: {settled.source}',)
                     + ((f'WARNING: {settled.warning}',) if settled.warning else ()))
-    calibrated = calibrated_envelope(options.motor_file) if options.motor_file else None
-    result = validate(table, model, options.liquid, mode, calibrated=calibrated)
+    motor_file = options.motor_file
+    result = validate(table, model, options.liquid, mode,
+                      calibrated=calibrated_envelope(motor_file) if motor_file else None,
+                      dynamics=calibrated_dynamics(motor_file) if motor_file else None)
     with output_dir('--out', out, 'validate', inputs, force) as tmp:
         summary = write_validation(result, tmp)
     target = Path(out)
@@ -81,19 +83,23 @@ def _validate(data: str, out: str, mode: Mode, options: MotorOptions, columns: s
     flagged += samples_left_out(summary['coverage'])
     beyond = summary['outside_calibrated_envelope']
     if beyond['share']:
-        flagged += (f'; {100 * beyond["share"]:.0f} % of the samples outside the calibrated '
-                    'envelope')
+        flagged += (f'; {beyond["samples"]} of {beyond["of"]} samples '
+                    f'({100 * beyond["share"]:.0f} %) outside the calibrated envelope')
     return ((f'WARNING: {settled.warning}; ' if settled.warning else '')
             + f'{model.name}, set {settled.source}, effects: {result.describe_effects()}; '
             f'RMSE of Q_vl {error["rmse_lpm"]:.4g} l/min, mean {error["mean_abs_pct"]:.3g} %, '
             f'max {error["max_abs_lpm"]:.4g} l/min over {summary["n_points"]} points{flagged}, '
-            f'{_refitted(result.parts.nuisance)}; wrote {target}/validation.json, report.md, '
-            'residuals.png')
+            f'{_refitted(summary)}; wrote {target}/validation.json, report.md, residuals.png')
 
 
-def _refitted(nuisance: Mapping[str, Any]) -> str:
-    """Say what was fitted on the data validated: nothing, or the transient terms."""
-    if not nuisance:
+def _refitted(summary: Mapping[str, Any]) -> str:
+    """Say how the transient terms entered the error, and the in-sample second figure."""
+    terms = summary.get('transient_terms')
+    if terms is None:
         return 'nothing refitted'
-    return (f'the model not refitted, but the transient terms ({", ".join(nuisance)}) fitted '
-            'on these data, in sample')
+    text = f'nothing refitted ({terms["error"]})'
+    second = summary.get('error_transient_fitted_in_sample')
+    if second is not None:
+        text += (f'; in sample, with the transient terms fitted on these data (not a '
+                 f'validation): RMSE {second["rmse_lpm"]:.4g} l/min')
+    return text

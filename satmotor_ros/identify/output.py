@@ -135,7 +135,20 @@ def _document(cal: Calibration) -> dict[str, Any]:
         'coefficient_sets': {cal.liquid: entry},
         # where the fit's data lie; `satmotor validate` counts the samples outside it
         'coverage': cal.coverage,
+        **_dynamics(cal),
     }
+
+
+def _dynamics(cal: Calibration) -> dict[str, Any]:
+    """
+    Return the fitted transient terms (name -> SI coefficient) when the rows were samples.
+
+    `satmotor validate` applies them unchanged, so its error on a time series stays out of
+    sample; a term the calibration left out is not written (it is zero in the fit).
+    """
+    terms = cal.mode_fields().get('dynamics', [])
+    fitted = {d['term']: float(d['coefficient']) for d in terms if 'coefficient' in d}
+    return {'dynamics': fitted} if terms else {}
 
 
 def _viscosity_span(cal: Calibration) -> list[float] | None:
@@ -174,6 +187,11 @@ def write_yaml(cal: Calibration, path: str | Path) -> None:
         head += ('# fitted_range: least and largest value of each quantity an effect reads '
                  'over the points it was\n# fitted on (dp_i, speed, flow as magnitudes); '
                  'outside it the model flags EXTRAPOLATED.\n')
-    body = yaml.safe_dump(_document(cal), sort_keys=False, allow_unicode=True,
+    doc = _document(cal)
+    if 'dynamics' in doc:
+        head += ('# dynamics: the transient terms fitted beside the model (the bench, not the '
+                 'motor; SI,\n# doc/calibration.md); `satmotor validate` applies them '
+                 'unchanged.\n')
+    body = yaml.safe_dump(doc, sort_keys=False, allow_unicode=True,
                           width=99)
     Path(path).write_text(head + body, encoding='utf-8')

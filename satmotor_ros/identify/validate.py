@@ -13,15 +13,24 @@ its in-sample error. Nothing is fitted, so no cross-validation is needed.
 Points the model flags invalid are left out; points it flags EXTRAPOLATED
 (outside its validated range, or an effect evaluated outside the data it was
 fitted on) are kept and counted.
+
+On a time series read with every sample, the bench's transient terms (line
+compliance, sensor lags) are the calibration's own, read from the motor file's
+``dynamics`` and applied unchanged, so the headline error stays out of sample;
+a file without them gives the error without transient terms as the headline and
+the error after fitting them on the data validated only as a second figure,
+labelled in sample.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from satmotor_ros.bounded_yaml import read_yaml, YamlLimitError
 from satmotor_ros.identify.coverage import outside
 from satmotor_ros.identify.effects import CalibratedModel
 from satmotor_ros.identify.errors import DataError, IdentificationError
@@ -30,7 +39,7 @@ from satmotor_ros.identify.pipeline import Mode, Options, read_rows
 from satmotor_ros.identify.selection import Errors
 from satmotor_ros.identify.steady import SteadyTolerance
 from satmotor_ros.identify.table import BenchTable
-from satmotor_ros.identify.transient import averaged, parts_at, Samples
+from satmotor_ros.identify.transient import averaged, DYNAMIC_TERMS, parts_at, Samples
 from satmotor_ros.model import MotorModel
 from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.results import PointStatus
@@ -52,6 +61,8 @@ class Validation:
     coverage: dict[str, Any] = field(default_factory=dict)  # the rows' Rows.coverage
     outside: dict[str, Any] | None = None  # samples outside the calibrated envelope
     flagged: np.ndarray | None = None  # which of the points are flagged EXTRAPOLATED [-]
+    transient: dict[str, Any] | None = None  # how the transient terms entered `error`
+    in_sample: Errors | None = None  # the error after fitting them on these data (2nd figure)
 
     def describe_effects(self) -> str:
         """Return the effects' names, comma-separated, or ``'none'``."""
@@ -70,10 +81,16 @@ class Validation:
             flagged EXTRAPOLATED: outside the validated range or an effect's fitted
             range), coverage (DESIGN.md) and outside_calibrated_envelope (the samples
             used that lie outside the envelope the model was calibrated on: samples,
-            of, share; null figures when the motor file holds no envelope).
+            of, share; null figures when the motor file holds no envelope); on a time
+            series read with every sample also transient_terms (how they entered
+            ``error``: the calibration's, or none) and error_transient_fitted_in_sample
+            (the error after fitting them on these data: in sample, not the headline).
 
         """
-        return {'n_points': len(self.parts), 'error': self.error.as_dict(),
+        transient = {} if self.transient is None else {'transient_terms': self.transient}
+        if self.in_sample is not None:
+            transient['error_transient_fitted_in_sample'] = self.in_sample.as_dict()
+        return {'n_points': len(self.parts), 'error': self.error.as_dict(), **transient,
                 'liquid': self.liquid, 'motor': self.model.name,
                 'effects': list(self.effects), 'data': self.table.source,
                 'n_flagged': self.invalid + self.extrapolated, 'n_invalid': self.invalid,
@@ -90,9 +107,51 @@ def _bare(model: MotorModel) -> MotorModel:
                       model.displacement_law, model.name)
 
 
+def calibrated_dynamics(path: str | Path) -> dict[str, float] | None:
+    """
+    Read the transient terms a calibrated ``coefficients.yaml`` holds (its ``dynamics``).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        A motor file, [-]
+
+    Returns
+    -------
+    dict or None
+        Term name -> coefficient (SI); None when the file holds none (a motor file no
+        calibration on every sample wrote).
+
+    Raises
+    ------
+    DataError
+        If ``dynamics`` is malformed (the message names the field).
+
+    """
+    try:
+        doc = read_yaml(path)
+    except (OSError, YamlLimitError) as err:
+        msg = f'{path}: {err}'
+        raise DataError(msg) from None
+    if not isinstance(doc, dict) or 'dynamics' not in doc:
+        return None
+    terms = doc['dynamics']
+    known = {term.name for term in DYNAMIC_TERMS}
+    if not isinstance(terms, dict) or not set(terms) <= known:
+        msg = f'{path}: dynamics = {terms!r}: need a mapping of {", ".join(sorted(known))}'
+        raise DataError(msg)
+    for name, value in terms.items():
+        if isinstance(value, bool) or not isinstance(value, (int, float)) \
+                or not np.isfinite(value):
+            msg = f'{path}: dynamics.{name} = {value!r}: need a finite number'
+            raise DataError(msg)
+    return {name: float(value) for name, value in terms.items()}
+
+
 def validate(table: BenchTable, model: MotorModel, liquid: str, mode: Mode = 'auto',
              tol: SteadyTolerance | None = None,
-             calibrated: dict[str, Any] | None = None) -> Validation:
+             calibrated: dict[str, Any] | None = None,
+             dynamics: dict[str, float] | None = None) -> Validation:
     """
     Compute the error of `model` on `table` without fitting anything.
 
@@ -106,13 +165,17 @@ def validate(table: BenchTable, model: MotorModel, liquid: str, mode: Mode = 'au
     liquid : str
         Its coefficient set, for the report, [-]
     mode : {'auto', 'points', 'series', 'transient'}
-        How to read the rows, as for a calibration (in ``'transient'`` mode the bench's
-        transient terms are fitted to the residual: the model file does not hold them), [-]
+        How to read the rows, as for a calibration, [-]
     tol : SteadyTolerance, optional
         Steady-state tolerances, [-]
     calibrated : dict, optional
         The envelope the model was calibrated on
-        (:func:`~satmotor_ros.identify.coverage.calibrated_envelope`), [-]
+        (:func:`~satmotor_ros.identify.coverage.calibrated_envelope`); every sample of
+        `table` is counted against it, [-]
+    dynamics : dict, optional
+        The calibration's transient terms (:func:`calibrated_dynamics`), applied unchanged
+        when the rows are samples; without them the headline error has no transient terms,
+        [-]
 
     Returns
     -------
@@ -129,10 +192,10 @@ def validate(table: BenchTable, model: MotorModel, liquid: str, mode: Mode = 'au
     """
     read = read_rows(_bare(model), table, Options(mode=mode, steady=tol or SteadyTolerance()),
                      check=False)
+    beyond = _outside(calibrated, table)
     if read.samples is not None:
-        raw = read.samples.samples.select(read.samples.in_bins)
-        return replace(_validate_samples(read.samples, model, liquid), coverage=read.coverage,
-                       outside=_outside(calibrated, raw))
+        return replace(_validate_samples(read.samples, model, liquid, dynamics),
+                       coverage=read.coverage, outside=beyond)
     points = read.table
     parts, usable = loss_parts(_bare(model), points)
     if not usable.all():
@@ -155,14 +218,15 @@ def validate(table: BenchTable, model: MotorModel, liquid: str, mode: Mode = 'au
     residual = parts.flow - predicted
     return Validation(liquid, model, points, parts, residual, Errors.of(residual, parts.loss),
                       tuple(evaluated.describe()), int(flagged.sum()), int(extrapolated.sum()),
-                      read.coverage, _outside(calibrated, points), flagged=extrapolated)
+                      read.coverage, beyond, flagged=extrapolated)
 
 
 def _outside(calibrated: dict[str, Any] | None, rows: BenchTable) -> dict[str, Any] | None:
-    """Count the rows (samples) outside the calibrated envelope; None without one."""
+    """Count the rows (every sample of the data) outside the calibrated envelope; None without."""
     if calibrated is None:
         return None
-    out = outside(calibrated, rows.p_in - rows.p_out, rows.speed)
+    dp, speed = rows.p_in - rows.p_out, rows.speed
+    out = outside(calibrated, dp, speed) & np.isfinite(dp) & np.isfinite(speed)
     return {'samples': int(out.sum()), 'of': int(out.size),
             'share': float(f'{out.sum() / max(out.size, 1):.4g}')}
 
@@ -193,14 +257,15 @@ def _predicted(calibrated: CalibratedModel, points: BenchTable,
     return parts.sign * flow, (status & int(PointStatus.EXTRAPOLATED)) != 0
 
 
-def _validate_samples(samples: Samples, model: MotorModel, liquid: str) -> Validation:
+def _validate_samples(samples: Samples, model: MotorModel, liquid: str,
+                      dynamics: dict[str, float] | None) -> Validation:
     """
     Hold the model against a time series' rows, as a calibration in transient mode reads them.
 
     The model is evaluated at every usable sample and averaged over the rows' bins; the
-    bench's transient terms (line compliance, sensor lags) are fitted to what is left by
-    linear least squares, since the model file does not hold them; nothing of the model
-    is refitted.
+    bench's transient terms (line compliance, sensor lags) are the calibration's
+    (`dynamics`), applied unchanged, or none; nothing is fitted for the headline error
+    (:func:`_transient_terms`).
     """
     raw = samples.samples
     keep = raw.select(samples.usable)
@@ -222,15 +287,48 @@ def _validate_samples(samples: Samples, model: MotorModel, liquid: str) -> Valid
         parts = parts_at(parts, good)
     residual, outside = residual[good], outside[good]
     points = _note_extrapolated(points, int(outside.sum()), 'rows')
-    if parts.nuisance:
-        x = np.column_stack(list(parts.nuisance.values()))
-        residual = residual - x @ np.linalg.lstsq(x, residual, rcond=None)[0]
-        points = replace(points, notes=points.notes + (
-            'the transient terms (' + ', '.join(parts.nuisance) + ') fitted to the residual: '
-            'they describe the bench, not the model',))
-    return Validation(liquid, model, points, parts, residual, Errors.of(residual, parts.loss),
+    headline, transient, in_sample = _transient_terms(residual, parts, dynamics)
+    points = replace(points, notes=points.notes + (transient['note'],))
+    return Validation(liquid, model, points, parts, headline, Errors.of(headline, parts.loss),
                       tuple(calibrated.describe()), int((~good).sum()), int(outside.sum()),
-                      flagged=outside)
+                      flagged=outside, transient=transient,
+                      in_sample=None if in_sample is None else Errors.of(in_sample, parts.loss))
+
+
+def _transient_terms(residual: FloatArray, parts: LossParts,
+                     dynamics: dict[str, float] | None
+                     ) -> tuple[FloatArray, dict[str, Any], FloatArray | None]:
+    """
+    Apply the calibration's transient terms to the residual; fit them only for a 2nd figure.
+
+    Returns the headline residual (the calibration's terms applied unchanged, or none:
+    out of sample), how it was made (validation.json's ``transient_terms``), and the
+    residual after fitting the terms on these data by least squares (in sample), None
+    when the data give no term.
+    """
+    x = parts.nuisance
+    in_sample = None
+    if x:
+        columns = np.column_stack(list(x.values()))
+        in_sample = residual - columns @ np.linalg.lstsq(columns, residual, rcond=None)[0]
+    if dynamics is None:
+        return residual, {
+            'error': 'no transient terms (the motor file holds none)', 'applied': {},
+            'note': ('the motor file holds no transient terms (dynamics): the error is without '
+                     'them; error_transient_fitted_in_sample fits them on these data (in '
+                     'sample, not a validation)')}, in_sample
+    applied = {name: value for name, value in dynamics.items() if name in x}
+    for name, value in applied.items():
+        residual = residual - value * x[name]
+    unused = sorted(set(dynamics) - set(applied))
+    missing = (f'; not applicable here: {", ".join(unused)} (the data give no such term)'
+               if unused else '')
+    return residual, {
+        'error': "the calibration's transient terms applied unchanged (out of sample)",
+        'applied': applied,
+        'note': ("the calibration's transient terms (" + (', '.join(applied) or 'none fitted')
+                 + ') applied unchanged: they describe the bench, not the model' + missing)
+    }, in_sample
 
 
 __all__ = ['Validation', 'validate']

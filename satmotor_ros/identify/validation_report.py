@@ -45,6 +45,24 @@ def _coverage_lines(summary: dict[str, Any]) -> list[str]:
     return lines + ['']
 
 
+def _transient_lines(summary: dict[str, Any]) -> list[str]:
+    """Say how the transient terms entered the error, and give the in-sample figure apart."""
+    terms = summary.get('transient_terms')
+    if terms is None:
+        return []
+    lines = [f'Transient terms (line compliance, sensor lags) in the error above: '
+             f'{terms["error"]}; {terms["note"]}.']
+    second = summary.get('error_transient_fitted_in_sample')
+    if second is not None:
+        lines.append(f'**In sample, not a validation**: with the transient terms fitted by '
+                     f'least squares on these data, RMSE {second["rmse_lpm"]:.4g} l/min, mean '
+                     f'{second["mean_abs_pct"]:.3g} %, max {second["max_abs_lpm"]:.4g} l/min '
+                     '(`error_transient_fitted_in_sample`): it shows how much of the error the '
+                     "bench's dynamics on these data explain, and is no figure of the "
+                     'calibration.')
+    return [' '.join(lines), '']
+
+
 def _report(val: Validation, summary: dict[str, Any]) -> str:
     """Return ``report.md``'s text."""
     err = val.error
@@ -61,6 +79,7 @@ def _report(val: Validation, summary: dict[str, Any]) -> str:
               'whole table is out of sample for the model. Compare the RMSE with the '
               "calibration's `error_after` (and the sensor noise): much larger, or a trend "
               'in the plots below, means the calibration no longer holds.', '',
+              *_transient_lines(summary),
               *_coverage_lines(summary),
               '## Residual against each channel', '',
               *grid_note(channel_axes(val.parts, val.table)), '![residuals](residuals.png)', '',
