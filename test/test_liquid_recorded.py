@@ -66,6 +66,19 @@ def test_a_contradicting_liquid_is_followed_but_said_loudly(tmp_path, capsys):
     assert 'liquid oil (--liquid; the bag records water); WARNING' in out.out
 
 
+def test_a_recorded_motor_other_than_the_packaged_one_is_said_loudly(tmp_path, capsys):
+    bag = _bag(tmp_path / 'bag', {LIQUID_KEY: 'water', MOTOR_KEY: 'rig 7 motor'})
+    assert main(['replay', str(bag), '--no-plot', '--out', str(tmp_path / 'a.csv')]) == 0
+    out = capsys.readouterr()
+    assert out.err.count('\n') == 1
+    assert "records the motor 'rig 7 motor'; replay uses the packaged SM-0,75/25" in out.err
+    assert 'WARNING' in out.out
+    assert main(['replay', str(_bag(tmp_path / 'same', WATER)), '--no-plot']) == 0
+    assert 'WARNING' not in ''.join(capsys.readouterr())
+    assert main(['replay', str(bag), '--no-plot', '--displacement', '30cm^3/rev']) == 0
+    assert 'records the motor' not in capsys.readouterr().err  # a motor was given
+
+
 def test_a_bag_without_liquid_is_refused_in_one_line_naming_the_option(tmp_path, capsys):
     bag = _bag(tmp_path / 'bag')
     assert main(['replay', str(bag), '--no-plot', '--out', str(tmp_path / 'x.csv')]) == 1

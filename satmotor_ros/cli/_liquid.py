@@ -19,6 +19,7 @@ from typing import NamedTuple
 from satmotor_ros.bags.custom import custom_data, LIQUID_KEY, MOTOR_KEY
 from satmotor_ros.cli._common import CliError
 from satmotor_ros.interface import MotorOptions
+from satmotor_ros.model import ModelError
 
 
 class Liquid(NamedTuple):
@@ -60,16 +61,34 @@ def settle_liquid(options: MotorOptions, data: str, command: str) -> Liquid:
         if not theirs:
             raise CliError(f'{data}: the data do not record their liquid: name it with '
                            "--liquid ('oil' or 'water', or a set of --motor)")
-        return Liquid(replace(options, liquid=theirs),
-                      f'{theirs} (recorded in the bag' + (f', motor {motor})' if motor else ')'),
-                      '')
-    if theirs and theirs != options.liquid:
-        warning = (f'--liquid {options.liquid} differs from the liquid recorded in {data} '
-                   f'({theirs}): {command} uses {options.liquid} as told')
+        options = replace(options, liquid=theirs)
+        settled = Liquid(options, f'{theirs} (recorded in the bag'
+                         + (f', motor {motor})' if motor else ')'), '')
+    elif theirs and theirs != options.liquid:
+        settled = Liquid(options, f'{options.liquid} (--liquid; the bag records {theirs})',
+                         f'--liquid {options.liquid} differs from the liquid recorded in {data} '
+                         f'({theirs}): {command} uses {options.liquid} as told')
+    else:
+        settled = Liquid(options, f'{options.liquid} (--liquid'
+                         + (', as recorded)' if theirs else ')'), '')
+    warnings = [w for w in (settled.warning, _other_motor(options, motor, data, command)) if w]
+    for warning in warnings:
         print(f'satmotor {command}: WARNING: {warning}', file=sys.stderr)
-        return Liquid(options, f'{options.liquid} (--liquid; the bag records {theirs})', warning)
-    return Liquid(options, f'{options.liquid} (--liquid' + (', as recorded)' if theirs else ')'),
-                  '')
+    return settled._replace(warning='; '.join(warnings))
+
+
+def _other_motor(options: MotorOptions, recorded: str, data: str, command: str) -> str:
+    """Say that the recording names a motor other than the packaged one used for want of one."""
+    if not recorded or options.motor_file or options.family or options.displacement:
+        return ''
+    try:
+        used = options.build_model().name
+    except ModelError:
+        return ''  # the command itself says what is wrong with the options, in one line
+    if used == recorded:
+        return ''
+    return (f'{data} records the motor {recorded!r}; {command} uses the packaged {used} for '
+            'want of --motor (give the file of the recorded motor with --motor)')
 
 
 __all__ = ['Liquid', 'settle_liquid']
