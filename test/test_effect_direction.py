@@ -126,6 +126,24 @@ def test_one_direction_of_data_offers_no_one_sided_candidate():
     assert [c.direction for c in candidates if c.effect == 'threshold:dp'] == ['both']
 
 
+def test_on_data_of_one_sign_the_valve_may_crack_near_the_top():
+    # a relief cracking above 94 % of the rows: the threshold must reach beyond the 85 %
+    # quantile, where a valve on both sides of two-sided data stops
+    crack = 26.5 * MPA
+    table = _four_quadrants(model_with({'threshold:dp': {**VALVE, 'reference': crack}}),
+                            np.random.default_rng(5), 800)
+    forward = table.dp > 0.0
+    table = BenchTable(table.speed[forward], table.flow[forward], table.p_in[forward],
+                       table.p_out[forward])
+    parts, _ = loss_parts(BARE, table)
+    assert np.mean(parts.dp > crack) < 0.08
+    candidates, _ = build_library(parts, {}, standard_law(BARE.liquid, 'oil'))
+    valve = next(c for c in candidates if c.effect == 'threshold:dp')
+    fit = LossFit([valve], sigma=0.02 * LPM).fit(parts)
+    assert not fit.pinned(effects_only=True)
+    assert fit.found()[-1][1].reference == pytest.approx(crack, rel=0.02)
+
+
 def test_a_one_sided_term_acts_where_its_direction_says():
     model = model_with({'term:dp@positive': {'coefficient': 1e-9, 'direction': 'positive'}})
     assert model.absorbency_point(-500 * RPM, -10 * MPA).flow == pytest.approx(

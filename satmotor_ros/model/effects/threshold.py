@@ -130,11 +130,13 @@ class Threshold(EffectKind):
         dp = np.abs(data.parts.dp)
         negative = negative_rows(data.parts)
         sides = [('both', np.ones(dp.shape, dtype=bool))]
-        if two_sided(data.parts):
+        both = two_sided(data.parts)
+        if both:
             sides += [('positive', ~negative), ('negative', negative)]
         out, skipped = [], []
         for direction, at in sides:
-            candidate = self._candidate(dp, at, direction)
+            # data of one sign are one side: the threshold may also sit near its top
+            candidate = self._candidate(dp, at, direction, both)
             if candidate is None:
                 skipped.append(f'{self.name}:dp ({direction}): too few points to place a '
                                'threshold')
@@ -142,10 +144,17 @@ class Threshold(EffectKind):
                 out.append(candidate)
         return out, skipped
 
-    def _candidate(self, dp: FloatArray, at: np.ndarray, direction: str) -> Candidate | None:
-        """Return the candidate acting at `at` only, the threshold among those points."""
+    def _candidate(self, dp: FloatArray, at: np.ndarray, direction: str,
+                   two: bool = True) -> Candidate | None:
+        """
+        Return the candidate acting at `at` only, the threshold among those points.
+
+        On data of one sign of dp (`two` false) the candidate on both sides is a one-sided
+        valve too: its threshold may sit as near the top as a side's, and starts both
+        within the range and at the side's quantiles.
+        """
         ordered = np.sort(dp[at])
-        share, least = MIN_ABOVE[direction]
+        share, least = MIN_ABOVE[direction if two else 'negative']
         above = max(least, int(np.ceil(share * ordered.size)))
         if ordered.size < 2 * above:
             return None
@@ -162,10 +171,10 @@ class Threshold(EffectKind):
             return Effect(f'{self.name}:dp', k / (top - x_c) ** e, 'dp', x_c,
                           options=(('exponent', e),), direction=direction)
 
-        starts = STARTS[direction]
-        if direction != 'both':
-            starts = tuple(float(np.clip((np.quantile(ordered, q) - low) / (high - low), 0.0, 1.0))
-                           for q in starts)
+        quantiles = tuple(float(np.clip((np.quantile(ordered, q) - low) / (high - low), 0.0,
+                                        1.0)) for q in STARTS[direction if two else 'negative'])
+        starts = (STARTS['both'] if direction == 'both' else ()) + (
+            quantiles if direction != 'both' or not two else ())
         shape = (Shape('threshold', starts, (0.0, 1.0), 'Pa', (low, high - low)),
                  Shape('exponent', (1.0,), EXPONENTS))
         return Candidate(f'{self.name}:dp', 'dp', self.unit, self.source, dp, modify,
