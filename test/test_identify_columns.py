@@ -222,7 +222,13 @@ def test_calibrate_each_mbari_log_with_the_f11_displacement(mbari_calibrations, 
     assert load_motor(out / 'coefficients.yaml').family == result['family']
 
 
-@pytest.mark.parametrize(('calibrated', 'data'), [MBARI, MBARI[::-1]])
+NO_VALVE_ON_2021 = pytest.mark.xfail(
+    strict=True, reason='issue 20, open: the 2021 log says none (its relief valve is only a '
+    'missed region), so its calibration misses the valve the FrictionID calibration names')
+
+
+@pytest.mark.parametrize(('calibrated', 'data'), [pytest.param(*MBARI, marks=NO_VALVE_ON_2021),
+                                                  MBARI[::-1]])
 def test_validate_one_mbari_logs_calibration_on_the_other(mbari_calibrations, tmp_path, capsys,
                                                           calibrated, data):
     _, out, _ = mbari_calibrations[calibrated]
