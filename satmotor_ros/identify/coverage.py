@@ -153,6 +153,34 @@ def outside(env: dict[str, Any], dp: FloatArray, speed: FloatArray) -> np.ndarra
     return out
 
 
+def calibrated_blocks(path: str | Path) -> dict[str, Any]:
+    """
+    Read the top-level blocks of a ``coefficients.yaml`` (``coverage``, ``dynamics``, ...).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        A motor file, [-]
+
+    Returns
+    -------
+    dict
+        Block name -> block as read; empty when the file is no mapping.
+
+    Raises
+    ------
+    DataError
+        If the file cannot be read.
+
+    """
+    try:
+        doc = read_yaml(path)
+    except (OSError, YamlLimitError) as err:
+        msg = f'{path}: {err}'
+        raise DataError(msg) from None
+    return doc if isinstance(doc, dict) else {}
+
+
 def calibrated_envelope(path: str | Path) -> dict[str, Any] | None:
     """
     Read the envelope a calibrated ``coefficients.yaml`` was fitted on (its ``coverage``).
@@ -174,12 +202,8 @@ def calibrated_envelope(path: str | Path) -> dict[str, Any] | None:
         If the file's ``coverage.envelope`` is malformed (the message names the field).
 
     """
-    try:
-        doc = read_yaml(path)
-    except (OSError, YamlLimitError) as err:
-        msg = f'{path}: {err}'
-        raise DataError(msg) from None
-    if not isinstance(doc, dict) or 'coverage' not in doc:
+    doc = calibrated_blocks(path)
+    if 'coverage' not in doc:
         return None
     env = doc['coverage'].get('envelope') if isinstance(doc['coverage'], dict) else None
     if not isinstance(env, dict) or not set(env) <= {name for name, _ in DIRECTIONS}:
@@ -230,5 +254,5 @@ def coverage(samples_used: int, samples_total: int, dp: FloatArray,
     return out
 
 
-__all__ = ['COVERED', 'MOST', 'TAIL', 'calibrated_envelope', 'coverage', 'envelope',
-           'envelope_share', 'outside']
+__all__ = ['COVERED', 'MOST', 'TAIL', 'calibrated_blocks', 'calibrated_envelope', 'coverage',
+           'envelope', 'envelope_share', 'outside']

@@ -30,8 +30,7 @@ from typing import Any
 
 import numpy as np
 
-from satmotor_ros.bounded_yaml import read_yaml, YamlLimitError
-from satmotor_ros.identify.coverage import outside
+from satmotor_ros.identify.coverage import calibrated_blocks, outside
 from satmotor_ros.identify.effects import CalibratedModel
 from satmotor_ros.identify.errors import DataError, IdentificationError
 from satmotor_ros.identify.parts import loss_parts, LossParts
@@ -128,12 +127,8 @@ def calibrated_dynamics(path: str | Path) -> dict[str, float] | None:
         If ``dynamics`` is malformed (the message names the field).
 
     """
-    try:
-        doc = read_yaml(path)
-    except (OSError, YamlLimitError) as err:
-        msg = f'{path}: {err}'
-        raise DataError(msg) from None
-    if not isinstance(doc, dict) or 'dynamics' not in doc:
+    doc = calibrated_blocks(path)
+    if 'dynamics' not in doc:
         return None
     terms = doc['dynamics']
     known = {term.name for term in DYNAMIC_TERMS}
