@@ -10,6 +10,7 @@ tests start inherit it.
 import os
 from pathlib import Path
 import sys
+import tempfile
 
 import pytest
 
@@ -28,11 +29,19 @@ _read_outside: list[str] = []
 
 
 def read_beside(path: str, repository: Path) -> bool:
-    """Tell whether opening ``path`` reads a file beside ``repository`` (not inside it)."""
+    """
+    Tell whether opening ``path`` reads a file beside ``repository`` that a clone lacks.
+
+    That is shared/ beside it, or any other sibling but the temporary directory (a clone
+    under /tmp has pytest's tmp_path beside it).
+    """
     path = os.path.abspath(path)
-    beside = path.startswith(str(repository.parent) + os.sep)
-    # A tool probing for a config file that is not there (pydocstyle) reads nothing.
-    return beside and not path.startswith(str(repository) + os.sep) and os.path.exists(path)
+    if path.startswith(str(repository) + os.sep) or not os.path.exists(path):
+        return False  # a tool probing for a config file that is not there reads nothing
+    if path.startswith(str(repository.parent / 'shared') + os.sep):
+        return True
+    return (path.startswith(str(repository.parent) + os.sep)
+            and not path.startswith(tempfile.gettempdir() + os.sep))
 
 
 def _note_reads_beside_the_repository(event, args):

@@ -27,6 +27,9 @@ def test_a_read_beside_the_repository_is_noted(tmp_path):
     assert not conftest.read_beside(str(clone / 'test' / 'a.csv'), clone)
     assert not conftest.read_beside(str(shared / 'absent.cfg'), clone)
     assert not conftest.read_beside(str(tmp_path.parent / 'elsewhere'), clone)
+    (tmp_path / 'pytest-of-root').mkdir()  # a clone under /tmp has tmp_path beside it
+    (tmp_path / 'pytest-of-root' / 'b.csv').write_text('x')
+    assert not conftest.read_beside(str(tmp_path / 'pytest-of-root' / 'b.csv'), clone)
 
 
 def test_the_audit_hook_notes_a_real_open(tmp_path, monkeypatch):
