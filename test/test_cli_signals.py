@@ -95,8 +95,10 @@ def test_kill_9_mid_write_leaves_a_partial_that_the_next_run_removes(bag):
     proc = subprocess.Popen(argv, env=_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     try:
         deadline = time.monotonic() + 60
-        while not list(work.glob('.out.partial-*')) and proc.poll() is None \
-                and time.monotonic() < deadline:
+        # the temporary bag is a directory; a file of that name is the writability probe,
+        # made and removed at once
+        while not any(p.is_dir() for p in work.glob('.out.partial-*')) \
+                and proc.poll() is None and time.monotonic() < deadline:
             time.sleep(0.002)
         assert proc.poll() is None, 'replay finished before its temporary bag appeared'
         proc.kill()
