@@ -53,6 +53,9 @@ setup(
         # zstd FILE and MESSAGE compressed bags; the stdlib has compression.zstd from Python
         # 3.14 on, which backports.zstd backports
         'backports.zstd; python_version < "3.14"',
+        # `satmotor fleet`: its tasks on a local or an existing Dask cluster
+        'dask',
+        'distributed',
     ],
     zip_safe=False,
     maintainer='satmotor_ros developers',
@@ -67,6 +70,7 @@ setup(
             'motor_model = satmotor_ros.nodes.launch:motor_model',
             'virtual_motor = satmotor_ros.nodes.launch:virtual_motor',
             'speed_controller = satmotor_ros.nodes.launch:speed_controller',
+            'motor_monitor = satmotor_ros.nodes.launch:motor_monitor',
         ],
     },
 )

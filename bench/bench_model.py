@@ -45,7 +45,8 @@ def floor(model: MotorModel, flow: np.ndarray, dp: np.ndarray) -> tuple[np.ndarr
     q_c = k_c * dp_i ** c.gamma
     x = np.maximum(flow - q_lfg - q_c, 0.0) * (2 * np.sqrt(RPM) / cm3min)
     b = c.c_id * m2h
-    root = x / (np.sqrt((2 / np.sqrt(RPM)) * (qt + (model.c * m2h / MPA) * dp_i) * x + b * b) + b)
+    k_p = model.c_lumped * m2h / MPA
+    root = x / (np.sqrt((2 / np.sqrt(RPM)) * (qt + k_p * dp_i) * x + b * b) + b)
     n = root * root
     ps = dp_i * n * (m2h * cm3min / (MPA * RPM))
     fc, dch, bl = model.c_fc_beta * ps, model.c_dch * ps, model.c_b * ps

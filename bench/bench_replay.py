@@ -30,9 +30,9 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))  # this source tree's satmotor_ros
 
 import numpy as np  # noqa: E402
-from satmotor_ros.bags import (encode_many, FLOAT64, FLUID_PRESSURE, JOINT_STATE,  # noqa: E402
-                               OutTopic, write_bag)
+from satmotor_ros.bags import encode_many, OutTopic, write_bag  # noqa: E402
 from satmotor_ros.cli.main import main as satmotor  # noqa: E402
+from satmotor_ros.interface import FLOAT64, FLUID_PRESSURE, JOINT_STATE  # noqa: E402
 from satmotor_ros.model import MotorModel  # noqa: E402
 from satmotor_ros.model.units import LPM, MPA  # noqa: E402
 

@@ -157,6 +157,8 @@ def _case(spec) -> dict:
     return {'log': log, 'kinds': kinds, 'scale': scale, 'seed': seed, 'code': code,
             'found': [e['effect'] for e in found['effects']], 'dynamics': lags,
             'named': named, 'shown': shown, 'took': took,
+            'regions': len(found.get('missed_regions', [])),
+            'inflation': found.get('variance_inflation', np.nan),
             'valve': None if valve is None else (valve.direction, valve.crack / 1e6),
             'fitted': [(e.get('direction'), round(e['threshold']['value'] / 1e6, 2))
                        for e in found['effects'] if e['effect'].startswith('threshold')]}
@@ -214,6 +216,11 @@ def main() -> None:
           f'name an effect; {sum(bool(r["dynamics"]) for r in clean)} give a nonzero transient '
           f'term; an effect not injected beside real ones in {extra} of '
           f'{len(results) - len(clean)}')
+    print(f'missed regions named on clean cases: {sum(r["regions"] for r in clean)} in '
+          f'{sum(bool(r["regions"]) for r in clean)} of {len(clean)}; variance inflation of the '
+          f'clean fits {np.nanmedian([r["inflation"] for r in clean]):.2f} median '
+          f'({np.nanmin([r["inflation"] for r in clean]):.2f}-'
+          f'{np.nanmax([r["inflation"] for r in clean]):.2f})')
     print(f'relief valves placed (crack within {100 * CRACK_TOLERANCE:.0f} %, right side): '
           f'{sum(placed)} of {len(placed)} named')
     print(f'{"kind":20s} {"named":>12s} {"detectable named":>18s}')

@@ -16,7 +16,7 @@ grep -v '^ros-\|colcon\|ament\|flake8\|pydocstyle\|mypy\|stubs' requirements.txt
 rm -rf "$work" && mkdir -p "$work"
 git archive HEAD | tar -x -C "$work"
 cd "$work"
-files=${*:-$(ls satmotor_ros/model/*.py | grep -v __init__)}
+files=${*:-$(find satmotor_ros/model -name "*.py" ! -name __init__.py | sort)}
 {
     printf '\n[mutmut]\nsource_paths=satmotor_ros/\nalso_copy=\n    config/\nonly_mutate=\n'
     for f in $files; do printf '    %s\n' "$f"; done

@@ -190,4 +190,34 @@ def read_yaml(path: str | Path) -> Any:
     return parse_yaml(text)
 
 
-__all__ = ['YamlLimitError', 'parse_yaml', 'read_yaml', 'shown']
+def read_yaml_or(path: str | Path, error: type[Exception], unreadable: str,
+                 hostile: str) -> Any:
+    """
+    Read and parse a YAML file as :func:`read_yaml` does, any failure one `error` line.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The file, [-]
+    error : type
+        The exception to raise (the caller's own kind of error), [-]
+    unreadable : str
+        What a file that cannot be read is called: ``'<unreadable>: <strerror>'``, [-]
+    hostile : str
+        What a file beyond a cap or not YAML is called: ``'<hostile>: <reason>'``, [-]
+
+    Returns
+    -------
+    Any
+        The parsed document.
+
+    """
+    try:
+        return read_yaml(path)
+    except OSError as err:
+        raise error(f'{unreadable}: {err.strerror}') from None
+    except YamlLimitError as err:
+        raise error(f'{hostile}: {err}') from None
+
+
+__all__ = ['YamlLimitError', 'parse_yaml', 'read_yaml', 'read_yaml_or', 'shown']

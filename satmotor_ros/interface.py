@@ -1,31 +1,23 @@
 # SPDX-License-Identifier: Apache-2.0
 """
-The DESIGN.md interface contract in one place: topics, message types, fields, options.
+The DESIGN.md topic contract in one place: topic names, message types and fields.
 
-Nodes, ``satmotor replay`` and ``calibrate``, the bag code and the tests import their topic
-names, message types, message fields, loss components, default joint name and the motor
-and liquid options from here. No ROS: message types are named by their type strings
-(``'sensor_msgs/msg/FluidPressure'``); the nodes map them to classes.
+Nodes, ``satmotor replay``, ``calibrate`` and ``demo``, the bag code and the tests import
+their topic names, message types, message fields, loss components and default joint name
+from here; nothing else spells a message type. No ROS and no physics: this module imports
+nothing of the package, so reading a bag loads no model; message types are named by their
+type strings (``'sensor_msgs/msg/FluidPressure'``) and the nodes map them to classes.
 
 Beyond DESIGN.md (documented here and in doc/interface.md): ``motor_model`` may also
 publish the loss breakdown as one ``std_msgs/Float64MultiArray`` on ``losses``
-(:data:`LOSSES_ARRAY`), its layout naming the components (:data:`LOSS_COMPONENTS` order),
-and every node accepts the same motor and liquid parameters (:class:`MotorOptions`).
+(:data:`LOSSES_ARRAY`), its layout naming the components (:data:`LOSS_COMPONENTS` order);
+``speed_controller`` reads its set-point on :data:`SPEED_SETPOINT`; every node reports on
+:data:`DIAGNOSTICS`. The motor and liquid options are :mod:`satmotor_ros.options`.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
-import math
 from typing import NamedTuple
-
-from satmotor_ros.model import load_motor, ModelError, MotorModel
-from satmotor_ros.model.coefficients import displacement_problem
-from satmotor_ros.model.config import MotorSpec
-from satmotor_ros.model.families import DEFAULT_FAMILY, FAMILY_NAMES
-from satmotor_ros.model.families.defaults import default_motor
-from satmotor_ros.model.motor import DisplacementLaw
-from satmotor_ros.model.results import COMPONENTS
 
 FLOAT64 = 'std_msgs/msg/Float64'
 FLOAT64_ARRAY = 'std_msgs/msg/Float64MultiArray'
@@ -35,7 +27,8 @@ JOINT_STATE = 'sensor_msgs/msg/JointState'
 DIAGNOSTIC_ARRAY = 'diagnostic_msgs/msg/DiagnosticArray'
 CLOCK = 'rosgraph_msgs/msg/Clock'
 
-LOSS_COMPONENTS = COMPONENTS
+LOSS_COMPONENTS = ('flat_clearance', 'commutation', 'compressibility', 'deformation',
+                   'backlash', 'inertia', 'external', 'total')
 """The ``<component>`` of ``losses/<component>``: the model's loss breakdown fields."""
 
 JOINT_NAME = 'motor_shaft'
@@ -47,12 +40,26 @@ LOSSES_PREFIX = 'losses/'
 LOSSES_ARRAY = 'losses'
 """One Float64MultiArray with every component (an addition to DESIGN.md, optional)."""
 
+SPEED_SETPOINT = 'speed_setpoint'
+"""The speed controller's set-point (std_msgs/Float64, rad/s), relative to its namespace."""
+
+DIAGNOSTICS = '/diagnostics'
+"""Where every node reports its state (diagnostic_msgs/DiagnosticArray), absolute."""
+
+CLOCK_TOPIC = '/clock'
+"""Simulated time (rosgraph_msgs/Clock), absolute."""
+
+HEALTH_TOPICS = ('health/leakage_factor', 'health/volumetric_efficiency',
+                 'health/hours_to_limit')
+"""What ``motor_monitor`` publishes (std_msgs/Float64): the factor, eta_v and the hours [h]."""
+
 TOPIC_TYPES = {
     'flow_command': FLOAT64, 'inlet_pressure': FLUID_PRESSURE,
     'outlet_pressure': FLUID_PRESSURE, 'case_pressure': FLUID_PRESSURE,
     'fluid_temperature': TEMPERATURE, 'flow_measured': FLOAT64, 'joint_states': JOINT_STATE,
     'load_torque': FLOAT64, PREDICTED_JOINT_STATE: JOINT_STATE, SPEED_RESIDUAL: FLOAT64,
     **{LOSSES_PREFIX + c: FLOAT64 for c in LOSS_COMPONENTS},
+    **dict.fromkeys(HEALTH_TOPICS, FLOAT64),
 }
 """Each DESIGN.md topic (relative name) and its message type."""
 
@@ -95,157 +102,10 @@ PREDICTION_INPUTS = ('flow', 'p_in', 'p_out', 'p_case', 'temperature', 'measured
 PRESSURE_TOPICS = ('inlet_pressure', 'outlet_pressure', 'case_pressure')
 """The FluidPressure topics, in the order the plant reads them."""
 
-DISPLACEMENT_LAWS = ('eq33', 'eq39')
-"""Laws of the change of displacement: physical eq. (33) or empirical eq. (39)."""
-
-LIQUID_PROPERTIES = {'viscosity': 'kinematic_viscosity', 'density': 'density',
-                     'bulk_modulus': 'bulk_modulus'}
-"""User-liquid option -> :class:`~satmotor_ros.model.Liquid` field it overrides."""
-
-
-class OptionError(ModelError):
-    """
-    A motor or liquid option is not acceptable; names the option and the value.
-
-    Parameters
-    ----------
-    option : str
-        Field of :class:`MotorOptions`, [-]
-    value : object
-        Its value, [-]
-    reason : str
-        What is wrong, [-]
-
-    """
-
-    def __init__(self, option: str, value: object, reason: str) -> None:
-        """Keep the parts, so that each front end can spell the option its own way."""
-        super().__init__(f'{option} = {value!r}: {reason}')
-        self.option, self.value, self.reason = option, value, reason
-
-
-@dataclass(frozen=True)
-class MotorOptions:
-    """
-    Which motor, model family, coefficient set, liquid and Delta q law a model is built from.
-
-    The same options are node parameters (same names) and ``satmotor`` options
-    (``--liquid``, ``--motor``, ``--family``, ``--displacement``, ``--law``,
-    ``--viscosity``, ``--density``, ``--bulk-modulus``).
-
-    Parameters
-    ----------
-    liquid : str
-        Coefficient set and its liquid: ``'oil'`` or ``'water'`` for the packaged
-        SM-0,75/25, or any set of `motor_file`, [-]
-    motor_file : str
-        Motor specification or calibrated coefficients YAML; empty: the packaged
-        SM-0,75/25, [-]
-    displacement_law : {'eq33', 'eq39'}
-        Change of displacement law, [-]
-    viscosity : float
-        Kinematic viscosity of a user liquid run on the set; 0: the set's own, [m^2/s]
-    density : float
-        Density of a user liquid; 0: the set's own, [kg/m^3]
-    bulk_modulus : float
-        Bulk modulus of a user liquid; 0: the set's own, [Pa]
-    family : str
-        Model family: ``'sliwinski2017'``, ``'balawender'`` or ``'paszota'``; empty:
-        the motor file's own (``sliwinski2017`` without a file). Without a motor
-        file, the SM-0,75/25 (or a motor of `displacement`) with the family's
-        default coefficients, [-]
-    displacement : float
-        Displacement of a motor that has no YAML (the family's default
-        coefficients, to be calibrated); 0: the motor file's, [m^3/rad]
-
-    """
-
-    liquid: str = 'oil'
-    motor_file: str = ''
-    displacement_law: DisplacementLaw = 'eq33'
-    viscosity: float = 0.0  # [m^2/s]; 0: the set's own
-    density: float = 0.0  # [kg/m^3]; 0: the set's own
-    bulk_modulus: float = 0.0  # [Pa]; 0: the set's own
-    family: str = ''  # '': the motor file's own
-    displacement: float = 0.0  # [m^3/rad]; 0: the motor file's
-
-    def __post_init__(self) -> None:
-        """Reject a family, law, displacement or liquid property that cannot be, naming it."""
-        if self.family not in ('', *FAMILY_NAMES):
-            raise OptionError('family', self.family, f'use one of {", ".join(FAMILY_NAMES)}')
-        problem = displacement_problem(self.displacement) if self.displacement != 0.0 else None
-        if problem is not None:
-            raise OptionError('displacement', self.displacement,
-                              f"{problem}; 0: the motor file's")
-        if self.displacement and self.motor_file:
-            raise OptionError('displacement', self.displacement, 'a motor file has its own: '
-                              'give the file or the displacement, not both')
-        if self.displacement_law not in DISPLACEMENT_LAWS:
-            raise OptionError('displacement_law', self.displacement_law,
-                              f'use one of {", ".join(DISPLACEMENT_LAWS)}')
-        for name in LIQUID_PROPERTIES:
-            value = getattr(self, name)
-            if not (math.isfinite(value) and value >= 0.0):
-                raise OptionError(name, value, "must be a finite value > 0 (0: the set's own)")
-
-    def spec(self) -> MotorSpec:
-        """
-        Load the motor file, or build a motor of the family, and check that it has the set.
-
-        Returns
-        -------
-        MotorSpec
-            The motor.
-
-        Raises
-        ------
-        ModelError
-            If the file cannot be read (the message names it), is of another family
-            than `family` (:class:`OptionError` on ``family``) or lacks the set
-            (:class:`OptionError` on ``liquid``).
-
-        """
-        if self.motor_file:
-            spec = load_motor(self.motor_file)
-            if self.family and self.family != spec.family:
-                raise OptionError('family', self.family, f'{self.motor_file} is a '
-                                  f'{spec.family} motor (omit the family, or convert the file)')
-        else:
-            spec = default_motor(self.family or DEFAULT_FAMILY, self.displacement or None)
-        if self.liquid not in spec.sets:
-            raise OptionError('liquid', self.liquid, f'not a coefficient set of {spec.name} '
-                              f'(has: {", ".join(spec.sets)})')
-        return spec
-
-    def build_model(self) -> MotorModel:
-        """
-        Build the motor model the options describe.
-
-        Returns
-        -------
-        MotorModel
-            The model, with the user liquid when a property is overridden.
-
-        Raises
-        ------
-        ModelError
-            If the motor file, the set or the user liquid is invalid; the message names it.
-
-        """
-        spec = self.spec()
-        overrides = {field: float(getattr(self, option))
-                     for option, field in LIQUID_PROPERTIES.items() if getattr(self, option)}
-        liquid = None
-        if overrides:
-            liquid = replace(spec.sets[self.liquid].liquid,
-                             name=f'user liquid on the {self.liquid} set', **overrides)
-        return MotorModel.from_spec(spec, self.liquid, liquid, self.displacement_law)
-
-
 __all__ = [
-    'CHANNELS', 'CLOCK', 'Channel', 'DIAGNOSTIC_ARRAY', 'DISPLACEMENT_LAWS', 'FLOAT64',
-    'FLOAT64_ARRAY', 'FLUID_PRESSURE', 'JOINT_NAME', 'JOINT_STATE', 'LIQUID_PROPERTIES',
-    'LOSSES_ARRAY', 'LOSSES_PREFIX', 'LOSS_COMPONENTS', 'MODEL_OUTPUTS', 'MotorOptions',
-    'OptionError', 'PREDICTED_JOINT_STATE', 'PREDICTION_INPUTS', 'PRESSURE_TOPICS',
-    'SPEED_RESIDUAL', 'TEMPERATURE', 'TOPIC_TYPES', 'VALUE_FIELD',
+    'CHANNELS', 'CLOCK', 'CLOCK_TOPIC', 'Channel', 'DIAGNOSTICS', 'DIAGNOSTIC_ARRAY', 'FLOAT64',
+    'FLOAT64_ARRAY', 'FLUID_PRESSURE', 'HEALTH_TOPICS', 'JOINT_NAME', 'JOINT_STATE',
+    'LOSSES_ARRAY', 'LOSSES_PREFIX', 'LOSS_COMPONENTS', 'MODEL_OUTPUTS', 'PREDICTED_JOINT_STATE',
+    'PREDICTION_INPUTS', 'PRESSURE_TOPICS', 'SPEED_RESIDUAL', 'SPEED_SETPOINT', 'TEMPERATURE',
+    'TOPIC_TYPES', 'VALUE_FIELD',
 ]

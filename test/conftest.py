@@ -53,6 +53,13 @@ def _note_reads_beside_the_repository(event, args):
 sys.addaudithook(_note_reads_beside_the_repository)
 
 
+def pytest_collection_modifyitems(items):
+    """Mark every test that uses a ROS fixture ``ros`` (pytest.ini), wherever it is."""
+    for item in items:
+        if {'harness', 'ros'} & set(getattr(item, 'fixturenames', ())):
+            item.add_marker(pytest.mark.ros)
+
+
 @pytest.fixture(autouse=True)
 def _self_contained():
     """Fail a test that opened a file beside the repository (a user's clone has none)."""
@@ -71,3 +78,28 @@ def harness():
         yield h
     finally:
         h.close()
+
+
+@pytest.fixture()
+def ros(request):
+    """
+    Give a fresh context, an executor on it and a probe node; shut all down afterwards.
+
+    The probe lives in the test module's ``NAMESPACE`` (the root without one). Yields
+    ``(context, executor, probe)``.
+    """
+    import rclpy  # only after the environment above
+    from rclpy.context import Context
+    from rclpy.executors import SingleThreadedExecutor
+    context = Context()
+    context.init()
+    executor = SingleThreadedExecutor(context=context)
+    probe = rclpy.create_node('probe', namespace=getattr(request.module, 'NAMESPACE', '/'),
+                              context=context)
+    executor.add_node(probe)
+    try:
+        yield context, executor, probe
+    finally:
+        executor.shutdown()
+        probe.destroy_node()
+        context.try_shutdown()

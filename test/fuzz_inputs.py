@@ -30,10 +30,10 @@ from satmotor_ros.identify.errors import DataError
 from satmotor_ros.identify.synthetic import generate, Injection, Plan
 from satmotor_ros.identify.table import BAD_CELLS, IMPOSSIBLE
 from satmotor_ros.identify.textfile import SANITY
-from satmotor_ros.interface import MotorOptions
 from satmotor_ros.model import ModelError, PointStatus
-from satmotor_ros.model.config import default_config_path
+from satmotor_ros.model.io.config import default_config_path
 from satmotor_ros.model.units import LPM, MPA, PSI, RPM
+from satmotor_ros.options import MotorOptions
 import yaml
 
 OUTCOMES = ('value', 'flagged', 'one line')

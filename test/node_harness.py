@@ -26,6 +26,33 @@ from sensor_msgs.msg import FluidPressure, JointState, Temperature
 from std_msgs.msg import Float64, Float64MultiArray
 
 
+def spin_until(executor, condition, timeout=20.0):
+    """
+    Spin `executor` until `condition()` holds or the deadline passes.
+
+    Parameters
+    ----------
+    executor : rclpy.executors.Executor
+        What to spin, [-]
+    condition : callable
+        Returns True when done, [-]
+    timeout : float
+        Deadline, [s]
+
+    Returns
+    -------
+    bool
+        Whether the condition held, [-]
+
+    """
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if condition():
+            return True
+        executor.spin_once(timeout_sec=0.01)
+    return condition()
+
+
 def unique_namespace(tag):
     """
     Return a namespace no parallel test run can share.
@@ -136,28 +163,8 @@ class Harness:
         return motor
 
     def spin_until(self, condition, timeout=10.0):
-        """
-        Spin until `condition()` holds or the deadline passes.
-
-        Parameters
-        ----------
-        condition : callable
-            Returns True when done, [-]
-        timeout : float
-            Deadline, [s]
-
-        Returns
-        -------
-        bool
-            Whether the condition held, [-]
-
-        """
-        deadline = time.monotonic() + timeout
-        while time.monotonic() < deadline:
-            if condition():
-                return True
-            self.executor.spin_once(timeout_sec=0.02)
-        return condition()
+        """Spin until `condition()` holds or `timeout` [s] passes; tell whether it held."""
+        return spin_until(self.executor, condition, timeout)
 
     def spin_for(self, duration):
         """Spin for `duration` seconds."""

@@ -12,10 +12,10 @@ import pytest
 from rosbags.highlevel import AnyReader
 from rosbags.rosbag2 import CompressionFormat, CompressionMode, StoragePlugin, Writer
 from rosbags.typesys import get_typestore, Stores
-from satmotor_ros.bags import (BagError, decode, encode_many, encode_message, FLOAT64,
-                               FLUID_PRESSURE, JOINT_STATE, list_topics, match_topics,
-                               missing_topics, OutTopic, pack_payloads, parse_topic_map,
-                               read_series, TEMPERATURE, write_bag)
+from satmotor_ros.bags import (BagError, decode, encode_many, encode_message, list_topics,
+                               match_topics, missing_topics, OutTopic, pack_payloads,
+                               parse_topic_map, read_series, write_bag)
+from satmotor_ros.interface import FLOAT64, FLUID_PRESSURE, JOINT_STATE, TEMPERATURE
 import yaml
 
 

@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 from rosbags.rosbag2 import StoragePlugin, Writer
 from rosbags.typesys import get_typestore, Stores
-from satmotor_ros.bags import BagError, encode_message, FLOAT64, read_series
+from satmotor_ros.bags import BagError, encode_message, read_series
+from satmotor_ros.interface import FLOAT64
 
 TYPESTORE = get_typestore(Stores.ROS2_KILTED)
 MCAP_MAGIC = b'\x89MCAP0\r\n'

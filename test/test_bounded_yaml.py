@@ -13,10 +13,10 @@ from satmotor_ros.bags import BagError, open_bag
 from satmotor_ros.bounded_yaml import parse_yaml, read_yaml, YamlLimitError
 from satmotor_ros.identify.columns import load_mapping
 from satmotor_ros.identify.errors import DataError
-from satmotor_ros.interface import MotorOptions
 from satmotor_ros.limits import YAML_MAX_BYTES
 from satmotor_ros.model import ConfigError, load_motor
-from satmotor_ros.model.config import default_config_path
+from satmotor_ros.model.io.config import default_config_path
+from satmotor_ros.options import MotorOptions
 from satmotor_ros.plant.errors import PlantError
 from satmotor_ros.plant.params import PlantParams
 

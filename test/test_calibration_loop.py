@@ -5,10 +5,13 @@ import csv
 import json
 
 import numpy as np
+import pytest
 from satmotor_ros.cli.demo import command
 from satmotor_ros.cli.main import main
 from satmotor_ros.model import load_motor, MotorModel
 import yaml
+
+pytestmark = [pytest.mark.ros, pytest.mark.slow]
 
 WEAR = 3e-9  # clearance growth injected into the virtual motor [m/rev]
 
@@ -31,7 +34,7 @@ def test_demo_bag_with_wear_is_calibrated_and_the_new_yaml_shrinks_the_speed_res
     """
     out = tmp_path / 'demo'
     assert command(liquid='water', duration='96', effect=[f'clearance_wear={WEAR}'],
-                   out=str(out), quiet=True) == 0
+                   out=str(out), quiet=True, no_loop=True) == 0  # the demo's own loop: test_demo
     bag = out / 'bags' / 'water_model'
     cal = tmp_path / 'cal'
     assert main(['calibrate', str(bag), '--liquid', 'water', '--out', str(cal)]) == 0

@@ -51,6 +51,7 @@ def test_a_good_cap_value_takes_effect_and_an_empty_one_is_the_default():
     assert _satmotor(_env(SATMOTOR_YAML_MAX_BYTES=''), *POINT).returncode == 0
 
 
+@pytest.mark.ros
 def test_a_node_logs_a_bad_cap_as_an_error_and_runs_on_the_default():
     code = 'from satmotor_ros.nodes.launch import motor_model; motor_model()'
     proc = subprocess.Popen(

@@ -114,7 +114,7 @@ def test_usage_errors_exit_2(capsys):
 
 def test_every_model_subcommand_takes_the_same_motor_options_as_the_nodes(capsys, tmp_path):
     """--law and a user liquid reach the model, as the node parameters of the same names."""
-    from satmotor_ros.interface import MotorOptions
+    from satmotor_ros.options import MotorOptions
     code, out, _ = _run(capsys, 'operating-point', '--flow', '10', '--dp', '10', '--json',
                         '--law', 'eq39', '--viscosity', '15', '--liquid', 'water')
     assert code == 0
@@ -131,7 +131,7 @@ def test_every_model_subcommand_takes_the_same_motor_options_as_the_nodes(capsys
 
 @pytest.mark.parametrize('family', ['sliwinski2017', 'balawender', 'paszota'])
 def test_operating_point_of_each_family_labels_its_own_components(capsys, family):
-    from satmotor_ros.interface import MotorOptions
+    from satmotor_ros.options import MotorOptions
     from satmotor_ros.model.families import FAMILIES
     code, out, _ = _run(capsys, 'operating-point', '--flow', '10', '--dp', '10', '--family',
                         family, '--json')

@@ -7,7 +7,7 @@ import errno
 import pytest
 
 from satmotor_ros.cli._bench import load_data, run_bench_command
-from satmotor_ros.cli.main import build_parser, SUBCOMMANDS
+from satmotor_ros.cli.main import build_parser, subcommand_module, SUBCOMMANDS
 from satmotor_ros.identify import DataError
 from satmotor_ros.model import ModelError
 
@@ -51,6 +51,7 @@ def test_missing_data_is_a_data_error(tmp_path):
 def test_every_subcommand_is_registered_with_its_command():
     sub = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction))
     assert list(sub.choices) == list(SUBCOMMANDS)
-    for name, module in SUBCOMMANDS.items():
+    for name in SUBCOMMANDS:
+        module = subcommand_module(name)
         assert sub.choices[name].get_default('command') is module.command
         assert sub.choices[name].description == module.DESCRIPTION

@@ -19,7 +19,8 @@ def test_directory_appears_whole_with_its_marker_and_parents(tmp_path):
         _write(tmp, 'first')
         assert not target.exists()  # nothing at the target until the block ends
     assert (target / 'report.md').read_text() == 'first'
-    assert json.loads((target / MARKER).read_text()) == {'command': 'calibrate'}
+    assert json.loads((target / MARKER).read_text()) == {'command': 'calibrate',
+                                                         'files': ['report.md']}
     assert [p.name for p in target.parent.iterdir()] == ['b']  # no temporary left
 
 
@@ -44,6 +45,27 @@ def test_failure_or_interrupt_leaves_the_previous_result_intact(tmp_path):
             raise error()
     assert (target / 'report.md').read_text() == 'first'
     assert [p.name for p in tmp_path.iterdir()] == ['cal']
+
+
+def test_a_file_the_user_put_in_an_earlier_output_makes_it_theirs(tmp_path):
+    target = tmp_path / 'cal'
+    with output_dir('--out', target, 'calibrate') as tmp:
+        _write(tmp, 'first')
+        (tmp / 'plots').mkdir()
+        (tmp / 'plots' / 'a.png').write_bytes(b'x')
+    (target / 'plots' / 'a.png').unlink()  # a file of ours gone: still ours
+    with output_dir('--out', target, 'calibrate') as tmp:
+        _write(tmp, 'second')
+    (target / 'my_notes.txt').write_text('mine')
+    with pytest.raises(CliError, match='not an earlier output of satmotor calibrate'):
+        with output_dir('--out', target, 'calibrate'):
+            pytest.fail('must not get here')
+    assert (target / 'my_notes.txt').read_text() == 'mine'
+    assert (target / 'report.md').read_text() == 'second'
+    (target / MARKER).write_text(json.dumps({'command': 'calibrate'}))  # an older marker
+    with output_dir('--out', target, 'calibrate') as tmp:
+        _write(tmp, 'third')
+    assert (target / 'report.md').read_text() == 'third'
 
 
 @pytest.mark.parametrize('other', ['user', 'validate'])

@@ -21,12 +21,13 @@ def _env():
 @pytest.fixture(scope='module')
 def bag(tmp_path_factory):
     path = tmp_path_factory.mktemp('signals') / 'bag'
-    subprocess.run([sys.executable, '-m', 'satmotor_ros.identify.synthetic', '--liquid',
+    subprocess.run([sys.executable, '-m', 'satmotor_ros.cli', 'synthetic', '--liquid',
                     'water', '--series', '30000', '--bag', 'mcap', '--seed', '3', '--out',
                     str(path)], env=_env(), check=True, capture_output=True, timeout=120)
     return path
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize('signum', [signal.SIGINT, signal.SIGTERM])
 def test_a_signal_while_the_bag_is_written_leaves_the_earlier_output(bag, signum):
     work = bag.parent / signum.name
@@ -86,6 +87,7 @@ def test_what_a_killed_run_left_is_cleaned_at_the_next_run_and_nothing_else(tmp_
         'taken'])
 
 
+@pytest.mark.slow
 def test_kill_9_mid_write_leaves_a_partial_that_the_next_run_removes(bag):
     work = bag.parent / 'killed'
     work.mkdir()

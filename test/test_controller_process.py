@@ -21,6 +21,8 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64
 import test_package_build as build
 
+pytestmark = [pytest.mark.ros, pytest.mark.slow]
+
 colcon_build = build.colcon_build  # the module-scoped build, as a fixture of this module
 sourced_install = build.sourced_install
 

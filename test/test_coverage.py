@@ -17,9 +17,9 @@ from satmotor_ros.identify.output import write_yaml
 from satmotor_ros.identify.synthetic import (generate, generate_transient, Injection, Plan,
                                              REALISTIC_DYNAMICS)
 from satmotor_ros.identify.transient import segments, spikes, transient_samples
-from satmotor_ros.interface import MotorOptions
 from satmotor_ros.model import MotorModel
 from satmotor_ros.model.units import LPM, MPA, RPM
+from satmotor_ros.options import MotorOptions
 from vendored_data import data_path
 import yaml
 

@@ -13,6 +13,8 @@ from satmotor_ros.cli.demo import command
 from satmotor_ros.cli.main import main
 from satmotor_ros.model.units import RPM
 
+pytestmark = [pytest.mark.ros, pytest.mark.slow]
+
 PNG = b'\x89PNG\r\n\x1a\n'
 
 
@@ -101,6 +103,10 @@ def test_demo_closes_the_loop_on_its_own_recording(tmp_path):
     assert result['error_after']['rmse_lpm'] < 0.3 * result['error_before']['rmse_lpm']
     assert (out / 'loop' / 'residuals.png').read_bytes().startswith(PNG)
     assert (out / 'bags' / 'water_model_loop' / 'metadata.yaml').is_file()
+    health = report[report.index('## Health over the runs'):]
+    assert '`water_model`' in health and '`water_model_loop`' in health
+    monitor = json.loads((out / 'health' / 'monitor.json').read_text())
+    assert monitor['n_samples'] > 1000 and monitor['recordings'][1]['data'] == 'water_model_loop'
 
 
 def test_demo_without_the_loop(tmp_path):

@@ -6,7 +6,10 @@ import re
 import subprocess
 import sys
 
+import pytest
 from rosbags.highlevel import AnyReader
+
+pytestmark = [pytest.mark.ros, pytest.mark.slow]
 
 ROOT = Path(__file__).resolve().parent.parent
 

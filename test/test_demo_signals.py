@@ -65,6 +65,8 @@ def test_sigterm_is_delivered_to_the_handler_that_was_there():
         signal.signal(signal.SIGTERM, before)
 
 
+@pytest.mark.ros
+@pytest.mark.slow
 def test_ctrl_c_of_a_running_demo_is_one_line_and_exit_130(tmp_path):
     env = {**os.environ, 'PYTHONPATH': str(ROOT), 'ROS_AUTOMATIC_DISCOVERY_RANGE': 'LOCALHOST'}
     for k, delay in enumerate((0.0, 0.4, 1.2)):

@@ -11,8 +11,8 @@ from satmotor_ros.identify.fit import LossFit
 from satmotor_ros.identify.parts import loss_parts
 from satmotor_ros.identify.table import BenchTable
 from satmotor_ros.model import ConfigError, INVALID, MotorModel, PointStatus
-from satmotor_ros.model.config import default_config_path, motor_from_mapping
 from satmotor_ros.model.effects import Effect, effect_from_mapping, effect_to_mapping
+from satmotor_ros.model.io.config import default_config_path, motor_from_mapping
 from satmotor_ros.model.units import ATMOSPHERE, LPM, MPA, RPM
 from satmotor_ros.model.viscosity import standard_law
 from satmotor_ros.prediction import Combiner, predict, Rule

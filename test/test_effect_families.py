@@ -8,9 +8,10 @@ import pytest
 from satmotor_ros.identify.pipeline import calibrate, Options
 from satmotor_ros.identify.table import BenchTable
 from satmotor_ros.model import ConfigError, MotorModel
-from satmotor_ros.model.effects import check_effects, Effect, effect_from_mapping, with_effects
+from satmotor_ros.model.effects import check_effects, Effect, effect_from_mapping
 from satmotor_ros.model.families import FAMILY_NAMES
 from satmotor_ros.model.families.defaults import default_motor
+from satmotor_ros.model.motor import with_effects
 from satmotor_ros.model.units import CM3_PER_REV, LPM, MPA, RPM
 from satmotor_ros.plant import ConstantLoad, Plant, PlantParams
 from satmotor_ros.plant.config import params_from_flat

@@ -4,11 +4,11 @@
 from node_harness import unique_namespace
 import pytest
 from rclpy.parameter import Parameter
-from satmotor_ros.interface import MotorOptions, OptionError
 from satmotor_ros.model import MotorModel
 from satmotor_ros.model.families import FAMILY_NAMES
 from satmotor_ros.model.units import CM3_PER_REV, LPM, MPA
 from satmotor_ros.nodes.motor_model import MotorModelNode
+from satmotor_ros.options import MotorOptions, OptionError
 from satmotor_ros.plant import ConstantLoad, Plant
 from std_msgs.msg import Float64
 
@@ -103,7 +103,7 @@ def test_node_family_and_displacement_parameters_rebuild_or_refuse(harness):
 
 
 def _packaged():
-    from satmotor_ros.model.config import default_config_path
+    from satmotor_ros.model.io.config import default_config_path
     return default_config_path()
 
 
@@ -116,7 +116,7 @@ def test_every_family_builds_from_the_packaged_liquids():
 
 @pytest.mark.parametrize('family', ['balawender', 'paszota'])
 def test_effects_of_a_coefficient_set_work_in_every_family(family, tmp_path):
-    from satmotor_ros.model.config import motor_from_mapping
+    from satmotor_ros.model.io.config import motor_from_mapping
     doc = {'motor': 'x', 'family': family, 'geometry': {'displacement': '10 cm^3/rev'},
            'valid_range': {'dp_max': '25 MPa', 'speed_max': '2000 rpm'},
            'coefficient_sets': {'oil': {

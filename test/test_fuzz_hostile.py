@@ -15,7 +15,7 @@ from hypothesis import example, given, HealthCheck, settings, strategies as st
 import pytest
 import yaml
 
-SETTINGS = settings(max_examples=120, deadline=None, derandomize=True, database=None,
+SETTINGS = settings(max_examples=50, deadline=None, derandomize=True, database=None,
                     suppress_health_check=[HealthCheck.function_scoped_fixture,
                                            HealthCheck.too_slow])
 

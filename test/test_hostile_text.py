@@ -53,6 +53,7 @@ def _cli(*argv, env=None, timeout=60):
 
 # -- item 3: no cap on text DATA ------------------------------------------------------------
 
+@pytest.mark.slow
 @pytest.mark.parametrize('command', ['calibrate', 'validate'])
 def test_a_device_or_a_fifo_as_data_is_one_line_at_once(tmp_path, command):
     fifo = tmp_path / 'fifo'
@@ -72,6 +73,7 @@ def test_the_byte_cap_is_read_no_further(tmp_path, monkeypatch, capsys, bench):
     _one_line(code, err, 'larger than 1000 bytes (the cap SATMOTOR_TEXT_MAX_BYTES)')
 
 
+@pytest.mark.slow
 def test_the_row_cap_is_overridden_through_the_environment(tmp_path, bench):
     code, err = _cli('validate', bench, '--liquid', 'oil', '--out', tmp_path / 'o',
                      env={'SATMOTOR_TEXT_MAX_ROWS': '39'})
@@ -216,6 +218,7 @@ def test_time_that_restarts_is_named_and_kept_apart(tmp_path):
     assert len(extract_steady(table)) == sum(apart)
 
 
+@pytest.mark.slow
 def test_a_displacement_that_makes_most_losses_negative_is_named(tmp_path, capsys, bench):
     code, _, err = _run(capsys, 'calibrate', bench, '--liquid', 'oil', '--displacement',
                         '45cm^3/rev', '--out', tmp_path / 'cal')

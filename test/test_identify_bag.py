@@ -39,6 +39,7 @@ def test_bag_reads_as_the_time_series_it_recorded(tmp_path, water_wear_series, s
     assert 'gauge' in table.notes[0]
 
 
+@pytest.mark.slow
 def test_calibrate_command_on_a_bag_names_the_wear(tmp_path, water_wear_series, capsys):
     write_bag_of(tmp_path / 'bag', water_wear_series, 'mcap')
     code = main(['calibrate', str(tmp_path / 'bag'), '--liquid', 'water', '--out',
@@ -78,6 +79,7 @@ def _residual_rms(path):
     return float(np.sqrt(np.mean(r ** 2)))
 
 
+@pytest.mark.slow
 def test_end_to_end_bag_calibrate_then_replay_with_the_new_yaml_shrinks_speed_residual(
         tmp_path, capsys):
     """A leaking motor's bag -> calibrate -> coefficients.yaml into the node's prediction."""

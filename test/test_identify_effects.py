@@ -62,6 +62,7 @@ def test_calibration_says_none_on_clean_data(liquid, seed):
     assert cal.error_after == cal.error_before
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(('liquid', 'effect'), [('oil', 'external_leakage'),
                                                 ('water', 'clearance_wear'),
                                                 ('water', 'none')])

@@ -86,6 +86,7 @@ def test_a_calibrated_family_writes_a_yaml_of_that_family_that_loads(tmp_path):
         packaged.k_g * factors['losses_scale'])
 
 
+@pytest.mark.slow
 def test_cli_family_pins_and_displacement_sizes_the_compared_families(tmp_path, capsys):
     data = _points_csv('paszota', tmp_path / 'points.csv')
     assert main(['calibrate', str(data), '--liquid', 'oil', '--out', str(tmp_path / 'a')]) == 0

@@ -18,7 +18,8 @@ from satmotor_ros.identify.output import write_json, write_yaml
 from satmotor_ros.identify.report import write_report
 from satmotor_ros.identify.synthetic import generate, Injection, Plan, with_outliers
 from satmotor_ros.model import MotorModel
-from satmotor_ros.model.effects import effect_from_mapping, with_effects
+from satmotor_ros.model.effects import effect_from_mapping
+from satmotor_ros.model.motor import with_effects
 from satmotor_ros.model.units import LPM, MPA, RPM
 
 
@@ -82,6 +83,7 @@ PAIRS = [
 ]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(('liquid', 'first', 'second'), PAIRS,
                          ids=[f'{a.effect}+{b.effect}' for _, a, b in PAIRS])
 def test_two_effects_are_found_one_after_the_other(tmp_path, liquid, first, second):

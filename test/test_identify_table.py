@@ -172,3 +172,14 @@ def test_table_reads_blank_separated_rows_under_a_commented_header(tmp_path):
             '  600  20 10 1\n 700 21 11 1\n')
     table = read_csv(_write(tmp_path, text))
     assert len(table) == 2 and table.speed[1] == pytest.approx(700 * RPM)
+
+
+def test_written_epoch_times_keep_their_sub_second_steps(tmp_path):
+    """A time column of epoch seconds at 100 Hz reads back to the hundredth of a second."""
+    from satmotor_ros.identify import write_csv
+    time = 1.78e9 + np.arange(50) / 100.0
+    path = tmp_path / 'epoch.csv'
+    write_csv(path, {'time': ('s', time), 'speed': ('rad/s', np.full(50, 10.0)),
+                     'flow': ('m^3/s', np.full(50, 1e-4)), 'p_in': ('Pa', np.full(50, 1e7)),
+                     'p_out': ('Pa', np.full(50, 5e5))})
+    assert read_csv(path).channels['time'] == pytest.approx(time, abs=1e-6, rel=0.0)

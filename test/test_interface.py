@@ -1,13 +1,21 @@
 # SPDX-License-Identifier: Apache-2.0
-"""The interface contract in one module: topics, types, fields and the motor options."""
+"""The interface contract in one module: topics, types, fields; and the motor options."""
 
+import ast
 import dataclasses
+from pathlib import Path
+import re
+import subprocess
+import sys
 
 import pytest
 
-from satmotor_ros.interface import (CHANNELS, JOINT_NAME, LOSS_COMPONENTS, MotorOptions,
-                                    OptionError, PREDICTION_INPUTS, TOPIC_TYPES, VALUE_FIELD)
+from satmotor_ros.interface import (CHANNELS, JOINT_NAME, LOSS_COMPONENTS, PREDICTION_INPUTS,
+                                    TOPIC_TYPES, VALUE_FIELD)
 from satmotor_ros.model import COMPONENTS, MotorModel
+from satmotor_ros.options import MotorOptions, OptionError
+
+PACKAGE = Path(__file__).resolve().parents[1] / 'satmotor_ros'
 
 DESIGN_TABLE = {  # DESIGN.md's topic table, as written there
     'flow_command': 'std_msgs/msg/Float64', 'inlet_pressure': 'sensor_msgs/msg/FluidPressure',
@@ -17,6 +25,9 @@ DESIGN_TABLE = {  # DESIGN.md's topic table, as written there
     'joint_states': 'sensor_msgs/msg/JointState', 'load_torque': 'std_msgs/msg/Float64',
     'predicted_joint_state': 'sensor_msgs/msg/JointState',
     'speed_residual': 'std_msgs/msg/Float64',
+    'health/leakage_factor': 'std_msgs/msg/Float64',
+    'health/volumetric_efficiency': 'std_msgs/msg/Float64',
+    'health/hours_to_limit': 'std_msgs/msg/Float64',
 }
 
 
@@ -68,3 +79,32 @@ def test_bad_option_names_itself(kwargs, option, text):
 def test_unreadable_motor_file_is_a_model_error_naming_it(tmp_path):
     with pytest.raises(ValueError, match='missing.yaml'):
         MotorOptions(motor_file=str(tmp_path / 'missing.yaml')).build_model()
+
+
+@pytest.mark.parametrize('module', ['satmotor_ros.interface', 'satmotor_ros.bags'])
+def test_the_contract_and_the_bag_reader_load_no_physics(module):
+    code = (f'import sys, {module}; '
+            'print(sorted(m for m in sys.modules if m.startswith("satmotor_ros.model")))')
+    out = subprocess.run([sys.executable, '-c', code], check=True, capture_output=True,
+                         text=True).stdout
+    assert out.strip() == '[]'
+
+
+def test_the_contract_imports_nothing_of_the_package():
+    tree = ast.parse((PACKAGE / 'interface.py').read_text(encoding='utf-8'))
+    imported = [node.module or '' for node in ast.walk(tree) if isinstance(node, ast.ImportFrom)]
+    imported += [a.name for node in ast.walk(tree) if isinstance(node, ast.Import)
+                 for a in node.names]
+    assert not [m for m in imported if m.startswith('satmotor_ros')]
+
+
+def test_no_module_but_the_contract_spells_a_message_type():
+    spelled = []
+    for path in PACKAGE.rglob('*.py'):
+        if path.name == 'interface.py' and path.parent == PACKAGE:
+            continue
+        for node in ast.walk(ast.parse(path.read_text(encoding='utf-8'))):
+            if (isinstance(node, ast.Constant) and isinstance(node.value, str)
+                    and re.fullmatch(r'\w+_msgs/msg/\w+', node.value)):
+                spelled.append(f'{path.relative_to(PACKAGE)}: {node.value}')
+    assert not spelled

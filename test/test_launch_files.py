@@ -13,7 +13,7 @@ import re
 import xml.etree.ElementTree as ElementTree
 
 import pytest
-from satmotor_ros.nodes import motor_model, speed_controller, virtual_motor
+from satmotor_ros.nodes import motor_model, motor_monitor, speed_controller, virtual_motor
 
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGE = 'satmotor_ros'
@@ -45,6 +45,7 @@ NODE_PARAMETERS = {
     'motor_model': {s.name for s in motor_model.PARAMETERS},
     'virtual_motor': {s.name for s in virtual_motor.all_parameters()},
     'speed_controller': {s.name for s in speed_controller.PARAMETERS},
+    'motor_monitor': {s.name for s in motor_monitor.PARAMETERS},
 }
 """What each executable declares; use_sim_time every node has."""
 

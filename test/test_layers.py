@@ -8,13 +8,14 @@ import sys
 
 import pytest
 
-from satmotor_ros.model import losses, speed
 from satmotor_ros.model.families import balawender_losses, paszota_losses
+from satmotor_ros.model.families.sliwinski2017 import losses, speed
 
 
 @pytest.mark.parametrize('module', ['satmotor_ros.model', 'satmotor_ros.plant',
                                     'satmotor_ros.identify', 'satmotor_ros.prediction',
-                                    'satmotor_ros.bags', 'satmotor_ros.cli'])
+                                    'satmotor_ros.bags', 'satmotor_ros.cli',
+                                    'satmotor_ros.fleet'])
 def test_layer_imports_without_rclpy(module):
     code = f'import sys, {module}; assert "rclpy" not in sys.modules, "rclpy imported"'
     subprocess.run([sys.executable, '-c', code], check=True)

@@ -4,13 +4,13 @@
 import numpy as np
 import pytest
 
-from satmotor_ros.bags import encode_many, FLOAT64, FLUID_PRESSURE, JOINT_STATE, OutTopic, \
-    write_bag
+from satmotor_ros.bags import encode_many, OutTopic, write_bag
 from satmotor_ros.bags.custom import custom_data, LIQUID_KEY, MOTOR_KEY
 from satmotor_ros.cli import main
 from satmotor_ros.identify.synthetic import (generate_series, generate_transient, Injection, Plan,
                                              to_columns, write_bag_of)
 from satmotor_ros.identify.table import write_csv
+from satmotor_ros.interface import FLOAT64, FLUID_PRESSURE, JOINT_STATE
 from satmotor_ros.model.units import LPM, MPA
 
 WATER = {LIQUID_KEY: 'water', MOTOR_KEY: 'SM-0,75/25'}
@@ -105,6 +105,7 @@ def test_replay_out_bag_records_the_liquid_it_used(tmp_path, capsys):
     assert 'liquid water (recorded' in capsys.readouterr().out
 
 
+@pytest.mark.slow
 def test_calibrate_takes_the_recorded_liquid_and_says_a_contradiction_in_the_report(
         tmp_path, capsys):
     table = generate_transient(Plan(liquid='water'), Injection(), seed=4, duration_s=40.0)

@@ -208,7 +208,7 @@ def test_a_nan_speed_in_the_batch_hides_no_other_elements_stall(oil):
 
 
 def test_a_nan_element_hides_no_other_elements_extrapolation(oil):
-    from satmotor_ros.model.screening import flag_extrapolated
+    from satmotor_ros.model.engine.screening import flag_extrapolated
     d = oil.derived
     status = np.zeros(3, np.uint8)
     speed = np.array([2.0 * d.speed_max, np.nan, d.speed_max])

@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 from satmotor_ros.model import (COMPONENTS, ConfigError, INVALID, InvalidInputError, load_motor,
                                 ModelError, MotorModel, PointStatus)
-from satmotor_ros.model.config import default_config_path, motor_from_mapping
 from satmotor_ros.model.effects import flow_reading
-from satmotor_ros.model.solve import solve_increasing_scalar, Tolerance, with_secant_slope
+from satmotor_ros.model.engine.solve import solve_increasing_scalar, Tolerance, with_secant_slope
+from satmotor_ros.model.io.config import default_config_path, motor_from_mapping
 from satmotor_ros.model.units import LPM, MPA, RPM
 from satmotor_ros.model.viscosity import vogel_viscosity, walther_slope, walther_viscosity
 import yaml

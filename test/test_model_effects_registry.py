@@ -9,9 +9,9 @@ from satmotor_ros.identify.candidates import build_library
 from satmotor_ros.identify.parts import loss_parts
 from satmotor_ros.identify.synthetic import generate, Injection, Plan
 from satmotor_ros.model import load_motor, MotorModel
-from satmotor_ros.model.effects import (Effect, effect_from_mapping, effect_to_mapping,
-                                        EffectKind, KINDS, PlantParameter, ranked, register,
-                                        unregister, with_effects)
+from satmotor_ros.model.effects import (Effect, effect_from_mapping, effect_to_mapping, EffectKind,
+                                        KINDS, PlantParameter, ranked, register, unregister)
+from satmotor_ros.model.motor import with_effects
 from satmotor_ros.model.units import LPM
 from satmotor_ros.model.viscosity import standard_law
 from satmotor_ros.plant import ConstantLoad, Plant

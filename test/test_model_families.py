@@ -7,14 +7,14 @@ from hypothesis import assume, given, settings, strategies as st
 import numpy as np
 import pytest
 
-from satmotor_ros.model import (ConfigError, INVALID, InvalidInputError, ModelError,
-                                MotorModel, PointStatus)
-from satmotor_ros.model.config import motor_from_mapping
+from satmotor_ros.model import (ConfigError, INVALID, InvalidInputError, ModelError, MotorModel,
+                                PointStatus)
 from satmotor_ros.model.families import balawender_losses as bal
 from satmotor_ros.model.families import (BalawenderCoefficients, FAMILIES, family_named,
                                          FAMILY_NAMES, PaszotaCoefficients)
 from satmotor_ros.model.families import paszota_losses as pas
 from satmotor_ros.model.families.defaults import default_motor
+from satmotor_ros.model.io.config import motor_from_mapping
 from satmotor_ros.model.units import CM3_PER_REV, CST, LPM, MPA, RPM
 
 MODELS = {(family, liquid): MotorModel.for_displacement(None, family, liquid)

@@ -12,12 +12,13 @@ from satmotor_ros.identify import calibrate, write_csv
 from satmotor_ros.identify.output import write_json, write_yaml
 from satmotor_ros.identify.synthetic import generate, Injection, Plan, to_columns
 from satmotor_ros.identify.validate import validate
-from satmotor_ros.interface import MotorOptions
 from satmotor_ros.model import ConfigError, load_motor, MotorModel, PointStatus
-from satmotor_ros.model.config import default_config_path, motor_from_mapping
-from satmotor_ros.model.effects import Effect, effect_to_mapping, with_effects
-from satmotor_ros.model.screening import FITTED_TOLERANCE
+from satmotor_ros.model.effects import Effect, effect_to_mapping
+from satmotor_ros.model.engine.screening import FITTED_TOLERANCE
+from satmotor_ros.model.io.config import default_config_path, motor_from_mapping
+from satmotor_ros.model.motor import with_effects
 from satmotor_ros.model.units import CM3_PER_REV, LPM, MPA, RPM
+from satmotor_ros.options import MotorOptions
 import yaml
 
 EXTRAPOLATED = int(PointStatus.EXTRAPOLATED)

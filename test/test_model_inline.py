@@ -6,8 +6,10 @@ import dis
 import numpy as np
 import pytest
 
-from satmotor_ros.model import composition, MotorModel
-from satmotor_ros.model._inline import inline_equations
+from satmotor_ros.model import MotorModel
+from satmotor_ros.model._inline import inline_equations, inline_on_floats
+from satmotor_ros.model.engine import screening
+from satmotor_ros.model.families.sliwinski2017 import composition
 from satmotor_ros.model.units import LPM, MPA, RPM
 
 KERNELS = {'channel_pressure_drop', 'chamber_pressure_drop', 'clearance_height',
@@ -213,3 +215,24 @@ def test_inlined_law_methods_equal_their_originals_bitwise(law):
             assert _same(terms(p), terms0(p))
     assert law != 'eq39' or all(hasattr(getattr(kind, m), '__wrapped__')
                                 for m in ('loss', 'floor'))
+
+
+def _rules_on_floats(speed: float, dp_i: float) -> tuple[int, int, int, int]:
+    """Apply the status rules the single-point path inlines (a module-level function)."""
+    return (screening.outside_range(speed, dp_i, 2.0, 3.0, -1.0, 0.5, False),
+            screening.channel_limited(dp_i), screening.input_flags(dp_i, 2.5),
+            screening.below_floor(speed, dp_i))
+
+
+@pytest.mark.parametrize('speed', [-1.0, 0.0, 0.5, 1.0, 3.0, 4.0, np.inf, np.nan])
+@pytest.mark.parametrize('dp_i', [-2.0, -1.0, 0.0, 1.0, 2.0, 2.6, -np.inf, np.nan])
+def test_rules_inlined_on_floats_give_the_flags_of_the_rules_and_their_array_form(speed, dp_i):
+    inlined = inline_on_floats(_rules_on_floats)
+    got = inlined(speed, dp_i)
+    assert got == _rules_on_floats(speed, dp_i)
+    on_arrays = _rules_on_floats(np.array([speed]), np.array([dp_i]))
+    assert got == tuple(int(np.asarray(f).reshape(-1)[0]) for f in on_arrays)
+    code = inlined.__code__
+    assert not {'outside_range', 'channel_limited', 'input_flags'} & set(code.co_names)
+    ors = [i for i in dis.get_instructions(code) if i.opname == 'BINARY_OP' and i.argrepr == '|']
+    assert len(ors) == 1, 'the four tests of outside_range are joined by or (its flag by |)'

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from satmotor_ros.model import INVALID, InvalidInputError, MotorModel, PointStatus
-from satmotor_ros.model.losses import channel_pressure_drop
+from satmotor_ros.model.families.sliwinski2017.losses import channel_pressure_drop
 from satmotor_ros.model.units import LPM, MPA, RPM
 
 DATA = Path(__file__).resolve().parent / 'data'  # reference grids (test/data/README.md)
@@ -109,7 +109,7 @@ def test_eq39_near_stall_is_no_root_not_a_silent_zero_speed():
 
 
 def test_a_solve_that_runs_out_of_iterations_is_flagged_not_converged(monkeypatch):
-    from satmotor_ros.model import forward, inverse, solve
+    from satmotor_ros.model.engine import forward, inverse, solve
     real = solve.solve_increasing
     for module in (forward, inverse):
         monkeypatch.setattr(module, 'solve_increasing',
@@ -156,7 +156,7 @@ def test_forward_map_with_port_drop_matches_the_port_reference_grid(liquid):
 
 def test_the_maps_give_the_same_fields_in_chunks_as_in_one_chunk(monkeypatch):
     """Chunk boundaries, masked elements and a component 0 throughout (Q_ex) change nothing."""
-    from satmotor_ros.model import batch
+    from satmotor_ros.model.engine import batch
     model, p_ex = MODELS['water', 'eq39'], 0.5 * MPA
     assert model.derived.k_ex == 0.0  # the external leakage stays 0 in every chunk
     rng = np.random.default_rng(3)

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from satmotor_ros.model import Liquid, load_motor, MotorModel, PointStatus
-from satmotor_ros.model import losses as eq
-from satmotor_ros.model.composition import Equations
+from satmotor_ros.model.families.sliwinski2017 import losses as eq
+from satmotor_ros.model.families.sliwinski2017.composition import Equations
 from satmotor_ros.model.units import LPM, MPA, RPM
 
 SPEC = load_motor()
@@ -98,7 +98,7 @@ def test_analytic_slopes_match_finite_differences(liquid, law):
 @pytest.mark.parametrize('law', ['eq33', 'eq39'])
 def test_solves_need_few_evaluations_with_right_slopes(law, monkeypatch):
     # a wrong slope still converges inside the bracket, but slowly: count the evaluations
-    from satmotor_ros.model import solve
+    from satmotor_ros.model.engine import solve
     calls = []
     real = solve.solve_increasing
 
@@ -108,7 +108,7 @@ def test_solves_need_few_evaluations_with_right_slopes(law, monkeypatch):
             return func(x)
         return real(counted, *args, **kwargs)
 
-    from satmotor_ros.model import forward, inverse
+    from satmotor_ros.model.engine import forward, inverse
     monkeypatch.setattr(forward, 'solve_increasing', counting)
     monkeypatch.setattr(inverse, 'solve_increasing', counting)
     model = _model('water', law)
@@ -222,7 +222,7 @@ def test_a_freshly_built_model_gives_the_same_points_on_both_paths(liquid, law):
 @pytest.mark.parametrize('fn', ['external_leakage', 'chamber_pressure_drop', 'speed_loss',
                                 'absorbency'])
 def test_equation_functions_return_floats_for_integer_input(fn):
-    from satmotor_ros.model import speed as sp
+    from satmotor_ros.model.families.sliwinski2017 import speed as sp
     model = _model('oil', external_leakage=1e-12)
     calls = {
         'external_leakage': lambda: eq.external_leakage(np.array([3]), model.derived.k_ex),

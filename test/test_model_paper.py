@@ -52,7 +52,7 @@ def test_paper_water_oil_loss_ratio_peaks_as_published(flow_lpm, peak):
 
 
 def test_paper_channel_drop_for_oil_is_0_03_0_44_1_76_mpa():
-    from satmotor_ros.model.losses import channel_pressure_drop
+    from satmotor_ros.model.families.sliwinski2017.losses import channel_pressure_drop
     oil = MotorModel.default('oil')
     dp = channel_pressure_drop(np.array([5, 20, 40]) * LPM, oil.derived.ch_a, oil.derived.ch_b)
     np.testing.assert_allclose(dp / MPA, [0.03, 0.44, 1.76], atol=0.005)
@@ -62,14 +62,14 @@ def test_paper_channel_drop_for_oil_is_0_03_0_44_1_76_mpa():
 
 
 def test_paper_clearance_is_5_865_um_unloaded_and_5_140_um_at_25_mpa():
-    from satmotor_ros.model.losses import clearance_height
+    from satmotor_ros.model.families.sliwinski2017.losses import clearance_height
     oil = MotorModel.default('oil')
     h = clearance_height(np.array([0.0, 25 * MPA]), oil.derived.h0, oil.derived.compliance)
     np.testing.assert_allclose(h * 1e6, [5.865, 5.140], atol=5e-4)
 
 
 def test_paper_eq39_is_nearly_independent_of_pressure():
-    from satmotor_ros.model.losses import displacement_change_empirical
+    from satmotor_ros.model.families.sliwinski2017.losses import displacement_change_empirical
     oil = MotorModel.default('oil')
     dq = displacement_change_empirical(np.array([2, 25]) * MPA, 1000 * RPM, oil.coef.c1_39,
                                        oil.coef.c2_39)
@@ -117,9 +117,9 @@ def test_model_matches_reference_speed_ratio_water_over_oil():
 
 
 def test_clearance_and_displacement_change_match_the_reference_grid(liquid):
-    from satmotor_ros.model.losses import (clearance_height, displacement_change,
-                                           displacement_change_empirical, EMPIRICAL_DP_FLOOR,
-                                           inertia_coefficient, pressure_speed_coefficient)
+    from satmotor_ros.model.families.sliwinski2017.losses import (
+        clearance_height, displacement_change, displacement_change_empirical, EMPIRICAL_DP_FLOOR,
+        inertia_coefficient, pressure_speed_coefficient)
     model = MotorModel.default(liquid)
     rows = [r for r in _grid(liquid) if r['case'] == 'n_const']
     n = np.array([float(r['n_rpm']) for r in rows]) * RPM

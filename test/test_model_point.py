@@ -8,7 +8,7 @@ import pytest
 
 from satmotor_ros.model import (COMPONENTS, InvalidInputError, ModelError, MotorModel, Point,
                                 PointStatus)
-from satmotor_ros.model import losses as eq, speed as sp
+from satmotor_ros.model.families.sliwinski2017 import losses as eq, speed as sp
 from satmotor_ros.model.units import LPM, MPA, RPM
 
 MODELS = {(liquid, law): MotorModel.default(liquid, law)

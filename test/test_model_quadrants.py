@@ -7,10 +7,10 @@ from hypothesis import given, settings, strategies as st
 import numpy as np
 import pytest
 
-from satmotor_ros.model import (InvalidInputError, load_motor, MotorModel, PointStatus)
+from satmotor_ros.model import InvalidInputError, load_motor, MotorModel, PointStatus
 from satmotor_ros.model.effects import effect_from_mapping
-from satmotor_ros.model.forward import absorbency_map
-from satmotor_ros.model.inverse import speed_map
+from satmotor_ros.model.engine.forward import absorbency_map
+from satmotor_ros.model.engine.inverse import speed_map
 from satmotor_ros.model.units import LPM, MPA, RPM
 
 SPEC = load_motor()

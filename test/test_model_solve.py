@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from satmotor_ros.model import MotorModel, PointStatus
-from satmotor_ros.model.solve import solve_increasing, solve_increasing_scalar, Tolerance
+from satmotor_ros.model.engine.solve import solve_increasing, solve_increasing_scalar, Tolerance
 from satmotor_ros.model.units import LPM, MPA, RPM
 
 NO_ROOT, NOT_CONVERGED = int(PointStatus.NO_ROOT), int(PointStatus.NOT_CONVERGED)

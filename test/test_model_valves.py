@@ -5,7 +5,7 @@ import copy
 
 import pytest
 from satmotor_ros.model import INVALID, MotorModel, PointStatus
-from satmotor_ros.model.config import default_config_path, motor_from_mapping
+from satmotor_ros.model.io.config import default_config_path, motor_from_mapping
 from satmotor_ros.model.units import MPA, RPM
 import yaml
 

@@ -6,7 +6,7 @@ import math
 from node_harness import unique_namespace
 import pytest
 from rclpy.parameter import Parameter
-from satmotor_ros.model.config import default_config_path
+from satmotor_ros.model.io.config import default_config_path
 from satmotor_ros.model.units import LPM, MPA
 from satmotor_ros.nodes.motor_model import MotorModelNode
 from std_msgs.msg import Float64

@@ -23,6 +23,8 @@ from std_msgs.msg import Float64
 from test_package_build import (_copy_source, _executable_path, _find_tool,
                                 _sourced_environment, BUILD_TIMEOUT, PACKAGE)
 
+pytestmark = pytest.mark.slow  # each test starts the node as its own process
+
 OIL, WATER = MotorModel.default('oil'), MotorModel.default('water')
 FLOW, P_IN, P_OUT = 20 * LPM, 20 * MPA, 0.2 * MPA
 

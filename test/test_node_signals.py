@@ -10,6 +10,8 @@ import time
 from node_harness import unique_namespace
 import pytest
 
+pytestmark = [pytest.mark.ros, pytest.mark.slow]
+
 QUIET = {0, 130, -signal.SIGTERM}
 """Quiet ends: done, interrupted during the imports, killed by SIGTERM before rclpy's handler."""
 

@@ -37,6 +37,8 @@ from rosbags.rosbag2 import CompressionFormat, CompressionMode, StoragePlugin, W
 from rosbags.typesys import get_typestore, Stores
 from satmotor_ros.cli import main
 
+pytestmark = pytest.mark.slow
+
 PACKAGE = 'satmotor_ros'
 REPO_ROOT = Path(__file__).resolve().parent.parent
 BUILD_TIMEOUT = 180.0  # a clean build takes a few seconds, [s]
@@ -532,6 +534,7 @@ def test_clean_venv_has_the_wheel_and_no_ros(clean_venv, tmp_path):
 
 
 @pytest.mark.parametrize('argv', [['motor_model'], ['virtual_motor'], ['speed_controller'],
+                                  ['motor_monitor'],
                                   ['satmotor', 'demo', '--quiet', '--out', 'demo']])
 def test_wheel_alone_says_in_one_line_that_a_node_needs_ros(clean_venv, tmp_path, argv):
     """Issue 21: a node or the demo without ROS 2 is one line naming what to install."""

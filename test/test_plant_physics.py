@@ -101,6 +101,7 @@ def test_relief_valve_holds_the_inlet_of_a_blocked_shaft(liquid):
     assert 0.0 < f.motor < 0.1 * flow  # what leaks through the standing motor
 
 
+@pytest.mark.slow
 def test_a_million_steps_of_water_with_a_blocked_shaft_stay_finite_and_bounded():
     """10^6 default steps, water, locked shaft, full flow on and off: no NaN, valve holds."""
     params = PlantParams(shaft=ShaftParams(locked=True))

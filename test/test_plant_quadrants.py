@@ -6,7 +6,8 @@ import math
 import pytest
 
 from satmotor_ros.model import MotorModel
-from satmotor_ros.model.effects import Effect, with_effects
+from satmotor_ros.model.effects import Effect
+from satmotor_ros.model.motor import with_effects
 from satmotor_ros.model.units import LPM, MPA
 from satmotor_ros.plant import ConstantLoad, Plant, PlantParams, ShaftParams
 from test_plant_physics import _settle

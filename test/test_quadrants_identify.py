@@ -116,6 +116,7 @@ def test_reverse_loss_in_the_array_maps_equals_the_points():
         assert not op.status[i] & PointStatus.NO_ROOT
 
 
+@pytest.mark.slow
 def test_a_bench_csv_with_port_pressures_and_signed_speed_calibrates(tmp_path):
     table = generate(FOUR, Injection('reverse_loss', 0.6 * LPM), seed=6)
     columns = to_columns(table)

@@ -50,6 +50,7 @@ def test_motor_model_predicts_signed_speed_and_losses(harness, flow, p_in, p_out
         node.destroy_node()
 
 
+@pytest.mark.ros
 def test_virtual_motor_runs_backwards_on_a_negative_command():
     namespace = f'/vm_quadrants_{os.getpid()}'
     context = rclpy.context.Context()

@@ -44,6 +44,7 @@ def _png_size(path):
     return width, height
 
 
+@pytest.mark.slow
 def test_residual_grid_is_capped_and_the_report_says_so(tmp_path, monkeypatch):
     table = generate(Plan(liquid='oil'), Injection.realistic('external_leakage', 1, 'oil'),
                      seed=3)

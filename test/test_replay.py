@@ -5,9 +5,9 @@ import csv
 
 import numpy as np
 import pytest
-from satmotor_ros.bags import (encode_many, FLOAT64, FLUID_PRESSURE, JOINT_STATE, OutTopic,
-                               read_series, write_bag)
+from satmotor_ros.bags import encode_many, OutTopic, read_series, write_bag
 from satmotor_ros.cli.main import main
+from satmotor_ros.interface import FLOAT64, FLUID_PRESSURE, JOINT_STATE
 from satmotor_ros.model import MotorModel
 from satmotor_ros.model.units import LPM, MPA, RPM
 from vendored_data import foreign_bag, FOREIGN_BAGS

@@ -6,8 +6,9 @@ import csv
 from node_harness import unique_namespace
 import numpy as np
 from rclpy.qos import qos_profile_sensor_data
-from satmotor_ros.bags import FLOAT64, FLUID_PRESSURE, JOINT_STATE, OutTopic, write_bag
+from satmotor_ros.bags import OutTopic, write_bag
 from satmotor_ros.cli.main import main
+from satmotor_ros.interface import FLOAT64, FLUID_PRESSURE, JOINT_STATE
 from satmotor_ros.interface import LOSS_COMPONENTS as COMPONENTS
 from satmotor_ros.model.units import LPM, MPA
 from satmotor_ros.nodes.motor_model import MotorModelNode

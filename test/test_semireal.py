@@ -243,6 +243,7 @@ EFFECTS = [('steady', BIAS, ('external_leakage',), -1), ('steady', STEPPED, ('fl
 VALVES = [('steady', STEPPED, -1), ('real', STEPPED, -1)]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(('noise', 'name'), CLEAN)
 def test_a_clean_case_names_no_effect(work, noise, name):
     _, result = _calibrated(work, noise, name, (), 11)
@@ -250,6 +251,7 @@ def test_a_clean_case_names_no_effect(work, noise, name):
     assert abs(_lags(result)[1]) < 0.03  # no flow lag beyond the speed's
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(('noise', 'name', 'kinds', 'direction'), EFFECTS)
 def test_the_loop_names_each_injected_effect_and_nothing_else(work, noise, name, kinds,
                                                               direction):
@@ -261,6 +263,7 @@ def test_the_loop_names_each_injected_effect_and_nothing_else(work, noise, name,
     assert stray == [], f'{kinds} named as {_names(result)}'
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(('noise', 'name', 'direction'), VALVES)
 def test_a_named_valve_has_the_injected_crack_pressure_and_side(work, noise, name, direction):
     case, result = _calibrated(work, noise, name, ('relief',), 21, direction)

@@ -6,6 +6,8 @@ import rclpy
 from rclpy.context import Context
 from satmotor_ros.nodes import _spin
 
+pytestmark = pytest.mark.ros
+
 
 def _spin_raising(message, capsys):
     context = Context()

@@ -18,8 +18,8 @@ from satmotor_ros.identify.pipeline import Options
 from satmotor_ros.identify.synthetic import (generate, generate_transient, Injection, Plan,
                                              REALISTIC_DYNAMICS)
 from satmotor_ros.identify.validate import calibrated_dynamics
-from satmotor_ros.interface import MotorOptions
 from satmotor_ros.model.units import LPM, MPA, RPM
+from satmotor_ros.options import MotorOptions
 
 ERROR_FIELDS = {'rmse_lpm', 'mean_abs_pct', 'max_abs_lpm'}
 
@@ -120,6 +120,7 @@ def test_the_residual_is_measured_minus_predicted_on_the_rows_as_read(tmp_path, 
     assert high['error']['max_abs_lpm'] > 0.9
 
 
+@pytest.mark.slow
 def test_a_recording_is_read_as_calibrate_reads_it(tmp_path, capsys):
     from satmotor_ros.identify.synthetic import generate_series, write_bag_of
     series = generate_series(Plan(liquid='oil'), Injection(), seed=2, samples=6000)

@@ -6,10 +6,8 @@ import os
 import time
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+from node_harness import spin_until
 import pytest
-import rclpy
-from rclpy.context import Context
-from rclpy.executors import SingleThreadedExecutor
 from rclpy.parameter import Parameter
 from rclpy.qos import qos_profile_sensor_data
 from rosgraph_msgs.msg import Clock
@@ -23,34 +21,11 @@ from std_msgs.msg import Float64
 NAMESPACE = f'/vm_node_test_{os.getpid()}'
 
 
-@pytest.fixture()
-def ros():
-    """Give a fresh context, an executor on it, and a probe node; shut all down after."""
-    context = Context()
-    context.init()
-    executor = SingleThreadedExecutor(context=context)
-    probe = rclpy.create_node('probe', namespace=NAMESPACE, context=context)
-    executor.add_node(probe)
-    try:
-        yield context, executor, probe
-    finally:
-        executor.shutdown()
-        probe.destroy_node()
-        context.try_shutdown()
-
-
 def _motor(context, executor, **overrides):
     params = [Parameter(k, value=v) for k, v in {'clock_mode': 'sim', **overrides}.items()]
     node = VirtualMotorNode(context=context, namespace=NAMESPACE, parameter_overrides=params)
     executor.add_node(node)
     return node
-
-
-def _spin_until(executor, done, timeout=10.0):
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline and not done():
-        executor.spin_once(timeout_sec=0.01)
-    return done()
 
 
 def _collect(probe, kind, topic, qos=qos_profile_sensor_data):
@@ -75,7 +50,7 @@ def test_commanded_flow_turns_the_shaft_at_the_models_speed(ros):
     def settled():
         command.publish(Float64(data=15.0 * LPM))
         return node.plant.state.time > 3.0 and len(joints) > 10 and len(outlet) > 10
-    assert _spin_until(executor, settled)
+    assert spin_until(executor, settled)
     assert all(len(x) > 10 for x in (inlet, case, flow, temperature, clock))
     speed = joints[-1].velocity[0]
     assert joints[-1].name == ['motor_shaft']
@@ -96,20 +71,20 @@ def test_bad_commands_are_refused_held_and_reported(ros):
     command = probe.create_publisher(Float64, 'flow_command', 10)
     load = probe.create_publisher(Float64, 'load_torque', 10)
     diagnostics = _collect(probe, DiagnosticArray, '/diagnostics', 10)
-    assert _spin_until(executor, lambda: (command.publish(Float64(data=10.0 * LPM)),
-                                          node.plant.state.time > 0.5)[1])
+    assert spin_until(executor, lambda: (command.publish(Float64(data=10.0 * LPM)),
+                                         node.plant.state.time > 0.5)[1])
     for bad in (math.nan, -1.0, 1.0, math.inf):
         command.publish(Float64(data=bad))
-    assert _spin_until(executor, lambda: node.rejected >= 4)
+    assert spin_until(executor, lambda: node.rejected >= 4)
     load.publish(Float64(data=math.nan))
-    assert _spin_until(executor, lambda: node.rejected >= 5)
+    assert spin_until(executor, lambda: node.rejected >= 5)
     assert 'load torque nan' in node.last_rejection
-    assert _spin_until(executor, lambda: any(
+    assert spin_until(executor, lambda: any(
         s.level == DiagnosticStatus.WARN and 'refused' in s.message
         for d in diagnostics for s in d.status))
     assert node._command == pytest.approx(10.0 * LPM)
     before = node.plant.state.time
-    assert _spin_until(executor, lambda: node.plant.state.time > before + 0.5)
+    assert spin_until(executor, lambda: node.plant.state.time > before + 0.5)
     assert node.plant.state.speed > 0.0
 
 
@@ -169,7 +144,7 @@ def test_wall_clock_mode_keeps_pace_with_the_wall_clock(ros):
     executor.add_node(node)
     clock = _collect(probe, Clock, '/clock', qos_profile_sensor_data)
     start = time.monotonic()
-    _spin_until(executor, lambda: time.monotonic() - start > 1.5, timeout=3.0)
+    spin_until(executor, lambda: time.monotonic() - start > 1.5, timeout=3.0)
     elapsed = time.monotonic() - start
     assert node.plant.state.time == pytest.approx(elapsed, abs=0.3)
     assert not clock
@@ -184,7 +159,7 @@ def test_every_message_carries_its_own_tick(ros):
     joints = _collect(probe, JointState, 'joint_states')
     inlet = _collect(probe, FluidPressure, 'inlet_pressure')
     clock = _collect(probe, Clock, '/clock', 10)
-    assert _spin_until(executor, lambda: len(joints) > 20 and len(inlet) > 20 and len(clock) > 20)
+    assert spin_until(executor, lambda: len(joints) > 20 and len(inlet) > 20 and len(clock) > 20)
 
     def seconds(stamp):
         return stamp.sec + 1e-9 * stamp.nanosec
@@ -201,7 +176,7 @@ def test_every_message_carries_its_own_tick(ros):
                          Parameter('frame_id', value='rig_2'),
                          Parameter('sensors.inlet_pressure.noise', value=2.0e4)])
     count, pressures = len(joints), len(inlet)
-    assert _spin_until(executor, lambda: len(joints) > count + 2 and len(inlet) > pressures + 2)
+    assert spin_until(executor, lambda: len(joints) > count + 2 and len(inlet) > pressures + 2)
     assert joints[-1].name == ['shaft_2'] and joints[-1].header.frame_id == 'rig_2'
     assert inlet[-1].header.frame_id == 'rig_2' and inlet[-1].variance == 4.0e8
 
@@ -214,14 +189,14 @@ def test_clock_mode_and_max_speedup_switch_at_run_time(ros):
 
     def pace(seconds):
         sim0, wall0 = node.plant.state.time, time.monotonic()
-        _spin_until(executor, lambda: time.monotonic() - wall0 > seconds, timeout=seconds + 1)
+        spin_until(executor, lambda: time.monotonic() - wall0 > seconds, timeout=seconds + 1)
         return (node.plant.state.time - sim0) / (time.monotonic() - wall0)
     assert pace(0.5) > 3.0  # as fast as possible is far faster than the wall clock
     assert node.set_parameters([Parameter('clock_mode', value='wall')])[0].successful
-    _spin_until(executor, lambda: False, timeout=0.05)
+    spin_until(executor, lambda: False, timeout=0.05)
     published = len(clock)
     assert pace(1.0) == pytest.approx(1.0, abs=0.2)
-    _spin_until(executor, lambda: False, timeout=0.1)
+    spin_until(executor, lambda: False, timeout=0.1)
     assert len(clock) == published  # no /clock on the wall clock
     assert node.set_parameters([Parameter('clock_mode', value='sim'),
                                 Parameter('max_speedup', value=2.0)])[0].successful
@@ -239,34 +214,34 @@ def test_lockstep_takes_one_period_per_flow_command(ros):
     clock = _collect(probe, Clock, '/clock', 10)
     diagnostics = _collect(probe, DiagnosticArray, '/diagnostics', 10)
     command = probe.create_publisher(Float64, f'{NAMESPACE}/flow_command', 10)
-    _spin_until(executor, lambda: command.get_subscription_count() > 0)
-    _spin_until(executor, lambda: False, timeout=0.3)
+    spin_until(executor, lambda: command.get_subscription_count() > 0)
+    spin_until(executor, lambda: False, timeout=0.3)
     assert node.plant.state.time == 0.0 and not clock  # paused: no step, nothing published
     assert node.set_parameters([Parameter('paused', value=False)])[0].successful
     # the start and the first period go out at once; then each period waits for its answer
-    assert _spin_until(executor, lambda: len(clock) == 2)
+    assert spin_until(executor, lambda: len(clock) == 2)
     for answered in range(1, 51):
         command.publish(Float64(data=10.0 * LPM))
-        assert _spin_until(executor, lambda: len(clock) == answered + 2)
+        assert spin_until(executor, lambda: len(clock) == answered + 2)
     assert node.plant.state.time == pytest.approx(0.51, abs=1e-12)
     for wait in (0.31, 0.3, 0.31, 0.3):  # a restart takes no period and publishes nothing
         assert node.set_parameters([Parameter('paused', value=True)])[0].successful
         assert node.set_parameters([Parameter('paused', value=False),
                                     Parameter('lockstep_wait', value=wait)])[0].successful
-    _spin_until(executor, lambda: False, timeout=0.1)
+    spin_until(executor, lambda: False, timeout=0.1)
     assert len(clock) == 52 and node.plant.state.time == pytest.approx(0.51, abs=1e-12)
     command.publish(Float64(data=10.0 * LPM))
-    assert _spin_until(executor, lambda: len(clock) == 53)
+    assert spin_until(executor, lambda: len(clock) == 53)
     stamps = [c.clock.sec * 1_000_000_000 + c.clock.nanosec for c in clock]
     assert stamps == [10_000_000 * k for k in range(53)]  # whole periods, none twice
     assert node.unanswered_steps == 0
     assert node.plant.state.speed > 0.0
     wall0 = time.monotonic()  # no answer: each period is taken after lockstep_wait
-    assert _spin_until(executor, lambda: len(clock) == 55, timeout=5.0)
+    assert spin_until(executor, lambda: len(clock) == 55, timeout=5.0)
     assert time.monotonic() - wall0 >= 0.55
     assert node.unanswered_steps == 2
-    assert _spin_until(executor, lambda: any('lockstep' in st.message for d in diagnostics
-                                             for st in d.status))
+    assert spin_until(executor, lambda: any('lockstep' in st.message for d in diagnostics
+                                            for st in d.status))
     warned = [st.message for d in diagnostics for st in d.status
               if st.level == DiagnosticStatus.WARN]
     assert '1 lockstep period(s) taken with no flow_command within lockstep_wait' in warned
@@ -276,5 +251,5 @@ def test_lockstep_takes_one_period_per_flow_command(ros):
                                                        for d in answered_time for st in d.status
                                                        if st.level != DiagnosticStatus.OK]
     assert node.set_parameters([Parameter('paused', value=True)])[0].successful
-    _spin_until(executor, lambda: False, timeout=0.7)
+    spin_until(executor, lambda: False, timeout=0.7)
     assert len(clock) == 55 and node.plant.state.time == pytest.approx(0.54, abs=1e-12)

@@ -9,19 +9,18 @@ pressures, speed and /clock out, bad commands survived, clean exit on SIGINT.
 
 import math
 import os
-import time
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+from node_harness import spin_until
 import pytest
-import rclpy
-from rclpy.context import Context
-from rclpy.executors import SingleThreadedExecutor
 from rclpy.qos import qos_profile_sensor_data
 from rosgraph_msgs.msg import Clock
 from satmotor_ros.model.units import LPM, MPA
 from sensor_msgs.msg import FluidPressure, JointState
 from std_msgs.msg import Float64
 import test_package_build as build
+
+pytestmark = [pytest.mark.ros, pytest.mark.slow]
 
 colcon_build = build.colcon_build  # the module-scoped build, as a fixture of this module
 sourced_install = build.sourced_install
@@ -36,29 +35,6 @@ def _start(env, cwd, name, *ros_args):
 _stop = build.stop_process
 
 
-@pytest.fixture()
-def probe():
-    """Give a context, executor and probe node in the test's namespace; shut down after."""
-    context = Context()
-    context.init()
-    executor = SingleThreadedExecutor(context=context)
-    node = rclpy.create_node('probe', namespace=NAMESPACE, context=context)
-    executor.add_node(node)
-    try:
-        yield executor, node
-    finally:
-        executor.shutdown()
-        node.destroy_node()
-        context.try_shutdown()
-
-
-def _spin_until(executor, done, timeout=20.0):
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline and not done():
-        executor.spin_once(timeout_sec=0.02)
-    return done()
-
-
 def _settled(joints, window=0.5, rel=0.01):
     """Tell whether the speed moved by less than `rel` over the last `window` s of stamps."""
     if not joints:
@@ -71,9 +47,9 @@ def _settled(joints, window=0.5, rel=0.01):
 
 
 def test_installed_virtual_motor_runs_on_sim_time_and_survives_bad_commands(
-        sourced_install, tmp_path, probe):
+        sourced_install, tmp_path, ros):
     """Command in, pressures and speed out, /clock advancing; NaN and -1 refused; SIGINT: 0."""
-    executor, node = probe
+    _, executor, node = ros
     clock, joints, inlet, diagnostics = [], [], [], []
     node.create_subscription(Clock, '/clock', clock.append, qos_profile_sensor_data)
     node.create_subscription(JointState, 'joint_states', joints.append, qos_profile_sensor_data)
@@ -88,22 +64,22 @@ def test_installed_virtual_motor_runs_on_sim_time_and_survives_bad_commands(
         def turning():
             command.publish(Float64(data=10.0 * LPM))
             return bool(joints) and joints[-1].velocity[0] > 10.0
-        assert _spin_until(executor, turning), 'no speed on joint_states'
-        assert _spin_until(executor, lambda: inlet[-1].fluid_pressure > 1.0 * MPA)
-        assert _spin_until(executor, lambda: len(clock) > 5)
+        assert spin_until(executor, turning), 'no speed on joint_states'
+        assert spin_until(executor, lambda: inlet[-1].fluid_pressure > 1.0 * MPA)
+        assert spin_until(executor, lambda: len(clock) > 5)
         sim_time = [c.clock.sec + 1e-9 * c.clock.nanosec for c in clock]
         assert sim_time == sorted(sim_time)
-        assert _spin_until(executor, lambda: (command.publish(Float64(data=10.0 * LPM)),
-                                              _settled(joints))[1]), 'speed never settled'
+        assert spin_until(executor, lambda: (command.publish(Float64(data=10.0 * LPM)),
+                                             _settled(joints))[1]), 'speed never settled'
 
         for bad in (math.nan, -1.0):
             command.publish(Float64(data=bad))
-        assert _spin_until(executor, lambda: any(
+        assert spin_until(executor, lambda: any(
             s.level == DiagnosticStatus.WARN and 'refused' in s.message
             for d in diagnostics for s in d.status)), 'bad commands not reported'
         speed = joints[-1].velocity[0]
         count = len(clock)
-        assert _spin_until(executor, lambda: len(clock) > count + 20)
+        assert spin_until(executor, lambda: len(clock) > count + 20)
         assert process.poll() is None, 'the node died on a bad command'
         assert joints[-1].velocity[0] == pytest.approx(speed, rel=0.05)  # command held
     finally:

@@ -38,7 +38,7 @@ def _console_scripts():
 
 
 SCRIPTS = _console_scripts()
-NEED_ROS = {'motor_model': [], 'virtual_motor': [], 'speed_controller': [],
+NEED_ROS = {'motor_model': [], 'virtual_motor': [], 'speed_controller': [], 'motor_monitor': [],
             'satmotor': ['demo', '--quiet', '--no-loop', '--duration', '2']}
 """Every script that needs ROS, with the arguments that make it need it."""
 

@@ -19,8 +19,7 @@ Example::
     t = series['inlet_pressure'].t_ns  # log time [ns]
 """
 
-from satmotor_ros.bags.decode import decode, FIELDS, FLOAT64, FLUID_PRESSURE, JOINT_STATE, \
-    pack_payloads, TEMPERATURE
+from satmotor_ros.bags.decode import decode, FIELDS, pack_payloads
 from satmotor_ros.bags.encode import encode_many, encode_message
 from satmotor_ros.bags.errors import BagError
 from satmotor_ros.bags.series import (describe_topics, list_topics, match_topics,
@@ -29,8 +28,7 @@ from satmotor_ros.bags.storage import open_bag, TopicInfo
 from satmotor_ros.bags.writer import OutTopic, write_bag
 
 __all__ = [
-    'BagError', 'FIELDS', 'FLOAT64', 'FLUID_PRESSURE', 'JOINT_STATE', 'OutTopic', 'Series',
-    'TEMPERATURE', 'TopicInfo', 'decode',
+    'BagError', 'FIELDS', 'OutTopic', 'Series', 'TopicInfo', 'decode',
     'describe_topics', 'encode_many', 'encode_message', 'list_topics', 'match_topics',
     'missing_topics', 'open_bag', 'pack_payloads', 'parse_topic_map', 'read_series',
     'write_bag',

@@ -22,11 +22,7 @@ import numpy as np
 import numpy.typing as npt
 
 from satmotor_ros.bags.errors import BagError
-
-FLOAT64 = 'std_msgs/msg/Float64'
-FLUID_PRESSURE = 'sensor_msgs/msg/FluidPressure'
-TEMPERATURE = 'sensor_msgs/msg/Temperature'
-JOINT_STATE = 'sensor_msgs/msg/JointState'
+from satmotor_ros.interface import FLOAT64, FLUID_PRESSURE, JOINT_STATE, TEMPERATURE
 
 FIELDS = {
     FLOAT64: ('data',),

@@ -9,9 +9,9 @@ import struct
 import numpy as np
 import numpy.typing as npt
 
-from satmotor_ros.bags.decode import (FIELDS, FLOAT64, FLUID_PRESSURE, JOINT_STATE,
-                                      parse_layout, TEMPERATURE)
+from satmotor_ros.bags.decode import FIELDS, parse_layout
 from satmotor_ros.bags.errors import BagError
+from satmotor_ros.interface import FLOAT64, FLUID_PRESSURE, JOINT_STATE, TEMPERATURE
 
 
 class _Writer:
@@ -136,4 +136,6 @@ def encode_many(msgtype: str, fields: Mapping[str, npt.ArrayLike],
 
 
 def _column(flat: np.ndarray, dtype: str, offset: int, stride: int, n: int) -> np.ndarray:
-    return np.ndarray((n,), dtype=dtype, buffer=flat, offset=offset, strides=(stride,))
+    view: np.ndarray = np.ndarray((n,), dtype=dtype, buffer=flat, offset=offset,
+                                  strides=(stride,))  # numpy types this constructor as Any
+    return view

@@ -5,16 +5,20 @@ from __future__ import annotations
 
 import argparse
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 import sys
 from typing import Any
 
 from satmotor_ros.cli._common import CliError, fail
+from satmotor_ros.cli._liquid import Liquid, settle_liquid
+from satmotor_ros.cli._output import check_target, written_by
 from satmotor_ros.identify import BenchTable, DataError, IdentificationError, read_csv
 from satmotor_ros.identify.columns import load_mapping, read_log
 from satmotor_ros.identify.table import BAD_CELLS, IMPOSSIBLE, negative_losses
 from satmotor_ros.identify.textfile import SANITY
 from satmotor_ros.model import ModelError
+from satmotor_ros.options import MotorOptions
 
 
 def add_data_arguments(parser: argparse.ArgumentParser,
@@ -46,6 +50,37 @@ def add_data_arguments(parser: argparse.ArgumentParser,
                         help='read a log with its own column names and units through a column '
                              'mapping: a YAML file or a packaged name such as mbari_pto '
                              '(doc/columns.md)')
+
+
+def open_bench(command: str, data: str, out: str, options: MotorOptions, columns: str,
+               force: bool, table: BenchTable | None) -> tuple[list[str], Liquid, BenchTable]:
+    """
+    Refuse an ``--out`` that may not be replaced, settle the liquid and load the data.
+
+    Parameters
+    ----------
+    command : str
+        The subcommand, [-]
+    data, out, options, columns, force
+        As the subcommand's ``command`` takes them, [-]
+    table : BenchTable or None
+        `data` already loaded by :func:`load_data`; read here when None, [-]
+
+    Returns
+    -------
+    tuple
+        (the inputs, never replaced; the liquid settled, :func:`settle_liquid`; the table,
+        whose notes say where the liquid came from).
+
+    """
+    inputs = [name for name in (data, options.motor_file, columns) if name]
+    check_target('--out', Path(out), inputs, force, written_by(command), command)
+    settled = settle_liquid(options, data, command)
+    if table is None:
+        table = load_data(data, columns, settled.options.spec().geometry.displacement)
+    table = replace(table, notes=table.notes + (f'liquid: {settled.source}',)
+                    + ((f'WARNING: {settled.warning}',) if settled.warning else ()))
+    return inputs, settled, table
 
 
 def load_data(data: str, columns: str = '', displacement: float | None = None) -> BenchTable:

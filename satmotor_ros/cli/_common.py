@@ -4,20 +4,56 @@
 from __future__ import annotations
 
 import argparse
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 import math
 import sys
 from types import ModuleType
-from typing import Any
+from typing import Any, TypeVar
 
-from satmotor_ros.interface import DISPLACEMENT_LAWS, MotorOptions, OptionError
 from satmotor_ros.model.errors import UnitError
 from satmotor_ros.model.families import FAMILIES
 from satmotor_ros.model.units import parse_quantity
+from satmotor_ros.options import DISPLACEMENT_LAWS, MotorOptions, OptionError
 
 
 class CliError(Exception):
     """A user-facing error: printed as one line, exit code 1."""
+
+
+Number = TypeVar('Number', int, float)
+
+
+def number_option(kind: Callable[[str], Number], acceptable: Callable[[Number], bool],
+                  need: str) -> Callable[[str], Number]:
+    """
+    Make the argparse ``type`` of a numeric option: a usage error names the text and the need.
+
+    Parameters
+    ----------
+    kind : {int, float}
+        What the text must be, [-]
+    acceptable : callable
+        Whether a value is in range, [-]
+    need : str
+        What an out-of-range value is told, e.g. ``'must be at least 2'``, [-]
+
+    Returns
+    -------
+    callable
+        Text -> value, raising :class:`argparse.ArgumentTypeError`.
+
+    """
+    what = 'a whole number' if kind is int else 'a number'
+
+    def read(text: str) -> Number:
+        try:
+            value = kind(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f'{text!r}: not {what}') from None
+        if not acceptable(value):
+            raise argparse.ArgumentTypeError(f'{text!r}: {need}')
+        return value
+    return read
 
 
 MOTOR_FLAGS = {'liquid': '--liquid', 'motor_file': '--motor', 'family': '--family',
@@ -33,7 +69,7 @@ _PREFIX = 'motor_options.'  # the argparse dest of a motor option: prefix + fiel
 
 
 def add_subcommand(sub: argparse._SubParsersAction[argparse.ArgumentParser], name: str,
-                   module: ModuleType, examples: Sequence[str] = ()) -> None:
+                   module: ModuleType, short: str, examples: Sequence[str] = ()) -> None:
     """
     Add the subcommand a module defines; its parsed options go to ``command`` as keywords.
 
@@ -44,14 +80,16 @@ def add_subcommand(sub: argparse._SubParsersAction[argparse.ArgumentParser], nam
     name : str
         The subcommand, [-]
     module : module
-        Defines ``HELP`` and ``DESCRIPTION`` (short and long help), ``add_arguments(parser)``
-        and ``command`` (runs it and returns the exit code), [-]
+        Defines ``DESCRIPTION`` (its long help), ``add_arguments(parser)`` and ``command``
+        (runs it and returns the exit code), [-]
+    short : str
+        Its line in ``satmotor --help``, [-]
     examples : sequence of str
         Command lines shown under "examples:" at the end of its ``--help``, [-]
 
     """
     epilog = 'examples:\n' + '\n'.join(f'  {line}' for line in examples) if examples else None
-    parser = sub.add_parser(name, help=module.HELP, description=module.DESCRIPTION,
+    parser = sub.add_parser(name, help=short, description=module.DESCRIPTION,
                             epilog=epilog, formatter_class=_ExamplesFormatter)
     parser.set_defaults(command=module.command)
     module.add_arguments(parser)
@@ -156,6 +194,9 @@ def quantity(flag: str, text: str, kind: str, default_unit: str, *,
     """
     Parse a command-line quantity into SI, naming the flag on error.
 
+    Returns the value in SI; raises a :class:`CliError` naming `flag` if `text` cannot be
+    parsed or is negative (unless `signed`), NaN or infinite.
+
     Parameters
     ----------
     flag : str
@@ -170,16 +211,6 @@ def quantity(flag: str, text: str, kind: str, default_unit: str, *,
         Require a value > 0 rather than >= 0, [-]
     signed : bool
         Accept any finite value (a flow or drop of a four-quadrant point), [-]
-
-    Returns
-    -------
-    float
-        The value in SI.
-
-    Raises
-    ------
-    CliError
-        If `text` cannot be parsed or is negative, NaN or infinite.
 
     """
     try:

@@ -12,7 +12,7 @@ import numpy as np
 from satmotor_ros.bags import OutTopic, read_series, write_bag
 from satmotor_ros.identify.plot_tools import robust_limits
 from satmotor_ros.interface import (CHANNELS, LOSS_COMPONENTS, LOSSES_PREFIX,
-                                    PREDICTED_JOINT_STATE, VALUE_FIELD)
+                                    PREDICTED_JOINT_STATE, SPEED_SETPOINT, VALUE_FIELD)
 from satmotor_ros.model import MotorModel
 from satmotor_ros.model.units import LPM, RPM
 from satmotor_ros.plant.scenario import Cycle, step_metrics, StepMetrics
@@ -96,7 +96,8 @@ def _topic(name: str) -> str:
 _SPEED, _TORQUE, _FLOW, _P_IN, _P_OUT, _FLOW_MEASURED, _PREDICTED = (_topic(name) for name in (
     'measured_speed', 'torque', 'flow', 'p_in', 'p_out', 'flow_measured', PREDICTED_JOINT_STATE))
 _LOSSES = {c: _topic(LOSSES_PREFIX + c) for c in LOSS_COMPONENTS}
-_PLOTTED = (_SPEED, '/speed_setpoint', _TORQUE, _FLOW, _P_IN, _P_OUT, _FLOW_MEASURED, _PREDICTED,
+_SETPOINT = _topic(SPEED_SETPOINT)
+_PLOTTED = (_SPEED, _SETPOINT, _TORQUE, _FLOW, _P_IN, _P_OUT, _FLOW_MEASURED, _PREDICTED,
             *_LOSSES.values())
 
 
@@ -128,7 +129,7 @@ class Tracking:
         self.data = data = read_run(run.bag)
         empty = (np.zeros(0), np.zeros(0))
         self.t, self.speed = data[_SPEED]
-        t_sp, sp = data.get('/speed_setpoint', empty)
+        t_sp, sp = data.get(_SETPOINT, empty)
         keep = self.t >= (t_sp[0] if len(t_sp) else np.inf)
         self.t, self.speed = self.t[keep], self.speed[keep]
         self.setpoint = hold(t_sp, sp, self.t)

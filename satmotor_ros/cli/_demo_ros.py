@@ -21,8 +21,9 @@ from satmotor_ros.bags.custom import LIQUID_KEY, MOTOR_KEY
 from satmotor_ros.cli._common import CliError
 from satmotor_ros.cli._demo_report import RunResult, write_run_bag
 from satmotor_ros.cli._safe_signals import signals_at_safe_points
-from satmotor_ros.interface import (CHANNELS, CLOCK, DIAGNOSTIC_ARRAY, FLOAT64, MODEL_OUTPUTS,
-                                    TOPIC_TYPES)
+from satmotor_ros.interface import (CHANNELS, CLOCK, CLOCK_TOPIC, DIAGNOSTIC_ARRAY,
+                                    DIAGNOSTICS, FLOAT64, FLUID_PRESSURE, JOINT_STATE,
+                                    MODEL_OUTPUTS, SPEED_SETPOINT, TEMPERATURE, TOPIC_TYPES)
 from satmotor_ros.nodes.motor_model import MotorModelNode
 from satmotor_ros.nodes.speed_controller import SpeedControllerNode
 from satmotor_ros.nodes.virtual_motor import VirtualMotorNode
@@ -30,10 +31,8 @@ from satmotor_ros.plant.scenario import Cycle
 from sensor_msgs.msg import FluidPressure, JointState, Temperature
 from std_msgs.msg import Float64
 
-_TYPES = {'std_msgs/msg/Float64': Float64, 'sensor_msgs/msg/FluidPressure': FluidPressure,
-          'sensor_msgs/msg/JointState': JointState, 'sensor_msgs/msg/Temperature': Temperature,
-          'diagnostic_msgs/msg/DiagnosticArray': DiagnosticArray,
-          'rosgraph_msgs/msg/Clock': Clock}
+_TYPES = {FLOAT64: Float64, FLUID_PRESSURE: FluidPressure, JOINT_STATE: JointState,
+          TEMPERATURE: Temperature, DIAGNOSTIC_ARRAY: DiagnosticArray, CLOCK: Clock}
 
 CONTROL_RATE = 100.0
 """Rate of the controller and of the set-point script, [Hz]."""
@@ -48,8 +47,8 @@ _RELIABLE = {CHANNELS['flow'].topic, CHANNELS['torque'].topic,
              *(t for t in TOPIC_TYPES if t.startswith(MODEL_OUTPUTS))}
 RECORDED = (  # topic relative to the run's namespace, type, reliable publisher?
     *((topic, msgtype, topic in _RELIABLE) for topic, msgtype in TOPIC_TYPES.items()),
-    ('speed_setpoint', FLOAT64, True), ('/diagnostics', DIAGNOSTIC_ARRAY, True),
-    ('/clock', CLOCK, True),
+    (SPEED_SETPOINT, FLOAT64, True), (DIAGNOSTICS, DIAGNOSTIC_ARRAY, True),
+    (CLOCK_TOPIC, CLOCK, True),
 )
 """Every topic of a run, relative to its namespace (DESIGN.md names and types)."""
 
@@ -63,7 +62,7 @@ class Script(Node):
         self.cycle = cycle
         self._motor = motor
         self._case_offset: float | None = None
-        self._setpoint = self.create_publisher(Float64, 'speed_setpoint', 10)
+        self._setpoint = self.create_publisher(Float64, SPEED_SETPOINT, 10)
         self._load = self.create_publisher(Float64, CHANNELS['torque'].topic, 10)
         self.create_timer(1.0 / CONTROL_RATE, self._tick)
 
@@ -77,8 +76,7 @@ class Script(Node):
         self._load.publish(Float64(data=segment.load))
 
 
-_STAMPED = frozenset({'sensor_msgs/msg/FluidPressure', 'sensor_msgs/msg/JointState',
-                      'sensor_msgs/msg/Temperature', DIAGNOSTIC_ARRAY, CLOCK})
+_STAMPED = frozenset({FLUID_PRESSURE, JOINT_STATE, TEMPERATURE, DIAGNOSTIC_ARRAY, CLOCK})
 """Types whose serialised form starts with a time (a header's stamp or the clock)."""
 
 _TIME = struct.Struct('<iI')
@@ -100,7 +98,7 @@ def _leading_time(data: bytes) -> int:
 
     """
     sec, nanosec = _TIME.unpack_from(data, 4)
-    return sec * 1_000_000_000 + nanosec
+    return int(sec) * 1_000_000_000 + int(nanosec)
 
 
 class Recorder(Node):

@@ -147,4 +147,5 @@ def rows(fields: Sequence[npt.NDArray[np.uint8]]) -> bytes:
         parts.append(np.full((n, 1), ord(',') if k < len(fields) - 1 else ord('\n'),
                              dtype=np.uint8))
     block = np.concatenate(parts, axis=1).reshape(-1)
-    return block[block != 0].tobytes()
+    text: bytes = block[block != 0].tobytes()  # numpy types a masked array as Any
+    return text

@@ -18,8 +18,8 @@ from typing import NamedTuple
 
 from satmotor_ros.bags.custom import custom_data, LIQUID_KEY, MOTOR_KEY
 from satmotor_ros.cli._common import CliError
-from satmotor_ros.interface import MotorOptions
 from satmotor_ros.model import ModelError
+from satmotor_ros.options import MotorOptions
 
 
 class Liquid(NamedTuple):

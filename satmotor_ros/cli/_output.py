@@ -202,14 +202,36 @@ def _empty_dir(path: Path) -> bool:
     return path.is_dir() and not path.is_symlink() and next(path.iterdir(), None) is None
 
 
+def _files(directory: Path) -> list[str]:
+    """Return every file under `directory` but the marker, as sorted relative names."""
+    return sorted(p.relative_to(directory).as_posix() for p in directory.rglob('*')
+                  if not p.is_dir() and p.name != MARKER)
+
+
+def write_marker(directory: Path, command: str) -> None:
+    """Name `command` and every file it wrote in `directory`'s :data:`MARKER`."""
+    (directory / MARKER).write_text(
+        json.dumps({'command': command, 'files': _files(directory)}) + '\n', encoding='utf-8')
+
+
 def written_by(command: str) -> Callable[[Path], bool]:
-    """Return the check that a directory holds an earlier output of `command` (its marker)."""
+    """
+    Return the check that a directory is an earlier output of `command` and nothing more.
+
+    Its marker must name `command`, and the directory may hold only the files the marker
+    lists (some may be gone): a file a user put beside them makes it theirs. A marker
+    without a list (written before the list was kept) is taken at its word.
+    """
     def ours(path: Path) -> bool:
         try:
             marker = json.loads((path / MARKER).read_text(encoding='utf-8'))
         except (OSError, ValueError):
             return False
-        return isinstance(marker, dict) and marker.get('command') == command
+        if not (isinstance(marker, dict) and marker.get('command') == command):
+            return False
+        listed = marker.get('files')
+        return listed is None or (isinstance(listed, list)
+                                  and set(_files(path)) <= {str(f) for f in listed})
     return ours
 
 
@@ -295,6 +317,16 @@ def _tidy(target: Path) -> None:
               'put back', file=sys.stderr)
 
 
+def _prepare(option: str, out: str | Path, command: str, ours: Callable[[Path], bool],
+             inputs: Sequence[str | Path], force: bool) -> tuple[Path, Path]:
+    """Tidy beside `out`, refuse it if it may not be replaced; return it and its temporary."""
+    target = Path(out)
+    _tidy(target)
+    check_target(option, target, inputs, force, ours, command)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    return target, _temporary(target)
+
+
 def _block_interrupts() -> bool:
     """Hold SIGINT and SIGTERM while an output is being swapped (delivered right after)."""
     if threading.current_thread() is not threading.main_thread():
@@ -338,17 +370,12 @@ def output_dir(option: str, out: str | Path, command: str, inputs: Sequence[str 
         If `out` is an input or exists and may not be replaced.
 
     """
-    target = Path(out)
-    _tidy(target)
-    check_target(option, target, inputs, force, written_by(command), command)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    temporary = _temporary(target)
+    target, temporary = _prepare(option, out, command, written_by(command), inputs, force)
     shutil.rmtree(temporary, ignore_errors=True)
     temporary.mkdir()
     try:
         yield temporary
-        (temporary / MARKER).write_text(json.dumps({'command': command}) + '\n',
-                                        encoding='utf-8')
+        write_marker(temporary, command)
         _commit(temporary, target, option, command, force, written_by(command))
     except BaseException:
         shutil.rmtree(temporary, ignore_errors=True)
@@ -387,11 +414,7 @@ def output_file(option: str, out: str | Path, command: str, ours: Callable[[Path
         If `out` is an input or exists and may not be replaced.
 
     """
-    target = Path(out)
-    _tidy(target)
-    check_target(option, target, inputs, force, ours, command)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    temporary = _temporary(target)
+    target, temporary = _prepare(option, out, command, ours, inputs, force)
     try:
         yield temporary
         _commit(temporary, target, option, command, force, ours)
@@ -423,4 +446,4 @@ def png_metadata(command: str) -> dict[str, str]:
 
 
 __all__ = ['MARKER', 'check_target', 'clean_stale', 'output_dir', 'output_file', 'png_by',
-           'png_metadata', 'resolve', 'written_by']
+           'png_metadata', 'resolve', 'write_marker', 'written_by']

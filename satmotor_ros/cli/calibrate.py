@@ -4,24 +4,21 @@
 from __future__ import annotations
 
 import argparse
-from dataclasses import replace
 from pathlib import Path
 import sys
 from typing import Any
 
-from satmotor_ros.cli._bench import (add_data_arguments, load_data, run_bench_command,
+from satmotor_ros.cli._bench import (add_data_arguments, open_bench, run_bench_command,
                                      samples_left_out)
-from satmotor_ros.cli._common import add_motor_options
-from satmotor_ros.cli._liquid import settle_liquid
-from satmotor_ros.cli._output import check_target, output_dir, written_by
-from satmotor_ros.identify import calibrate, Options
+from satmotor_ros.cli._common import add_motor_options, number_option
+from satmotor_ros.cli._output import output_dir
+from satmotor_ros.identify import BenchTable, calibrate, Options
 from satmotor_ros.identify.output import write_json, write_yaml
 from satmotor_ros.identify.pipeline import AT_BOUND, IMPLAUSIBLE, Mode, MODES
 from satmotor_ros.identify.report import write_report
-from satmotor_ros.interface import MotorOptions
+from satmotor_ros.options import MotorOptions
 
 
-HELP = 'fit the model to bench data and find the effect it lacks'
 DESCRIPTION = ('Fit the loss model to a bench table (CSV with "name [unit]" headers: speed, '
                'flow, p_in, p_out or p_a, p_b, and any other channels), a log of its own '
                'layout read through --columns, or a rosbag2 recording, test candidate effects '
@@ -40,26 +37,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_motor_options(parser, liquid_from_data=True, model_options=False)
 
 
-def _alpha(text: str) -> float:
-    """Read ``--alpha``: a level strictly between 0 and 1."""
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f'{text!r}: not a number') from None
-    if not 0.0 < value < 1.0:
-        raise argparse.ArgumentTypeError(f'{text!r}: must be between 0 and 1')
-    return value
+_alpha = number_option(float, lambda value: 0.0 < value < 1.0, 'must be between 0 and 1')
+"""Read ``--alpha``: a level strictly between 0 and 1."""
 
-
-def _folds(text: str) -> int:
-    """Read ``--folds``: a whole number of at least 2."""
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f'{text!r}: not a whole number') from None
-    if value < 2:
-        raise argparse.ArgumentTypeError(f'{text!r}: must be at least 2')
-    return value
+_folds = number_option(int, lambda value: value >= 2, 'must be at least 2')
+"""Read ``--folds``: a whole number of at least 2."""
 
 
 def command(data: str, out: str, mode: Mode, alpha: float, folds: int,
@@ -88,21 +70,24 @@ def command(data: str, out: str, mode: Mode, alpha: float, folds: int,
         unusable data or options.
 
     """
-    return run_bench_command(out, lambda: _calibrate(data, out, mode, alpha, folds, options,
-                                                     columns, force))
+    return run_bench_command(out, lambda: calibrate_into(
+        data, out, mode, alpha, folds, options, columns, force))
 
 
-def _calibrate(data: str, out: str, mode: Mode, alpha: float, folds: int,
-               options: MotorOptions, columns: str, force: bool) -> str:
-    """Calibrate, write the outputs and return the summary line."""
-    inputs = [name for name in (data, options.motor_file, columns) if name]
-    check_target('--out', Path(out), inputs, force, written_by('calibrate'), 'calibrate')
-    settled = settle_liquid(options, data, 'calibrate')
+def calibrate_into(data: str, out: str, mode: Mode, alpha: float, folds: int,
+                   options: MotorOptions, columns: str, force: bool,
+                   table: BenchTable | None = None) -> str:
+    """
+    Calibrate, write the outputs and return the summary line ``command`` prints.
+
+    The arguments are those of :func:`command`, and `table`: `data` already loaded by
+    :func:`~satmotor_ros.cli._bench.load_data` (``satmotor fleet`` screens it first), or None
+    to read it here. The errors are those :func:`~satmotor_ros.cli._bench.run_bench_command`
+    reports (CliError, IdentificationError, ModelError, OSError).
+    """
+    inputs, settled, table = open_bench('calibrate', data, out, options, columns, force, table)
     options = settled.options
     spec = options.spec()
-    table = load_data(data, columns, spec.geometry.displacement)
-    table = replace(table, notes=table.notes + (f'liquid: {settled.source}',)
-                    + ((f'WARNING: {settled.warning}',) if settled.warning else ()))
     cal = calibrate(table, options.liquid, spec, Options(alpha=alpha, n_folds=folds, mode=mode,
                                                          compare_families=not options.family))
     warnings = cal.warnings().get('warnings', [])

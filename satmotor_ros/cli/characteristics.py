@@ -12,13 +12,14 @@ import numpy as np
 
 from satmotor_ros.cli._common import add_motor_options, CliError, fail
 from satmotor_ros.cli._output import output_dir
-from satmotor_ros.interface import MotorOptions
 from satmotor_ros.limits import CURVE_MAX_POINTS
 from satmotor_ros.model import ModelError, MotorModel
 from satmotor_ros.model.families import DEFAULT_FAMILY
-from satmotor_ros.model.losses import (displacement_change, displacement_change_empirical,
-                                       EMPIRICAL_DP_FLOOR)
-from satmotor_ros.model.units import LPM, MPA, RPM
+from satmotor_ros.model.families.sliwinski2017.losses import (displacement_change,
+                                                              displacement_change_empirical,
+                                                              empirical_drop)
+from satmotor_ros.model.units import CM3_PER_REV, LPM, MPA, RPM
+from satmotor_ros.options import MotorOptions
 
 FLOWS_LPM = (5.0, 10.0, 20.0, 40.0)
 """Constant flows of the paper's Figs. 8, 13 and 16, [l/min]."""
@@ -40,7 +41,6 @@ class Figure:
     plotted: tuple[str, ...]  # which columns are drawn; line styles in order
 
 
-HELP = 'write characteristic plots (PNG) and their data (CSV)'
 DESCRIPTION = ("Characteristics of the paper's Figs. 8-16 kind over the chamber pressure drop: "
                'losses at constant flow and at constant speed, change of displacement, speed '
                'loss, and water against oil.')
@@ -147,10 +147,10 @@ def constant_speed(model: MotorModel, dp_i: np.ndarray) -> Figure:
 def displacement(model: MotorModel, dp_i: np.ndarray) -> Figure:
     """Compute dq of eqs. (33) and (39) over `dp_i` [Pa] at each of SPEEDS_RPM (Figs. 11-12)."""
     n = np.array(SPEEDS_RPM)[:, None] * RPM
-    to_cm3 = 2.0 * np.pi * 1.0e6
+    to_cm3 = 1.0 / CM3_PER_REV
     d = model.derived
     dq33 = displacement_change(dp_i[None, :], n, d.k_p, d.k_i)
-    dq39 = displacement_change_empirical(np.maximum(dp_i[None, :], EMPIRICAL_DP_FLOOR), n,
+    dq39 = displacement_change_empirical(empirical_drop(dp_i[None, :]), n,
                                          d.c1_39, d.c2_39)
     return Figure('displacement_change', 'Change of displacement (Figs. 11-12 kind)',
                   'dq [cm^3/rev]', 'n [rpm]', SPEEDS_RPM,

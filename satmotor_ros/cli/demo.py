@@ -40,7 +40,6 @@ BENCH_SENSORS = {'sensors.flow.noise': 0.05 * LPM, 'sensors.speed.noise': 0.5 * 
 """The loop run's sensor noise (SI), as on a bench: the other runs have ideal sensors."""
 
 
-HELP = 'run virtual motor, model and controller over ROS; bag + report'
 DESCRIPTION = ('Runs the virtual motor, the motor_model node and the speed controller together '
                'over real ROS topics through a cycle of speed and load steps, with and without '
                'feed-forward, faster than real time; records every topic to an MCAP bag per run '
@@ -182,6 +181,9 @@ def command(liquid: str, duration: str, effect: list[str], out: str, quiet: bool
                 loop_runs.append(run_cycle(liquids[0], 'model', loop_cycle, loop, bag,
                                            progress))
                 section = close_loop(bag, liquids[0], loop, out_dir, loop_cycle)
+                from satmotor_ros.cli._demo_health import health_section
+                section += health_section(out_dir, liquids[0],
+                                          [out_dir / 'bags' / f'{liquids[0]}_model', bag], loop)
             if progress is not None:
                 progress.done()
             report.write_report(out_dir, runs, cycle, effects, section)

@@ -6,20 +6,52 @@ from __future__ import annotations
 import argparse
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
+import importlib
 import signal
 import sys
 import threading
+from types import ModuleType
+from typing import NamedTuple
 
 from satmotor_ros import __version__
-from satmotor_ros.cli import (_output, calibrate, characteristics, demo, operating_point,
-                              replay, validate)
+from satmotor_ros.cli import _output
 from satmotor_ros.cli._common import add_subcommand, CliError, fail, take_motor_options
 from satmotor_ros.limits import BAD_OVERRIDES
 
-SUBCOMMANDS = {'demo': demo, 'operating-point': operating_point,
-               'characteristics': characteristics, 'replay': replay, 'calibrate': calibrate,
-               'validate': validate}
-"""Each ``satmotor`` subcommand and the module that defines it, in the order of ``--help``."""
+
+class Subcommand(NamedTuple):
+    """Where a subcommand is defined, and what it does in a line."""
+
+    module: str  # defines DESCRIPTION, add_arguments(parser) and command(**options)
+    summary: str  # its line in `satmotor --help`
+
+
+SUBCOMMANDS = {
+    'demo': Subcommand('satmotor_ros.cli.demo',
+                       'run virtual motor, model and controller over ROS; bag + report'),
+    'operating-point': Subcommand('satmotor_ros.cli.operating_point',
+                                  'speed and losses at one flow and pressure drop'),
+    'characteristics': Subcommand('satmotor_ros.cli.characteristics',
+                                  'write characteristic plots (PNG) and their data (CSV)'),
+    'replay': Subcommand('satmotor_ros.cli.replay',
+                         "run the motor_model node's prediction over a recorded bag"),
+    'calibrate': Subcommand('satmotor_ros.cli.calibrate',
+                            'fit the model to bench data and find the effect it lacks'),
+    'validate': Subcommand('satmotor_ros.cli.validate',
+                           'error of a given (calibrated) model on new data'),
+    'synthetic': Subcommand('satmotor_ros.cli.synthetic',
+                            'write a bench table or recording generated from the model'),
+    'monitor': Subcommand('satmotor_ros.cli.monitor',
+                          'motor health over recordings: leakage factor, trend, alarms'),
+    'fleet': Subcommand('satmotor_ros.cli.fleet',
+                        'health of every recording of every motor, on a Dask cluster'),
+}
+"""
+Each ``satmotor`` subcommand, in the order of ``--help``.
+
+Its module is imported only when the subcommand runs (or shows its own help): a command
+never needs the libraries of another (``operating-point`` runs without the bag library).
+"""
 
 EXAMPLES = {
     'demo': ['satmotor demo    # both liquids, 24 s simulated each, into out/demo',
@@ -39,6 +71,18 @@ EXAMPLES = {
                   "--displacement '0.30 in^3/rev' --out out/cal_log"],
     'validate': ['satmotor validate today.csv --motor out/cal/coefficients.yaml --liquid water '
                  '--out out/val'],
+    'monitor': ['satmotor monitor day1.csv day2.csv --motor out/cal/coefficients.yaml '
+                '--liquid oil --out out/health',
+                'satmotor monitor run.exp --columns mbari_pto --liquid oil --family paszota '
+                "--displacement '0.30 in^3/rev' --out out/health_log"],
+    'synthetic': ['satmotor synthetic --liquid water --effect external_leakage --seed 4 '
+                  '--out out/leak.csv',
+                  'satmotor synthetic --liquid water --effect external_leakage --transient 90 '
+                  '--bag mcap --out out/run_transient'],
+    'fleet': ['satmotor fleet recordings/ --out out/fleet    # local cluster, a worker per core',
+              'satmotor fleet recordings/ --fleet fleet.yaml --calibrate --workers 2 '
+              '--out out/fleet',
+              'satmotor fleet recordings/ --scheduler tcp://10.0.0.5:8786 --out out/fleet'],
 }
 """Example command lines of each subcommand, shown at the end of its ``--help``."""
 
@@ -76,9 +120,33 @@ def _interrupted(err: KeyboardInterrupt) -> int:
     return INTERRUPTED
 
 
-def build_parser() -> argparse.ArgumentParser:
+def subcommand_module(name: str) -> ModuleType:
+    """
+    Import the module that defines a subcommand.
+
+    Parameters
+    ----------
+    name : str
+        A key of :data:`SUBCOMMANDS`, [-]
+
+    Returns
+    -------
+    module
+        Its module.
+
+    """
+    return importlib.import_module(SUBCOMMANDS[name].module)
+
+
+def build_parser(argv: Sequence[str] | None = None) -> argparse.ArgumentParser:
     """
     Build the ``satmotor`` argument parser.
+
+    Parameters
+    ----------
+    argv : sequence of str, optional
+        The arguments it will parse: only the subcommand they name is imported and given
+        its options (the others are listed by name and help); None: every subcommand, [-]
 
     Returns
     -------
@@ -92,9 +160,19 @@ def build_parser() -> argparse.ArgumentParser:
                     '(Śliwiński 2017 model).')
     parser.add_argument('--version', action='version', version=f'%(prog)s {__version__}')
     sub = parser.add_subparsers(dest='subcommand', required=True, metavar='COMMAND')
-    for name, module in SUBCOMMANDS.items():
-        add_subcommand(sub, name, module, EXAMPLES[name])
+    named = SUBCOMMANDS.keys() if argv is None else _named(argv)
+    for name, (_, short) in SUBCOMMANDS.items():
+        if name in named:
+            add_subcommand(sub, name, subcommand_module(name), short, EXAMPLES[name])
+        else:
+            sub.add_parser(name, help=short)
     return parser
+
+
+def _named(argv: Sequence[str]) -> set[str]:
+    """Return the subcommand `argv` names: its first word (before it, options take no value)."""
+    first = next((arg for arg in argv if not arg.startswith('-')), None)
+    return {first} if first in SUBCOMMANDS else set()
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -125,7 +203,9 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 def _run(argv: Sequence[str] | None) -> int:
-    args = vars(build_parser().parse_args(argv))
+    if argv is None:
+        argv = sys.argv[1:]
+    args = vars(build_parser(argv).parse_args(argv))
     args.pop('subcommand')
     command = args.pop('command')
     if BAD_OVERRIDES:  # the user meant a cap to change; running on the default would hide that
@@ -134,7 +214,8 @@ def _run(argv: Sequence[str] | None) -> int:
         args = take_motor_options(args)
     except CliError as err:
         return fail(err)
-    return command(**args)
+    code: int = command(**args)  # argparse's defaults are Any
+    return code
 
 
 if __name__ == '__main__':

@@ -10,12 +10,12 @@ import math
 from typing import Any, TypedDict
 
 from satmotor_ros.cli._common import add_motor_options, CliError, fail, quantity
-from satmotor_ros.interface import MotorOptions
 from satmotor_ros.model import (COMPONENTS, describe_status, ModelError, MotorModel,
                                 OperatingPoints, PointStatus)
 from satmotor_ros.model.errors import UnitError
 from satmotor_ros.model.families import DEFAULT_FAMILY, FAMILIES
-from satmotor_ros.model.units import ATMOSPHERE, LPM, MPA, parse_quantity, RPM
+from satmotor_ros.model.units import channel_gauge, LPM, MPA, parse_quantity, RPM
+from satmotor_ros.options import MotorOptions
 
 ABSOLUTE_UNITS = ('bara', 'psia')
 """Pressure units that say absolute; a channel's pressure is gauge, one atmosphere less."""
@@ -49,7 +49,6 @@ class PointReport(TypedDict):
     warnings: list[str]
 
 
-HELP = 'speed and losses at one flow and pressure drop'
 DESCRIPTION = ('Effective speed (eq. 40), speed loss (eq. 41) and the volumetric-loss breakdown '
                '(eq. 31, or the components of the chosen --family) at one operating point. '
                'Quantities take an optional unit: --flow '
@@ -175,7 +174,7 @@ def _channel_value(text: str, name: str, value: str) -> float:
             if kind[0] == 'pressure' and number < 0.0:
                 raise CliError(f'--channel {text!r}: a pressure must be >= 0')
             if kind[0] == 'pressure' and value.rstrip().endswith(ABSOLUTE_UNITS):
-                number = max(0.0, number - ATMOSPHERE)  # bara, psia: the effects read gauge
+                number = channel_gauge(number)  # bara, psia: the effects read gauge
     except (UnitError, ValueError) as err:
         raise CliError(f'--channel {text!r}: {err}') from None
     if not math.isfinite(number):

@@ -12,25 +12,25 @@ from __future__ import annotations
 
 import argparse
 from contextlib import ExitStack
-import json
 from pathlib import Path
 import time
 
 import numpy as np
 
-from satmotor_ros.bags import (BagError, describe_topics, encode_many, FLOAT64, JOINT_STATE,
-                               list_topics, missing_topics, OutTopic, parse_topic_map,
-                               read_series, Series, write_bag)
+from satmotor_ros.bags import (BagError, describe_topics, encode_many, list_topics,
+                               missing_topics, OutTopic, parse_topic_map, read_series, Series,
+                               write_bag)
 from satmotor_ros.bags.custom import LIQUID_KEY, MOTOR_KEY
 from satmotor_ros.cli import _fastcsv as fastcsv
 from satmotor_ros.cli._common import add_motor_options, CliError, fail
 from satmotor_ros.cli._liquid import settle_liquid
-from satmotor_ros.cli._output import (check_target, MARKER, output_file, png_by, png_metadata,
-                                      resolve, written_by)
-from satmotor_ros.interface import (CHANNELS, JOINT_NAME, LOSS_COMPONENTS, LOSSES_PREFIX,
-                                    MotorOptions, PREDICTED_JOINT_STATE, SPEED_RESIDUAL)
+from satmotor_ros.cli._output import (check_target, output_file, png_by, png_metadata,
+                                      resolve, write_marker, written_by)
+from satmotor_ros.interface import (CHANNELS, FLOAT64, JOINT_NAME, JOINT_STATE, LOSS_COMPONENTS,
+                                    LOSSES_PREFIX, PREDICTED_JOINT_STATE, SPEED_RESIDUAL)
 from satmotor_ros.model import describe_status, ModelError, MotorModel
 from satmotor_ros.model.units import LPM, MPA, RPM
+from satmotor_ros.options import MotorOptions
 from satmotor_ros.prediction import (combine_batch, driving_times, INPUTS, InputState, Level,
                                      MODES, predict, PredictionBatch, Progress, REQUIRED, Rule,
                                      TOPICS)
@@ -52,7 +52,6 @@ _CSV_START = b'log_time [ns],time [s]'
 CSV_CHUNK_ROWS = 65536
 """Rows formatted at once; the text of a CSV row takes about 1.5 KB while it is built, [-]."""
 
-HELP = "run the motor_model node's prediction over a recorded bag"
 DESCRIPTION = ("Replay a rosbag2 bag (sqlite3 or MCAP) through the motor_model node's "
                'prediction, as fast as it can: the inputs are combined in log-time order by the '
                "node's rule. With a measured speed (joint_states) it prints residual statistics "
@@ -163,8 +162,7 @@ def command(bag: str, out: str | None, out_bag: str | None, plot: str | None, no
                                                         written_by(COMMAND), inputs, force))
                 _write_bag(tmp, series, batch, joint, Path(out_bag).name,
                            {LIQUID_KEY: options.liquid, MOTOR_KEY: model.name})
-                (tmp / MARKER).write_text(json.dumps({'command': COMMAND}) + '\n',
-                                          encoding='utf-8')
+                write_marker(tmp, COMMAND)
             if out is not None:
                 tmp = outputs.enter_context(output_file('--out', out, COMMAND, _csv_by_replay,
                                                         inputs, force))

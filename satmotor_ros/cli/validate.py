@@ -5,23 +5,21 @@ from __future__ import annotations
 
 import argparse
 from collections.abc import Mapping
-from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-from satmotor_ros.cli._bench import (add_data_arguments, load_data, run_bench_command,
+from satmotor_ros.cli._bench import (add_data_arguments, open_bench, run_bench_command,
                                      samples_left_out)
 from satmotor_ros.cli._common import add_motor_options
-from satmotor_ros.cli._liquid import settle_liquid
-from satmotor_ros.cli._output import check_target, output_dir, written_by
+from satmotor_ros.cli._output import output_dir
+from satmotor_ros.identify import BenchTable
 from satmotor_ros.identify.coverage import calibrated_envelope
 from satmotor_ros.identify.pipeline import Mode, MODES
 from satmotor_ros.identify.validate import calibrated_dynamics, validate
 from satmotor_ros.identify.validation_report import write_validation
-from satmotor_ros.interface import MotorOptions
+from satmotor_ros.options import MotorOptions
 
 
-HELP = 'error of a given (calibrated) model on new data'
 DESCRIPTION = ('Hold a model (the packaged one, a motor file or a calibrated coefficients.yaml '
                'with its effects) against a bench CSV or a rosbag2 recording without refitting '
                'anything, and write validation.json, report.md and residuals.png into --out.')
@@ -54,20 +52,20 @@ def command(data: str, out: str, mode: Mode, options: MotorOptions, columns: str
         0 with the error on stdout; 1 with one line on stderr for unusable data or options.
 
     """
-    return run_bench_command(out, lambda: _validate(data, out, mode, options, columns, force))
+    return run_bench_command(out, lambda: validate_into(
+        data, out, mode, options, columns, force))
 
 
-def _validate(data: str, out: str, mode: Mode, options: MotorOptions, columns: str,
-              force: bool) -> str:
-    """Validate, write the outputs and return the summary line."""
-    inputs = [name for name in (data, options.motor_file, columns) if name]
-    check_target('--out', Path(out), inputs, force, written_by('validate'), 'validate')
-    settled = settle_liquid(options, data, 'validate')
+def validate_into(data: str, out: str, mode: Mode, options: MotorOptions, columns: str,
+                  force: bool, table: BenchTable | None = None) -> str:
+    """
+    Validate, write the outputs and return the summary line ``command`` prints.
+
+    `table` and the errors are as for :func:`~satmotor_ros.cli.calibrate.calibrate_into`.
+    """
+    inputs, settled, table = open_bench('validate', data, out, options, columns, force, table)
     options = settled.options
     model = options.build_model()
-    table = load_data(data, columns, model.geometry.displacement)
-    table = replace(table, notes=table.notes + (f'liquid: {settled.source}',)
-                    + ((f'WARNING: {settled.warning}',) if settled.warning else ()))
     motor_file = options.motor_file
     result = validate(table, model, options.liquid, mode,
                       calibrated=calibrated_envelope(motor_file) if motor_file else None,

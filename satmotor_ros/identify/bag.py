@@ -26,7 +26,7 @@ from satmotor_ros.identify.errors import DataError
 from satmotor_ros.identify.table import BenchTable, table_from_columns
 from satmotor_ros.interface import CHANNELS, JOINT_NAME, MODEL_OUTPUTS
 from satmotor_ros.model._typing import FloatArray
-from satmotor_ros.model.units import ATMOSPHERE
+from satmotor_ros.model.units import gauge
 
 
 COLUMNS = {CHANNELS[c].topic: (c, CHANNELS[c].field)
@@ -132,7 +132,7 @@ def read_bag(path: str | Path, joint: str | None = JOINT_NAME,
             columns[column] = (unit, _on(series[topic], field, t, t0))
     for column in ('p_in', 'p_out', 'p_case'):  # FluidPressure is absolute
         if column in columns:
-            columns[column] = ('Pa', columns[column][1] - ATMOSPHERE)
+            columns[column] = ('Pa', gauge(columns[column][1]))
     for name, base in extra.items():
         s = extra_series.get(name)
         if s is not None and len(s) and base not in columns:

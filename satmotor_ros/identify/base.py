@@ -25,7 +25,7 @@ the linear factors (:mod:`.fit`).
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, fields, replace
 import math
 from typing import Any
@@ -243,8 +243,8 @@ def fit_base(spec: MotorSpec, liquid: str, points: BenchTable,
     return result(best, fitted, [], note)
 
 
-def _kept(result: Any, names: tuple[str, ...], model: MotorModel, factor: float,
-          why: str) -> BaseFit:
+def _kept(result: Callable[[float, list[dict[str, Any]], list[dict[str, Any]], str], BaseFit],
+          names: tuple[str, ...], model: MotorModel, factor: float, why: str) -> BaseFit:
     kept = [{'coefficient': n, 'value': float(getattr(model.coef, n)) * factor, 'why': why}
             for n in names]
     return result(factor, [], kept, f'channel drop kept: {why}')
@@ -288,7 +288,7 @@ def _minimum(profile: _Profile, bound: float, kept: float) -> float:
                                                   'maxiter': 12})
         if profile(float(found.x)) < values[i]:
             return float(found.x)
-    return grid[i]
+    return float(grid[i])
 
 
 __all__ = ['ALPHA', 'BaseFit', 'fit_base', 'guessed']

@@ -16,12 +16,13 @@ from collections.abc import Mapping
 
 from satmotor_ros.identify.parts import LossParts
 from satmotor_ros.model._typing import FloatArray
-from satmotor_ros.model.effects import build_candidates, Candidate, CandidateData
+from satmotor_ros.model.effects import build_candidates, Candidate, CandidateData, Sampled
 from satmotor_ros.model.viscosity import ViscosityLaw
 
 
 def build_library(parts: LossParts, channels: Mapping[str, FloatArray], law: ViscosityLaw,
-                  family: str = '') -> tuple[list[Candidate], list[str]]:
+                  family: str = '', samples: Sampled | None = None
+                  ) -> tuple[list[Candidate], list[str]]:
     """
     Build every candidate the data can test, kind by kind in the registry's order.
 
@@ -36,6 +37,9 @@ def build_library(parts: LossParts, channels: Mapping[str, FloatArray], law: Vis
     family : str
         The model family of `parts`: kinds that do not apply to it are not offered;
         '' offers every kind, [-]
+    samples : Sampled, optional
+        The samples whose bins the points are (a time series' every sample): a kind
+        nonlinear in the port drop is evaluated at them and averaged, [-]
 
     Returns
     -------
@@ -45,7 +49,7 @@ def build_library(parts: LossParts, channels: Mapping[str, FloatArray], law: Vis
         Why other candidates were not offered (missing or constant channel).
 
     """
-    return build_candidates(CandidateData(parts, channels, law, frozenset(), family))
+    return build_candidates(CandidateData(parts, channels, law, frozenset(), family, samples))
 
 
-__all__ = ['Candidate', 'build_library']
+__all__ = ['Candidate', 'Sampled', 'build_library']

@@ -16,17 +16,14 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from satmotor_ros.bounded_yaml import read_yaml, shown, YamlLimitError
+from satmotor_ros.bounded_yaml import read_yaml_or, shown
 from satmotor_ros.identify.errors import DataError
-from satmotor_ros.identify.table import (BenchTable, column_to_si, KNOWN_KINDS,
-                                         table_from_columns)
-from satmotor_ros.identify.textfile import (HEADERS, read_cells, SANITY, SEPARATORS,
-                                            split_unit)
+from satmotor_ros.identify.table import BenchTable, column_to_si, KNOWN_KINDS, table_from_columns
+from satmotor_ros.identify.textfile import HEADERS, read_cells, SANITY, SEPARATORS, split_unit
 from satmotor_ros.limits import CSV_MAX_COLUMNS
-from satmotor_ros.model.config import default_config_path
 from satmotor_ros.model.errors import ConfigError, UnitError
-from satmotor_ros.model.units import (ATMOSPHERE, parse_quantity, pressure_reference,
-                                      to_si, units_of)
+from satmotor_ros.model.io.config import default_config_path
+from satmotor_ros.model.units import gauge, parse_quantity, pressure_reference, to_si, units_of
 
 FIELDS = ('time', 'speed', 'flow', 'p_in', 'p_out', 'p_a', 'p_b', 'temperature', 'p_case',
           'torque')
@@ -221,14 +218,7 @@ def load_mapping(name: str | Path) -> ColumnMapping:
         except ConfigError:
             msg = f'--columns {str(name)!r}: no such file and no packaged mapping of that name'
             raise DataError(msg) from None
-    try:
-        doc = read_yaml(path)
-    except OSError as err:
-        msg = f'--columns {str(name)!r}: {err.strerror}'
-        raise DataError(msg) from None
-    except YamlLimitError as err:
-        msg = f'{path}: {err}'
-        raise DataError(msg) from None
+    doc = read_yaml_or(path, DataError, f'--columns {str(name)!r}', str(path))
     # a packaged mapping by its name: its installed path is of this machine, not of the data
     return mapping_from_dict(doc, str(path) if path == Path(name) else f'{name} (packaged)')
 
@@ -276,7 +266,7 @@ def _to_si(values: np.ndarray, source: Source, name: str, unit: str, where: str)
         raise _fail(where, f'unit {unit!r} is not a {kind} unit (accepted: '
                            f'{", ".join(units_of(kind))})') from None
     if source.reference == 'absolute' and pressure_reference(unit) is None:
-        si = si - ATMOSPHERE
+        si = gauge(si)
     return si * source.sign
 
 

@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from satmotor_ros.bounded_yaml import read_yaml, YamlLimitError
+from satmotor_ros.bounded_yaml import read_yaml_or
 from satmotor_ros.identify.errors import DataError
 from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.units import MPA, RPM
@@ -173,11 +173,7 @@ def calibrated_blocks(path: str | Path) -> dict[str, Any]:
         If the file cannot be read.
 
     """
-    try:
-        doc = read_yaml(path)
-    except (OSError, YamlLimitError) as err:
-        msg = f'{path}: {err}'
-        raise DataError(msg) from None
+    doc = read_yaml_or(path, DataError, str(path), str(path))
     return doc if isinstance(doc, dict) else {}
 
 

@@ -18,8 +18,8 @@ import numpy as np
 from satmotor_ros.model import load_motor, MotorModel
 from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.effects import flow_reading
+from satmotor_ros.model.engine.screening import Status
 from satmotor_ros.model.results import OperatingPoints
-from satmotor_ros.model.screening import Status
 
 
 class CalibratedModel:

@@ -161,7 +161,8 @@ class FitReport:
     def correlation(self) -> FloatArray:
         """Return the correlation matrix of the fitted parameters, [-]."""
         sd = np.sqrt(np.maximum(np.diag(self.covariance), 1e-300))
-        return np.clip(self.covariance / np.outer(sd, sd), -1.0, 1.0)
+        correlation: FloatArray = np.clip(self.covariance / np.outer(sd, sd), -1.0, 1.0)
+        return correlation  # np.clip is Any to numpy's stubs
 
 
 class LossFit:
@@ -363,12 +364,21 @@ class LossFit:
         keep = np.ones(self.fun_.size, dtype=bool)
         keep[drop] = False
         step = np.linalg.lstsq(self.jac_[keep], -self.fun_[keep], rcond=None)[0]
-        return np.clip(self.u_ + step, *self.bounds_)
+        within: FloatArray = np.clip(self.u_ + step, *self.bounds_)  # numpy types it as Any
+        return within
 
     def found(self) -> list[tuple[Candidate, Effect]]:
         """Return each effect's candidate with the effect at the fitted values (for the YAML)."""
         self._check_fitted()
         return [(c, c.as_effect(k, *theta)) for c, k, theta in self._effect_values(self.u_)]
+
+    def last_modifier(self) -> Modifier:
+        """Return what the last effect alone does to the prediction, at its fitted values."""
+        self._check_fitted()
+        if not self.effects:
+            return NO_EFFECT
+        c, k, theta = self._effect_values(self.u_)[-1]
+        return c.modify(k, *theta)
 
     def pinned(self, effects_only: bool = False) -> list[tuple[str, float]]:
         """

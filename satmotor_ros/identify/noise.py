@@ -96,7 +96,8 @@ def noise_model(residual: FloatArray, flow: FloatArray, n_params: int,
     ratio = np.abs(residual) / sigma
     sigma = sigma * MAD * float(np.median(ratio)) * np.sqrt(
         residual.size / max(residual.size - n_params, 1))
-    return np.maximum(sigma, floor)
+    floored: FloatArray = np.maximum(sigma, floor)  # numpy types it as Any
+    return floored
 
 
 def outlier_limit(n: int) -> float:

@@ -26,7 +26,7 @@ from satmotor_ros.identify.table import BenchTable
 from satmotor_ros.model import MotorModel
 from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.effects import Modifier
-from satmotor_ros.model.losses import clearance_height
+from satmotor_ros.model.families.sliwinski2017.losses import clearance_height
 
 
 @dataclass(frozen=True)
@@ -207,7 +207,7 @@ def loss_parts(model: MotorModel, table: BenchTable) -> tuple[LossParts, np.ndar
                                     ('commutation', losses.commutation)), 0.0, 0.0,
                   'A_1 (eq. 1) and C_1 (eq. 5)', 'leakage'),
         Component('c_scale', (('', pressure_speed),), 1.0,
-                  model.c_fc_beta / model.c if model.c > 0 else 0.0, 'C (eq. 33)',
+                  model.c_fc_beta / model.c_lumped if model.c_lumped > 0 else 0.0, 'C (eq. 33)',
                   'pressure_speed'),
         Component('c_id_scale', (('', losses.inertia),), 0.5, 0.0, 'C_id (eq. 14)', 'inertia'))
     parts = LossParts(

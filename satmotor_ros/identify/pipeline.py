@@ -15,7 +15,7 @@ from typing import Any, Literal
 import numpy as np
 
 from satmotor_ros.identify.base import BaseFit, fit_base
-from satmotor_ros.identify.candidates import build_library, Candidate
+from satmotor_ros.identify.candidates import build_library, Candidate, Sampled
 from satmotor_ros.identify.coverage import (coverage, COVERED, envelope, envelope_share, MOST,
                                             TAIL)
 from satmotor_ros.identify.errors import DataError, IdentificationError
@@ -28,10 +28,10 @@ from satmotor_ros.identify.selection import (at_bound, CrossValidatedSelector, E
 from satmotor_ros.identify.steady import (extract_steady, looks_like_series, steady_windows,
                                           SteadyTolerance)
 from satmotor_ros.identify.table import BenchTable
-from satmotor_ros.identify.transient import (dynamics_summary, Samples, transient_samples,
-                                             TransientOptions)
+from satmotor_ros.identify.transient import (averaged, dynamics_summary, Samples,
+                                             transient_samples, TransientOptions)
 from satmotor_ros.model import load_motor, MotorModel, MotorSpec
-from satmotor_ros.model.effects import Effect, kind_of, measured_range
+from satmotor_ros.model.effects import coefficients_without, Effect, kind_of, measured_range
 from satmotor_ros.model.revolutions import sampled_revolutions
 from satmotor_ros.model.units import LPM
 from satmotor_ros.model.viscosity import standard_law, ViscosityLaw
@@ -546,9 +546,7 @@ def _without_effects(spec: MotorSpec, liquid: str,
     fitted = spec.sets[liquid]
     if not fitted.effects:
         return spec, table
-    coef = fitted.coefficients
-    if any(e.kind == 'external_leakage' for e in fitted.effects):
-        coef = replace(coef, external_leakage=0.0)  # its effect named the pressure; gone too
+    coef = coefficients_without(fitted.effects, fitted.coefficients)  # what they set, too
     bare = replace(fitted, coefficients=coef, effects=())
     names = ', '.join(e.name for e in fitted.effects)
     note = f'{spec.source}: its effects ({names}) were left out; the calibration looks anew'
@@ -597,7 +595,8 @@ def calibrate(table: BenchTable, liquid: str = 'oil', spec: MotorSpec | None = N
         points = replace(points, notes=points.notes + (note,))
     law = standard_law(model.liquid, liquid)
     channels = {**points.channels, 'p_in': points.p_in, 'p_out': points.p_out}
-    candidates, skipped = build_library(parts, channels, law, model.family.name)
+    candidates, skipped = build_library(parts, channels, law, model.family.name,
+                                        _sampled(samples))
     selector = _selector(options, points, samples)
     forward = selector.select(parts, candidates, points.channels.get('time'))
     first = forward.steps[0]
@@ -632,6 +631,15 @@ def _with_base(spec: MotorSpec, liquid: str, table: BenchTable, options: Options
     again = read_rows(model, table, replace(options, mode=read.mode))
     return base.spec, model, replace(again, reason=read.reason,
                                      coverage={**read.coverage, **again.coverage}), base
+
+
+def _sampled(samples: Samples | None) -> Sampled | None:
+    """Return the samples the rows average, as the candidates read them (None: steady rows)."""
+    if samples is None:
+        return None
+    raw = samples.samples
+    dp = np.where(samples.usable, raw.p_in - raw.p_out, np.nan)
+    return Sampled(dp, lambda x: averaged(samples, x))
 
 
 def _selector(options: Options, points: BenchTable,

@@ -130,8 +130,9 @@ def clustered(flagged: np.ndarray, z: FloatArray, space: Space) -> np.ndarray:
 
     def alike(near: np.ndarray) -> np.ndarray:
         # a neighbour misses alike: the same sign, beyond NEIGHBOUR_Z, within a factor LIKE
-        return ((z[near] * sign[at, None] > NEIGHBOUR_Z)
-                & (size[at, None] <= LIKE * size[near]))
+        missed: np.ndarray = ((z[near] * sign[at, None] > NEIGHBOUR_Z)
+                              & (size[at, None] <= LIKE * size[near]))  # numpy types it as Any
+        return missed
 
     for near in nears:
         out[at[np.sum(alike(near), axis=1) >= MIN_AGREE]] = True

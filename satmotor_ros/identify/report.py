@@ -21,9 +21,11 @@ from satmotor_ros.identify.residual_map import coverage_section, plot_residual_m
 from satmotor_ros.identify.selection import at_bound, Errors
 from satmotor_ros.identify.table import BenchTable
 from satmotor_ros.identify.transient import transient_section
+from satmotor_ros.interface import SPEED_SETPOINT
 from satmotor_ros.limits import PLOT_MAX_PANELS
 from satmotor_ros.model import MotorModel
 from satmotor_ros.model._typing import FloatArray
+from satmotor_ros.model.effects import coefficients_without
 from satmotor_ros.model.units import LPM, MPA, RPM
 
 UNSEPARABLE = 0.95
@@ -31,7 +33,7 @@ UNSEPARABLE = 0.95
 
 _UNITS = {'time': ('s', 1.0), 'revolutions': ('rev', 1.0), 'temperature': ('degC', 1.0),
           'p_case': ('MPa', MPA), 'p_out': ('MPa', MPA), 'p_in': ('MPa', MPA),
-          'speed_setpoint': ('rpm', RPM)}  # the demo's set-point topic, SI (rad/s)
+          SPEED_SETPOINT: ('rpm', RPM)}  # the demo's set-point topic, SI (rad/s)
 
 
 def pyplot() -> ModuleType:
@@ -226,7 +228,7 @@ def quadrants(parts: LossParts) -> np.ndarray:
 
 def _fitted_model(cal: Calibration) -> MotorModel:
     spec = cal.model.coefficient_set
-    coef = replace(fitted_coefficients(cal), external_leakage=0.0)
+    coef = coefficients_without(cal.effects(), fitted_coefficients(cal))
     return MotorModel(cal.model.geometry, replace(spec, coefficients=coef),
                       cal.model.valid_range, cal.model.liquid)
 

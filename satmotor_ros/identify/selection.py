@@ -64,6 +64,7 @@ from satmotor_ros.identify.errors import IdentificationError
 from satmotor_ros.identify.fit import HUBER, LossFit
 from satmotor_ros.identify.noise import noise_model, outliers, robust_scale
 from satmotor_ros.identify.parts import LossParts
+from satmotor_ros.identify.regional import acting, local_gain, LocalGain
 from satmotor_ros.identify.regions import clustered, regions, Space
 from satmotor_ros.identify.transient import variance_inflation
 from satmotor_ros.model._typing import FloatArray
@@ -160,6 +161,7 @@ class Selection:
     sigma: FloatArray  # noise model of the step at every point [m^3/s]
     left_out: np.ndarray  # bool: outliers even under the step's best model, not fitted
     refused: tuple[Score, ...] = ()  # ahead of the candidates chosen from, but on a bound
+    confined: bool = False  # chosen by its gain where it acts (:mod:`.regional`): the last
 
 
 @dataclass(frozen=True)
@@ -393,6 +395,26 @@ class CrossValidatedSelector:
     def _passes(self, score: Score, baseline: Score, m: int) -> bool:
         return self._significant(score, baseline, m) and not score.fit.pinned(effects_only=True)
 
+    # -- an effect confined to a region of a time series, judged where it acts (.regional)
+    def _local(self, score: Score, baseline: Score, sigma: FloatArray,
+               index: np.ndarray) -> LocalGain | None:
+        at = acting(score.fit.last_modifier().additive, sigma.size)
+        if not self.correlated or at is None:
+            return None
+        return local_gain(at, baseline.cv_error, score.cv_error, sigma, index, self.block)
+
+    def _confined(self, estimated: Sequence[Score], baseline: Score, sigma: FloatArray,
+                  index: np.ndarray, m: int) -> Score | None:
+        """Return the best candidate passing every test but the gain, which it has locally."""
+        for score in estimated:
+            if not (score.p_value < self.alpha / m and score.cv_rmse < baseline.cv_rmse
+                    and not score.rmse >= baseline.rmse and determined(score.fit)):
+                continue
+            local = self._local(score, baseline, sigma, index)
+            if local is not None and local.passes(self.min_gain):
+                return score
+        return None
+
     def _noise(self, parts: LossParts, found: tuple[Candidate, ...], pool: Sequence[Candidate],
                start: FloatArray | None) -> tuple[FloatArray, np.ndarray, list[LossFit]]:
         """
@@ -432,7 +454,9 @@ class CrossValidatedSelector:
         flagged = outliers(residual, sigma)
         if not flagged.any():
             return flagged
-        return flagged & ~clustered(flagged, residual / sigma, self.space(parts))
+        isolated: np.ndarray = flagged & ~clustered(flagged, residual / sigma,
+                                                    self.space(parts))  # numpy types it as Any
+        return isolated
 
     def space(self, parts: LossParts) -> Space:
         """Return where the rows lie (signed drop and speed, and time when given)."""
@@ -486,6 +510,12 @@ class CrossValidatedSelector:
         top = estimated[0]
         gain = 1.0 - top.cv_rmse / baseline.cv_rmse if baseline.cv_rmse > 0 else 0.0
         if not self._passes(top, baseline, m):
+            confined = self._confined(estimated, baseline, sigma, index, m)
+            if confined is not None:
+                local = self._local(confined, baseline, sigma, index)
+                verdict = _local_verdict(confined, baseline, self.alpha, m, local)
+                return Selection(baseline, ranking, confined, None, verdict + _at_bound(refused),
+                                 self.alpha, sigma, left_out, refused, True)
             return _with_verdict(done, (
                 f'{"none" if not found else "no further effect"}: the best candidate, '
                 f'{top.label}, cuts the cross-validated error by {100 * gain:.1f} % (need > '
@@ -555,7 +585,9 @@ class CrossValidatedSelector:
                 break
             found = (*found, step.chosen.added)
             start = step.chosen.fit.u_
-            if len(found) >= self.max_effects:
+            # an effect chosen where it acts ends the search: a form fitted on a few events
+            # moves with the next step's weights (the noise re-estimated without its misses)
+            if len(found) >= self.max_effects or step.confined:
                 break
         # the model as accepted (the last step only re-weighs it to test what is left)
         accepted = [s.chosen for s in steps if s.chosen is not None]
@@ -580,6 +612,22 @@ def _guarded(test: np.ndarray, guard: int, n: int) -> np.ndarray:
 def _plain(baseline: Score, score: Score) -> str:
     """Say how a candidate moves the plain out-of-sample RMSE, [l/min]."""
     return f'{baseline.rmse / LPM:.4g} -> {score.rmse / LPM:.4g} l/min'
+
+
+ENDS_SEARCH = ('it ends the search: no further effect is tested after it (a form fitted on a '
+               "few openings moves with the next step's noise weights), so an effect beside it "
+               'may be missing')
+"""What the report says after an effect chosen where it acts, since nothing follows it."""
+
+
+def _local_verdict(score: Score, baseline: Score, alpha: float, m: int,
+                   local: LocalGain | None) -> str:
+    """Say why an effect confined to a region was accepted by its gain where it acts."""
+    return (f'{score.label}: an effect confined to a region: '
+            f'{"" if local is None else local.says()}; p = {score.p_value:.2g} < {alpha:g}/{m}; '
+            f'over every row it cuts the cross-validated error by '
+            f'{100 * (1.0 - score.cv_rmse / baseline.cv_rmse):.1f} %, plain RMSE '
+            f'{_plain(baseline, score)}; {ENDS_SEARCH}')
 
 
 def _with_verdict(step: Selection, verdict: str) -> Selection:

@@ -240,6 +240,67 @@ class ReliefValve:
 
 
 @dataclass(frozen=True)
+class DemandRelief:
+    """
+    A relief valve whose flow the demand sets: it clamps the drop near its crack, one way only.
+
+    Past the crack the drop hardly rises: the valve opens fully within `width` (a steep,
+    saturating characteristic), and what it passes is what the motor does not take, which
+    changes from one opening to the next: each opening (a run of samples past the crack)
+    passes `full_flow` times its own factor, drawn in [1 - spread, 1 + spread]. The flow at
+    one drop thus scatters by the demand, as on the MBARI rig, and no law of the drop alone
+    (the ``threshold`` candidate's) gives it.
+    """
+
+    crack: float  # crack pressure p_c [Pa]
+    direction: int  # +1: opens while p_a > p_b; -1: while p_b > p_a
+    full_flow: float  # mean flow of a fully open valve [m^3/s]
+    width: float = 0.15 * MPA  # drop over the crack at which it is fully open [Pa]
+    spread: float = 0.5  # relative spread of the openings' flows [-]
+    seed: int = 0  # of the openings' factors [-]
+
+    kind = 'threshold:dp'
+
+    def flow(self, dp: FloatArray, speed: FloatArray, t: FloatArray) -> FloatArray:
+        """Return the valve's flow into port A, [m^3/s]."""
+        x = self.direction * dp
+        lift = np.clip((x - self.crack) / self.width, 0.0, 1.0)
+        opening = np.cumsum(np.diff(np.concatenate(([0], (lift > 0.0).astype(int)))) > 0)
+        factors = np.random.default_rng(self.seed).uniform(
+            1.0 - self.spread, 1.0 + self.spread, int(opening[-1]) + 1 if opening.size else 1)
+        return self.direction * self.full_flow * factors[opening] * lift
+
+
+def demand_relief(trajectory: Trajectory, scale: float = 1.0, *, direction: int = -1,
+                  crack_fraction: float = 0.97, seed: int = 0) -> DemandRelief:
+    """
+    Build a demand-set relief valve passing 5 l/min on average, `scale` times that.
+
+    Parameters
+    ----------
+    trajectory : Trajectory
+        The (cropped) trajectory the valve will act on, [-]
+    scale : float
+        Factor on the flow, [-]
+    direction : {-1, 1}
+        Sign of p_a - p_b where it opens, [-]
+    crack_fraction : float
+        The crack pressure over the 99th percentile of the drop in its direction (the
+        largest drop is a spike of the readings), [-]
+    seed : int
+        Seed of the openings' flows, [-]
+
+    Returns
+    -------
+    DemandRelief
+        The valve.
+
+    """
+    top = float(np.percentile(direction * (trajectory.p_a - trajectory.p_b), 99.0))
+    return DemandRelief(crack_fraction * top, direction, 5.0 * LPM * scale, seed=seed)
+
+
+@dataclass(frozen=True)
 class ExternalLeak:
     """
     A leak to the drain from one port: k times that port's gauge pressure (eq. 24's form).
@@ -273,7 +334,8 @@ class Wear:
     def flow(self, dp: FloatArray, speed: FloatArray, t: FloatArray) -> FloatArray:
         """Return the extra flow into port A, [m^3/s]."""
         grown = (t - t[0]) / max(float(t[-1] - t[0]), 1e-9)
-        return self.end_flow * grown * dp / self.reference_drop
+        flow: FloatArray = self.end_flow * grown * dp / self.reference_drop  # Any to numpy
+        return flow
 
 
 @dataclass(frozen=True)
@@ -300,7 +362,7 @@ class FlowLag:
     kind = 'flow_lag'
 
 
-Injected = ReliefValve | ExternalLeak | Wear | FlowGain | SpeedGain | FlowLag
+Injected = ReliefValve | DemandRelief | ExternalLeak | Wear | FlowGain | SpeedGain | FlowLag
 """The effects a semi-real case can carry."""
 
 KINDS = ('relief', 'external_leakage', 'clearance_wear', 'flow_sensor_gain',
@@ -442,7 +504,7 @@ def build_case(trajectory: Trajectory, effects: Sequence[Injected] = (), *,
     for effect in effects:
         if isinstance(effect, ExternalLeak):
             true += effect.flow(dp, speed, t, p_a, p_b)
-        elif isinstance(effect, (ReliefValve, Wear)):
+        elif isinstance(effect, (ReliefValve, DemandRelief, Wear)):
             true += effect.flow(dp, speed, t)
     reading = true
     step_s = float(np.median(np.diff(t)))
@@ -497,6 +559,7 @@ def write_mbari_log(path: str | Path, case: Case) -> Path:
     return path
 
 
-__all__ = ['build_case', 'Case', 'estimate_noise', 'ExternalLeak', 'F11_5', 'FlowGain',
+__all__ = ['build_case', 'Case', 'demand_relief', 'DemandRelief', 'estimate_noise',
+           'ExternalLeak', 'F11_5', 'FlowGain',
            'FlowLag', 'Injected', 'KINDS', 'load_trajectory', 'MBARI_AREA', 'Noise', 'realistic',
            'ReliefValve', 'SpeedGain', 'Trajectory', 'Wear', 'write_mbari_log']

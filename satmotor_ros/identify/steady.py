@@ -187,24 +187,7 @@ def steady_runs(table: BenchTable, time: FloatArray,
 
 
 def extract_steady(table: BenchTable, tol: SteadyTolerance | None = None) -> BenchTable:
-    """
-    Average each steady window of a time series into one operating point.
-
-    As :func:`steady_windows`, without the count of samples.
-
-    Parameters
-    ----------
-    table : BenchTable
-        Raw samples with a ``time`` channel, [-]
-    tol : SteadyTolerance, optional
-        The tolerances; the defaults when omitted, [-]
-
-    Returns
-    -------
-    BenchTable
-        One row per steady window, ``time_series`` False.
-
-    """
+    """Average each steady window of a time series into one row: :func:`steady_windows`'s table."""
     return steady_windows(table, tol)[0]
 
 
@@ -260,7 +243,8 @@ def steady_windows(table: BenchTable,
         c = np.concatenate(([0.0], np.cumsum(np.where(np.isfinite(x), x, 0.0))))
         k = np.concatenate(([0], np.cumsum(np.isfinite(x))))
         with np.errstate(invalid='ignore', divide='ignore'):
-            return (c[stops] - c[starts]) / (k[stops] - k[starts])
+            mean: FloatArray = (c[stops] - c[starts]) / (k[stops] - k[starts])  # Any to numpy
+            return mean
 
     channels = {name: average(x) for name, x in table.channels.items()}
     channels['revolutions'] = average(revs)

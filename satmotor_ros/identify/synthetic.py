@@ -11,25 +11,34 @@ effect's coefficient by the kind (:meth:`~satmotor_ros.model.effects.EffectKind.
 The injected viscosity law is the liquid's standard one pinned at the mean
 temperature of the data, while the candidate library pins it at the set's
 viscosity, so a test still checks that the fit generalises over the pinning.
+
+A recording can age (:func:`aging`): a wear that grows with the hours of the recording,
+the family's own (:func:`wear_kind`), and a step fault: any injection with an `onset`
+is absent before that time and present after it (a wear then starts growing there).
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
+import math
 from pathlib import Path
 import re
 
 import numpy as np
 
 from satmotor_ros.identify.table import BenchTable
-from satmotor_ros.interface import CHANNELS, JOINT_NAME
+from satmotor_ros.interface import (CHANNELS, FLOAT64, FLUID_PRESSURE, JOINT_NAME, JOINT_STATE,
+                                    TEMPERATURE)
 from satmotor_ros.model import load_motor, MotorModel
 from satmotor_ros.model._typing import FloatArray
-from satmotor_ros.model.effects import Effect, kind_of, sensor_error, Synthetic, with_effects
+from satmotor_ros.model.effects import Effect, kind_of, ranked, sensor_error, Synthetic
+from satmotor_ros.model.effects._wear import Wear
+from satmotor_ros.model.motor import with_effects
 from satmotor_ros.model.revolutions import revolutions
 from satmotor_ros.model.units import ATMOSPHERE, LPM, MPA, RPM
 from satmotor_ros.model.viscosity import standard_law
+from satmotor_ros.options import MotorOptions
 from scipy.signal import lfilter
 
 EFFECTS = ('none', 'external_leakage', 'viscosity_temperature', 'clearance_wear',
@@ -64,9 +73,11 @@ class Injection:
 
     `magnitude` means: k_ex [m^3/(s*Pa)] for external_leakage; the
     temperature span [K] for viscosity_temperature; the clearance growth
-    over the test [m] for clearance_wear; b [m^3/s] for flow_sensor_offset;
+    over the test [m] for clearance_wear; the relative growth of the leakage
+    over the test [-] for leakage_wear; b [m^3/s] for flow_sensor_offset;
     g [-] for the gains; the peak-to-peak loss change [m^3/s] for
-    ``channel:<name>``; the largest extra loss [m^3/s] for ``term:<expr>``.
+    ``channel:<name>``; the largest extra loss [m^3/s] for ``term:<expr>``,
+    each over the samples from `onset` on (a wear grows from there to the end).
     """
 
     effect: str = 'none'  # an id of the DESIGN.md vocabulary
@@ -74,6 +85,7 @@ class Injection:
     regressor: str = ''  # p_case|p_out (external_leakage), time|revolutions (wear)
     shape: tuple[tuple[str, float], ...] = ()  # kind-specific numbers (threshold: reference [Pa],
     # exponent [-])
+    onset: float = -math.inf  # time of the data it steps in at (a step fault) [s]
 
     @classmethod
     def realistic(cls, effect: str, scale: float = 1.0, liquid: str = 'oil') -> Injection:
@@ -83,7 +95,7 @@ class Injection:
         Parameters
         ----------
         effect : str
-            A key of :data:`REALISTIC`, [-]
+            A key of :data:`REALISTIC` or :data:`FAMILY_REALISTIC`, [-]
         scale : float
             Factor on the realistic magnitude, [-]
         liquid : str
@@ -95,7 +107,7 @@ class Injection:
             The injection.
 
         """
-        (oil, water), regressor = REALISTIC[effect]
+        (oil, water), regressor = {**REALISTIC, **FAMILY_REALISTIC}[effect]
         return cls(effect, (water if 'water' in liquid else oil) * scale, regressor)
 
 
@@ -104,12 +116,16 @@ class Plan:
     """Operating range, duration and sensor noise of a synthetic bench test."""
 
     liquid: str = 'oil'  # coefficient set
+    family: str = ''  # model family of the motor; '': the packaged SM-0,75/25's own
+    displacement: float = 0.0  # of a family's default motor; 0: the SM-0,75/25's [m^3/rad]
     n_points: int = 100  # operating points
     speed_rpm: tuple[float, float] = (100.0, 1500.0)  # [rpm]
     dp_mpa: tuple[float, float] = (2.0, 25.0)  # port drop [MPa]
     p_out_mpa: tuple[float, float] = (0.3, 3.0)  # [MPa]
     p_case_mpa: tuple[float, float] = (0.05, 0.6)  # [MPa]
     temperature_c: tuple[float, float] = (38.0, 48.0)  # when viscosity is not injected [degC]
+    temperature_jitter: float = 0.3  # share of the span drawn anew per set-point; 0: only the
+    # slow warm-up and cool-down cycles, as a tank of oil [-]
     duration_s: float = 3600.0  # test duration [s]
     noise_flow_lpm: float = 0.02  # flowmeter noise, absolute [l/min]
     noise_flow_rel: float = 0.0005  # flowmeter noise, share of reading [-]
@@ -140,6 +156,12 @@ class Plan:
         q = np.hypot(self.noise_flow_lpm, self.noise_flow_rel * flow / LPM)
         n = model.geometry.displacement * self.noise_speed_rpm * RPM / LPM
         return np.hypot(q, n)
+
+
+FAMILY_REALISTIC = {
+    'leakage_wear': ((0.5, 0.5), 'time'),  # relative growth of the leakage over the test [-]
+}
+"""Realistic magnitudes of effects only other families than the packaged motor's have."""
 
 
 def injected_effect(base: MotorModel, injection: Injection, speed: FloatArray,
@@ -231,7 +253,10 @@ def _temperature(plan: Plan, injections: tuple[Injection, ...], rng: np.random.G
     # warm-up and cool-down cycles, so that temperature is no proxy for time
     phase = rng.uniform(0, 2 * np.pi)
     cycles = 0.5 * (1 + np.sin(2 * np.pi * 2.5 * time / max(time[-1], 1e-9) + phase))
-    return lo + (hi - lo) * (0.7 * cycles + 0.3 * rng.uniform(0, 1, time.size))
+    jitter = plan.temperature_jitter
+    temperature: FloatArray = lo + (hi - lo) * ((1.0 - jitter) * cycles
+                                                + jitter * rng.uniform(0, 1, time.size))
+    return temperature
 
 
 def _channels(plan: Plan, injections: tuple[Injection, ...], rng: np.random.Generator,
@@ -250,12 +275,18 @@ def _channels(plan: Plan, injections: tuple[Injection, ...], rng: np.random.Gene
     return channels
 
 
-def _measure(plan: Plan, effects: tuple[Effect, ...], rng: np.random.Generator,
+def _errors(spans: Spans, channel: str) -> tuple[FloatArray, FloatArray]:
+    """Return the gain and offset of an instrument at each row, as its spans' effects make."""
+    errors = np.array([sensor_error(effects, channel) for effects in spans.effects])
+    return errors[spans.which, 0], errors[spans.which, 1]
+
+
+def _measure(plan: Plan, spans: Spans, rng: np.random.Generator,
              flow: FloatArray, speed: FloatArray, dp: FloatArray,
              channels: dict[str, FloatArray], noise: float) -> BenchTable:
     n = flow.size
-    gain_q, offset_q = sensor_error(effects, 'flow')
-    gain_n, offset_n = sensor_error(effects, 'speed')
+    gain_q, offset_q = _errors(spans, 'flow')
+    gain_n, offset_n = _errors(spans, 'speed')
     sd_q = np.hypot(plan.noise_flow_lpm * LPM, plan.noise_flow_rel * flow) * noise
     flow_m = gain_q * flow + offset_q + rng.normal(0.0, 1.0, n) * sd_q
     speed_m = (gain_n * speed + offset_n
@@ -278,13 +309,118 @@ def _effects(base: MotorModel, injections: tuple[Injection, ...], speed: FloatAr
     return tuple(e for e in effects if e is not None)
 
 
+@dataclass(frozen=True)
+class Spans:
+    """Stretches of a recording between onsets: the effects of each and the span of each row."""
+
+    effects: tuple[tuple[Effect, ...], ...]  # what is injected in each span
+    which: np.ndarray  # span of each row [-]
+
+    def __getitem__(self, rows: slice) -> Spans:
+        """Return the spans of some rows."""
+        return Spans(self.effects, self.which[rows])
+
+
+def base_model(plan: Plan) -> MotorModel:
+    """
+    Build the motor a plan's data come from: the packaged SM-0,75/25, or a family's.
+
+    Parameters
+    ----------
+    plan : Plan
+        Liquid, family and displacement, [-]
+
+    Returns
+    -------
+    MotorModel
+        The model (without effects).
+
+    """
+    if not plan.family and not plan.displacement:
+        return MotorModel.from_spec(load_motor(), plan.liquid)
+    return MotorOptions(liquid=plan.liquid, family=plan.family,
+                        displacement=plan.displacement).build_model()
+
+
 def _motor_flow(plan: Plan, injections: tuple[Injection, ...], speed: FloatArray,
-                dp: FloatArray, channels: dict[str, FloatArray]
-                ) -> tuple[tuple[Effect, ...], FloatArray]:
-    """Return the injected effects and the flow the packaged motor absorbs with them, [m^3/s]."""
-    base = MotorModel.from_spec(load_motor(), plan.liquid)
-    effects = _effects(base, injections, speed, dp, channels)
-    return effects, true_flow(base, effects, speed, dp, channels)
+                dp: FloatArray, channels: dict[str, FloatArray]) -> tuple[Spans, FloatArray]:
+    """Return the injected effects per span and the flow the motor absorbs with them, [m^3/s]."""
+    base = base_model(plan)
+    time = channels['time']
+    steps = sorted({i.onset for i in injections if i.onset > time[0]})
+    effect_of = {}
+    for i, injection in enumerate(injections):  # each scaled on the rows it acts on
+        rows = time >= injection.onset
+        if rows.any():
+            effect_of[i] = injected_effect(base, injection, speed[rows], dp[rows],
+                                           {k: v[rows] for k, v in channels.items()})
+    which = np.searchsorted(np.asarray(steps), time, side='right')
+    flow = np.empty_like(speed)
+    spans = []
+    for span, start in enumerate([-math.inf, *steps]):
+        effects = tuple(e for i, e in effect_of.items()
+                        if e is not None and injections[i].onset <= max(start, time[0]))
+        spans.append(effects)
+        rows = which == span
+        if rows.any():
+            flow[rows] = true_flow(base, effects, speed[rows], dp[rows],
+                                   {k: v[rows] for k, v in channels.items()})
+    return Spans(tuple(spans), which), flow
+
+
+def wear_kind(family: str) -> str:
+    """
+    Name the wear a motor of `family` has: the Wear kind of the registry made for it.
+
+    Parameters
+    ----------
+    family : str
+        Model family; '' the default's, [-]
+
+    Returns
+    -------
+    str
+        ``clearance_wear`` (sliwinski2017) or ``leakage_wear`` (balawender, paszota).
+
+    """
+    family = family or 'sliwinski2017'
+    return next(k.name for k in ranked() if isinstance(k, Wear)
+                and (k.families is None or family in k.families))
+
+
+def aging(family: str = '', wear: float = 1.0, fault: Injection | None = None,
+          liquid: str = 'oil', temperature_span: float = 0.0) -> tuple[Injection, ...]:
+    """
+    Build the injections of an ageing motor: its family's wear over the data, and a fault.
+
+    Parameters
+    ----------
+    family : str
+        Model family; '' the default's, [-]
+    wear : float
+        Factor on the wear's realistic growth over the recording (:data:`REALISTIC`:
+        clearances 1.5 um in oil; :data:`FAMILY_REALISTIC`: the leakage +50 %); 0: no
+        wear, [-]
+    fault : Injection, optional
+        A step fault (an injection with its `onset`), [-]
+    liquid : str
+        ``'oil'`` or ``'water'``, [-]
+    temperature_span : float
+        The losses follow the temperature over this span, by the liquid's own viscosity
+        law (``viscosity_temperature``), as a real motor's do; 0: the temperature column
+        is drawn but the losses do not depend on it, [K]
+
+    Returns
+    -------
+    tuple of Injection
+        For :func:`generate_series` (at a slow rate for hours; ``Plan.temperature_jitter``
+        0 for a temperature that moves as a tank's) and the others.
+
+    """
+    worn = (Injection.realistic(wear_kind(family), wear, liquid),) if wear else ()
+    warm = ((Injection('viscosity_temperature', temperature_span, 'temperature'),)
+            if temperature_span else ())
+    return worn + warm + ((fault,) if fault is not None else ())
 
 
 def _injections(injection: Injection | Sequence[Injection]) -> tuple[Injection, ...]:
@@ -319,8 +455,8 @@ def generate(plan: Plan, injection: Injection | Sequence[Injection],
     injections = _injections(injection)
     channels = _channels(plan, injections, rng, time, n, np.arange(n))
     channels['revolutions'] = revolutions(speed, np.diff(time, prepend=0.0))
-    effects, flow = _motor_flow(plan, injections, speed, dp, channels)
-    return _measure(plan, effects, rng, flow, speed, dp, channels, 1.0)
+    spans, flow = _motor_flow(plan, injections, speed, dp, channels)
+    return _measure(plan, spans, rng, flow, speed, dp, channels, 1.0)
 
 
 def with_outliers(table: BenchTable, rows: Sequence[int], size_lpm: Sequence[float]) -> BenchTable:
@@ -395,8 +531,8 @@ def generate_series(plan: Plan, injection: Injection | Sequence[Injection], seed
     injections = _injections(injection)
     channels = _channels(plan, injections, rng, time, steps, k)
     channels['revolutions'] = revolutions(speed, 1.0 / rate)
-    effects, flow = _motor_flow(plan, injections, speed, dp, channels)
-    table = _measure(plan, effects, rng, flow, speed, dp, channels, noise)
+    spans, flow = _motor_flow(plan, injections, speed, dp, channels)
+    table = _measure(plan, spans, rng, flow, speed, dp, channels, noise)
     return replace(table, time_series=True)
 
 
@@ -425,7 +561,7 @@ def first_order(x: FloatArray, dt: float, tau: float) -> FloatArray:
 
     """
     if tau <= 0.0:
-        return np.asarray(x, dtype=float).copy()
+        return np.array(x, dtype=np.float64)
     e = np.exp(-dt / tau)
     c = 1.0 - tau / dt * (1.0 - e)
     y, _ = lfilter([c, 1.0 - e - c], [1.0, -e], x, zi=[(1.0 - c) * x[0]])
@@ -499,13 +635,13 @@ def generate_transient(plan: Plan, injection: Injection | Sequence[Injection],
     channels = _channels(plan, injections, rng, time, steps, k)
     channels['p_out'] = first_order(channels['p_out'], dt, tau_s)
     channels['revolutions'] = revolutions(speed, dt)
-    effects, flow = _motor_flow(plan, injections, speed, dp, channels)
+    spans, flow = _motor_flow(plan, injections, speed, dp, channels)
     flow = flow + dynamics.line_compliance * np.gradient(channels['p_out'] + dp, dt)
     flow = first_order(flow, dt, dynamics.flow_lag)
     read_speed = first_order(speed, dt, dynamics.speed_lag)
     pick = slice(None, None, oversample)
     channels = {name: x[pick] for name, x in channels.items()}
-    table = _measure(plan, effects, rng, flow[pick], read_speed[pick], dp[pick], channels,
+    table = _measure(plan, spans[pick], rng, flow[pick], read_speed[pick], dp[pick], channels,
                      noise)
     return replace(table, time_series=True)
 
@@ -530,8 +666,7 @@ def write_bag_of(path: str | Path, table: BenchTable, storage: str = 'mcap',
         What the bag records of itself (:mod:`satmotor_ros.bags.custom`), [-]
 
     """
-    from satmotor_ros.bags import (encode_many, FLOAT64, FLUID_PRESSURE, JOINT_STATE,
-                                   OutTopic, TEMPERATURE, write_bag)
+    from satmotor_ros.bags import encode_many, OutTopic, write_bag
     t_ns = 1_700_000_000_000_000_000 + np.round(table.channels['time'] * 1e9).astype(np.int64)
 
     def pressure(name: str, p: FloatArray) -> OutTopic:  # FluidPressure is absolute
@@ -625,102 +760,3 @@ def parse_injection(text: str, liquid: str) -> Injection:
     msg = (f'--effect {text!r}: use NAME or NAME*SCALE (NAME one of {", ".join(REALISTIC)}), '
            'term:EXPR=LPM (e.g. term:dp^0.76=0.8) or threshold:dp=LPM@MPA')
     raise ValueError(msg)
-
-
-def _replaceable(path: Path, columns: dict[str, tuple[str, FloatArray]]) -> bool:
-    """Whether `path` is free or a table this command wrote (the same header line)."""
-    if not (path.exists() or path.is_symlink()):
-        return True
-    header = ','.join(f'{name} [{unit}]' for name, (unit, _) in columns.items())
-    try:
-        with path.open('rb') as file:
-            return path.is_file() and file.readline().rstrip(b'\r\n') == header.encode()
-    except OSError:
-        return False
-
-
-def main(argv: list[str] | None = None) -> int:
-    """
-    Write a synthetic bench CSV: ``python -m satmotor_ros.identify.synthetic``.
-
-    Parameters
-    ----------
-    argv : list of str, optional
-        Command-line arguments, [-]
-
-    Returns
-    -------
-    int
-        0, or 2 with one line on stderr for a bad option, a model that cannot be built or
-        an ``--out`` that exists and was not written by this command (``--force`` replaces it).
-
-    """
-    import argparse
-    from satmotor_ros.identify.table import write_csv
-    parser = argparse.ArgumentParser(description='Write a synthetic bench table (CSV) from '
-                                                 'the model with effects injected.')
-    parser.add_argument('--liquid', default='oil')
-    parser.add_argument('--effect', action='append', default=[],
-                        help='NAME or NAME*SCALE (NAME one of '
-                             f'{", ".join(REALISTIC)}), term:EXPR=LPM or threshold:dp=LPM@MPA; '
-                             'repeatable (default: none)')
-    parser.add_argument('--outlier', action='append', default=[], metavar='ROW:LPM',
-                        help='add LPM l/min to the flow of row ROW (repeatable)')
-    parser.add_argument('--seed', type=int, default=0)
-    parser.add_argument('--points', type=int, default=100)
-    parser.add_argument('--series', type=int, default=None, metavar='SAMPLES',
-                        help='write a 100 Hz time series of this many samples instead')
-    parser.add_argument('--transient', type=float, default=None, metavar='SECONDS',
-                        help='write a 100 Hz recording of this length whose set-points change '
-                             'every 0.6-1.5 s, with a line volume and sensor lags '
-                             '(REALISTIC_DYNAMICS) instead')
-    parser.add_argument('--bag', choices=('mcap', 'sqlite3'), default=None,
-                        help='write the time series as a rosbag2 bag (directory --out)')
-    parser.add_argument('--out', required=True, help='CSV file (or bag directory) to write')
-    parser.add_argument('--force', action='store_true',
-                        help='replace an existing --out CSV that this command did not write')
-    args = parser.parse_args(argv)
-    for option, value, least in (('--points', args.points, 2), ('--series', args.series, 2),
-                                 ('--transient', args.transient, 0.1)):
-        if value is not None and not value >= least:
-            parser.error(f'{option} {value!r}: must be at least {least:g}')
-    plan = Plan(liquid=args.liquid, n_points=args.points)
-    try:
-        injections = [parse_injection(e, args.liquid) for e in args.effect] or [Injection()]
-        rows, sizes = zip(*((int(r), float(v)) for r, v in
-                            (o.split(':') for o in args.outlier))) if args.outlier else ((), ())
-    except ValueError as err:
-        parser.error(str(err) if str(err).startswith('--') else
-                     f'--outlier {args.outlier!r}: use ROW:LPM, e.g. 7:1.5')
-    try:
-        if args.transient is not None:
-            table = generate_transient(plan, injections, REALISTIC_DYNAMICS, args.seed,
-                                       duration_s=args.transient)
-        elif args.series is not None:
-            table = generate_series(plan, injections, args.seed, samples=args.series)
-        else:
-            table = generate(plan, injections, args.seed)
-        if any(not 0 <= row < len(table) for row in rows):
-            parser.error(f'--outlier {args.outlier!r}: a row from 0 to {len(table) - 1}')
-        if rows:
-            table = with_outliers(table, rows, sizes)
-        Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-        if args.bag:
-            write_bag_of(args.out, table, args.bag)
-        else:
-            columns = to_columns(table)
-            if not (args.force or _replaceable(Path(args.out), columns)):
-                parser.error(f'--out {args.out!r} exists and is not a table this command wrote; '
-                             'choose a new path or pass --force to replace it')
-            write_csv(args.out, columns)
-    except (ValueError, OSError) as err:  # a model or bag error, a path that cannot be written
-        parser.error(f'{err}' if str(err) else f'--out {args.out!r}: {err!r}')
-    described = ', '.join(f'{i.effect} (magnitude {i.magnitude:.4g})' for i in injections)
-    print(f'wrote {args.out}: {len(table)} rows, {args.liquid}, {described}'
-          + (f', outliers at rows {", ".join(map(str, rows))}' if rows else ''))
-    return 0
-
-
-if __name__ == '__main__':
-    import sys
-    sys.exit(main())

@@ -13,7 +13,7 @@ from satmotor_ros.identify.errors import DataError
 from satmotor_ros.identify.textfile import read_cells, SANITY, shorten, split_unit
 from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.errors import UnitError
-from satmotor_ros.model.units import (ATMOSPHERE, kinds, pressure_reference, RPM, to_si,
+from satmotor_ros.model.units import (ATMOSPHERE, gauge, kinds, pressure_reference, RPM, to_si,
                                       units_of)
 
 REQUIRED = ('speed', 'flow', 'p_in', 'p_out')
@@ -169,7 +169,7 @@ def column_to_si(name: str, unit: str, values: FloatArray) -> FloatArray:
         return values
     unit = _known_spelling(kind, unit)
     if kind == 'pressure' and pressure_reference(unit) == 'absolute':
-        return values * _affine(unit, kind)[0] - ATMOSPHERE
+        return gauge(values * _affine(unit, kind)[0])
     if (kind, unit) in _EXTRA_UNITS:
         return values * _EXTRA_UNITS[(kind, unit)]
     if not unit:
@@ -538,4 +538,6 @@ def write_csv(path: str | Path, columns: Mapping[str, tuple[str, np.ndarray]]) -
     """
     header = ','.join(f'{name} [{unit}]' for name, (unit, _) in columns.items())
     data = np.column_stack([np.asarray(v, dtype=float) for _, v in columns.values()])
-    np.savetxt(path, data, delimiter=',', header=header, comments='', fmt='%.9g')
+    # time in epoch seconds needs 15 digits for its hundredths; 9 rounded it to 10 s
+    fmt = ['%.15g' if name == 'time' else '%.9g' for name in columns]
+    np.savetxt(path, data, delimiter=',', header=header, comments='', fmt=fmt)

@@ -60,8 +60,11 @@ MAX_ROWS = 20_000
 MAX_CORRELATION = 0.9999
 """A dynamic term this correlated with the others (r of its fit on them) is left out."""
 
-MIN_BLOCKS = 10
-"""Fewest blocks a batch-means estimate of the variance inflation uses."""
+MIN_LAGS = 10
+"""The variance inflation looks at lags up to N / MIN_LAGS, and at series of 2 MIN_LAGS or more."""
+
+QUIET_LAGS = 5
+"""Autocorrelations in a row within chance that end the residuals' memory (Politis: >= 5)."""
 
 END_SAMPLES = 7
 """Samples of the local fit that gives a bin's end values (a third of their noise variance)."""
@@ -700,16 +703,26 @@ def dynamics_summary(fit: FitReport, samples: Samples) -> list[dict[str, Any]]:
 
 
 def variance_inflation(residual: FloatArray) -> float:
-    """
+    r"""
     Estimate how much the correlation of neighbouring residuals inflates a variance.
 
-    Batch means: the residuals in time order are cut into blocks of b and the
-    inflation is b var(block means) / var(residuals), the factor by which the
-    variance of a mean (and of a least-squares coefficient on a slowly varying
-    regressor) exceeds the independent case; N / inflation is the effective
-    number of samples. Blocks shorter than the residuals' memory underestimate
-    it, so b doubles from ceil(sqrt(N)) while at least :data:`MIN_BLOCKS` blocks
-    remain, and the largest estimate counts.
+    The inflation is the long-run variance over the variance, :math:`1 + 2\sum_k
+    \lambda(k/M)\,\rho_k`, from the residuals' own autocorrelation :math:`\rho_k` (in
+    time order) through Politis' flat-top lag window (:math:`\lambda = 1` to M/2, falling
+    linearly to 0 at M): the factor by which the variance of a mean (and of a least-squares
+    coefficient on a slowly varying regressor) exceeds the independent case; N / inflation
+    is the effective number of samples. M is twice the memory m: the first lag after which
+    :data:`QUIET_LAGS` autocorrelations in a row stay below
+    :math:`2\sqrt{\log_{10} N / N}` (what N independent residuals pass by chance), so the
+    window reaches as far as the data show a positive correlation and no further (the
+    negative lobes that a short series' estimates show by chance would cancel it), and
+    at most sqrt(N) (or N / :data:`MIN_LAGS`) lags: further lags rest on too few
+    independent pairs, and a slow effect the model still lacks (wear, before it is
+    found) would count as noise that leaves a handful of effective rows. A flat
+    window is not biased down over the memory as Bartlett's, and is far steadier than batch
+    means, whose longest blocks decide with a few means each: on noise like the MBARI logs'
+    (a 0.12 s Gaussian correlation, 0.2 s rows, inflation 2.36) batch means gave 1.1-3.5
+    (sd 0.75), this gives 2.24 (sd 0.20) over 850 rows.
 
     Parameters
     ----------
@@ -723,20 +736,46 @@ def variance_inflation(residual: FloatArray) -> float:
 
     """
     r = residual[np.isfinite(residual)]
-    if r.size < 2 * MIN_BLOCKS:
+    if r.size < 2 * MIN_LAGS:
         return 1.0
     r = r - r.mean()
     variance = float(np.mean(r ** 2))
     if variance == 0.0:
         return 1.0
-    inflation = 1.0
-    b = int(np.ceil(np.sqrt(r.size)))
-    while r.size // b >= MIN_BLOCKS:
-        blocks = r.size // b
-        means = r[:blocks * b].reshape(blocks, b).mean(axis=1)
-        inflation = max(inflation, b * float(np.mean(means ** 2)) / variance)
-        b *= 2
-    return inflation
+    rho = autocorrelation(r, min(r.size // MIN_LAGS, int(np.ceil(np.sqrt(r.size)))))
+    quiet = rho < 2.0 * np.sqrt(np.log10(r.size) / r.size)
+    memory = rho.size
+    for m in range(rho.size - QUIET_LAGS + 1):
+        if quiet[m:m + QUIET_LAGS].all():
+            memory = m
+            break
+    width = 2 * max(memory, 1)
+    k = np.arange(1, min(width, rho.size) + 1)
+    window = np.minimum(1.0, 2.0 * (1.0 - k / width))
+    return max(1.0, 1.0 + 2.0 * float(np.sum(window * rho[:k.size])))
+
+
+def autocorrelation(residual: FloatArray, lags: int) -> FloatArray:
+    """
+    Return the autocorrelation of zero-mean residuals at lags 1 to `lags`.
+
+    Parameters
+    ----------
+    residual : ndarray
+        Zero-mean residuals in time order, [any]
+    lags : int
+        The largest lag, [-]
+
+    Returns
+    -------
+    ndarray
+        rho_1 ... rho_lags (the biased estimator: sums over N), [-]
+
+    """
+    n = residual.size
+    spectrum = np.fft.rfft(residual, 2 * n)
+    cov = np.fft.irfft(spectrum * np.conj(spectrum), 2 * n)[:lags + 1]
+    return np.asarray(cov[1:] / cov[0])
 
 
 def transient_section(summary: dict[str, Any], inflation: float) -> list[str]:

@@ -41,6 +41,8 @@ from satmotor_ros.identify.table import BenchTable
 from satmotor_ros.identify.transient import averaged, DYNAMIC_TERMS, parts_at, Samples
 from satmotor_ros.model import MotorModel
 from satmotor_ros.model._typing import FloatArray
+from satmotor_ros.model.effects import Effect, flow_reading, kind_of
+from satmotor_ros.model.engine.valves import Valves
 from satmotor_ros.model.results import PointStatus
 
 
@@ -101,7 +103,12 @@ class Validation:
 
 def _bare(model: MotorModel) -> MotorModel:
     """Return `model` without its effects: it only places the points (dp_i, usable rows)."""
-    coefficient_set = replace(model.coefficient_set, effects=())
+    return _with(model, ())
+
+
+def _with(model: MotorModel, effects: tuple[Effect, ...]) -> MotorModel:
+    """Return `model` with only `effects`."""
+    coefficient_set = replace(model.coefficient_set, effects=effects)
     return MotorModel(model.geometry, coefficient_set, model.valid_range, model.liquid,
                       model.displacement_law, model.name)
 
@@ -238,7 +245,15 @@ def _note_extrapolated(points: BenchTable, count: int, what: str) -> BenchTable:
 
 def _predicted(calibrated: CalibratedModel, points: BenchTable,
                parts: LossParts) -> tuple[FloatArray, np.ndarray]:
-    """Predict the flow reading in each row's frame (as ``parts.flow``); which are EXTRAPOLATED."""
+    """
+    Predict the flow reading in each row's frame (as ``parts.flow``); which are EXTRAPOLATED.
+
+    The motor is evaluated at the chamber drop the calibration uses; a valve across the
+    ports (:mod:`~satmotor_ros.model.engine.valves`) at the measured port drop, as the calibration
+    fitted it: through the chamber drop the model would place the valve at the port drop
+    of the motor's own flow, lower than the one measured by the channel drop of the valve's
+    flow, where a relief valve's steep law passes a fraction of what it passes.
+    """
     channels = {**points.channels, 'p_in': points.p_in, 'p_out': points.p_out}
     model = calibrated.model
     missing = [name for name in model.channels if name not in channels]
@@ -246,10 +261,20 @@ def _predicted(calibrated: CalibratedModel, points: BenchTable,
         msg = (f'{points.source}: no {", ".join(missing)} column, which the effects of '
                f'{model.name} need')
         raise DataError(msg)
+    valves = Valves(model.effects)
+    if valves:
+        kept = tuple(e for e in model.effects if not kind_of(e).bypass)
+        calibrated = CalibratedModel(_with(model, kept))
     # the model takes the signed row; the parts hold it where its loss runs forward
-    flow, status = calibrated.measured_flow(parts.rotation * parts.speed, channels,
-                                            dp_i=parts.sign * parts.dp_i)
-    return parts.sign * flow, (status & int(PointStatus.EXTRAPOLATED)) != 0
+    at = calibrated.points(model.true_speed(parts.rotation * parts.speed), channels,
+                           dp_i=parts.sign * parts.dp_i)
+    flow, extrapolated = at.flow, (at.status & int(PointStatus.EXTRAPOLATED)) != 0
+    if valves:
+        port = parts.sign * parts.dp
+        opened = [valves.flow(float(x)) for x in port]
+        flow = flow + np.array([v for v, _ in opened])
+        extrapolated = extrapolated | np.array([f for _, f in opened], dtype=bool)
+    return parts.sign * flow_reading(model.effects, flow), extrapolated
 
 
 def _validate_samples(samples: Samples, model: MotorModel, liquid: str,

@@ -10,9 +10,9 @@ motor", Polish Maritime Research 24 (2017): one function per equation in
 
 from satmotor_ros.model.coefficients import (CoefficientSet, Liquid, LossCoefficients,
                                              MotorGeometry, ValidRange)
-from satmotor_ros.model.config import (default_config_path, liquid_from_mapping, load_motor,
-                                       MotorSpec)
 from satmotor_ros.model.errors import ConfigError, InvalidInputError, ModelError, UnitError
+from satmotor_ros.model.io.config import (default_config_path, liquid_from_mapping, load_motor,
+                                          MotorSpec)
 from satmotor_ros.model.motor import MotorModel
 from satmotor_ros.model.results import (COMPONENTS, describe_status, INVALID, LossBreakdown,
                                         OperatingPoints, Point, PointStatus)

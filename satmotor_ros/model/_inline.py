@@ -37,6 +37,7 @@ import builtins
 import copy
 import functools
 import inspect
+import numbers
 import sys
 from typing import Any, Callable, cast, TypeVar
 
@@ -208,8 +209,9 @@ class _Inliner(ast.NodeTransformer):
                  and isinstance(n.target, ast.Name)}
         for name in set(names) - set(params) - local:
             value = callee.__globals__.get(name, vars(builtins).get(name, self))
-            if name.isupper() and type(value) in (float, int):
-                values[name] = ast.Constant(value)  # a unit or constant: its value
+            if name.isupper() and (type(value) is float or isinstance(value, numbers.Integral)):
+                number = value if type(value) is float else int(value)  # a flag: a uint8
+                values[name] = ast.Constant(number)  # a unit or constant: its value
             elif value is not self.namespace.get(name, vars(builtins).get(name)) or (
                     name in self.rebound):
                 return node  # the builder's module, or the builder itself, has another `name`
@@ -242,15 +244,47 @@ class _Inliner(ast.NodeTransformer):
         return name
 
 
-def _compile(builder: Builder, classes: dict[str, type]) -> Builder:
-    """Return `builder` recompiled with its calls inlined; `classes`: arguments' types by name."""
+def _tests(node: ast.expr) -> bool:
+    """Whether `node` is a comparison, or ``|`` of comparisons: a bool on Python floats."""
+    if isinstance(node, ast.BinOp) and isinstance(node.op, ast.BitOr):
+        return _tests(node.left) and _tests(node.right)
+    return isinstance(node, ast.Compare) or isinstance(node, ast.BoolOp) and isinstance(
+        node.op, ast.Or)
+
+
+class _OnFloats(ast.NodeTransformer):
+    """
+    Write a rule's tests as Python does on floats: the same values, fewer operations.
+
+    ``|`` of comparisons becomes ``or`` (the later tests skipped), and a test times a flag,
+    ``(x < 0.0) * 2``, becomes ``(2 if x < 0.0 else 0)``.
+    """
+
+    def visit_BinOp(self, node: ast.BinOp) -> ast.expr:  # noqa: N802 (ast's name)
+        self.generic_visit(node)
+        if _tests(node):
+            return ast.copy_location(ast.BoolOp(ast.Or(), [node.left, node.right]), node)
+        if (isinstance(node.op, ast.Mult) and _tests(node.left)
+                and isinstance(node.right, ast.Constant) and type(node.right.value) is int):
+            return ast.copy_location(ast.IfExp(node.left, node.right, ast.Constant(0)), node)
+        return node
+
+
+def _compile(builder: Builder, classes: dict[str, type], floats: bool = False) -> Builder:
+    """
+    Return `builder` recompiled with its calls inlined; `classes`: arguments' types by name.
+
+    With `floats`, the builder runs on Python floats only, and the rules it inlines (written
+    for floats and arrays alike, ``(a < b) | (c < d)``) test as Python does on floats.
+    """
     node = _parse(builder)
     if node is None:
         return builder
     node.decorator_list = []
     module = sys.modules[builder.__module__]
     inliner = _Inliner(vars(module), _bound(node), classes)
-    tree = ast.Module(body=[inliner.visit(node)], type_ignores=[])
+    inlined = inliner.visit(node)
+    tree = ast.Module(body=[_OnFloats().visit(inlined) if floats else inlined], type_ignores=[])
     ast.fix_missing_locations(tree)
     namespace: dict[str, Any] = {}
     code = compile(tree, inspect.getsourcefile(builder) or '<inlined>', 'exec',
@@ -276,6 +310,28 @@ def inline_equations(builder: Builder) -> Builder:
 
     """
     return _compile(builder, {})
+
+
+def inline_on_floats(builder: Builder) -> Builder:
+    """
+    Return a function of Python floats recompiled with its equation and rule calls inlined.
+
+    As :func:`inline_equations`, and ``|`` of comparisons (how a rule written for floats and
+    arrays alike combines its tests) becomes ``or``, which on floats gives the same bool and
+    skips the tests after the first true one: the single-point path's form of the rules.
+
+    Parameters
+    ----------
+    builder : callable
+        A function or method that runs on Python floats only, [-]
+
+    Returns
+    -------
+    callable
+        The function, compiled from the inlined tree.
+
+    """
+    return _compile(builder, {}, floats=True)
 
 
 def inline_per_class(argument: str) -> Callable[[Builder], Builder]:

@@ -10,7 +10,6 @@ the array maps alike.
 
 from __future__ import annotations
 
-from collections.abc import Callable
 import math
 
 import numpy as np
@@ -20,9 +19,8 @@ from satmotor_ros.model._typing import Real
 
 def maximum(x: Real, floor: float) -> Real:
     """Return the larger of `x` and `floor`, elementwise; NaN stays NaN, as in numpy."""
-    if type(x) is float:
-        return floor if x < floor else x
-    return np.maximum(x, floor)
+    # one expression, so that a composition or the single-point path inlines it
+    return (floor if x < floor else x) if type(x) is float else np.maximum(x, floor)
 
 
 def log(x: Real) -> Real:
@@ -37,14 +35,3 @@ def minimum(x: Real, ceiling: float) -> Real:
     if type(x) is float:
         return ceiling if x > ceiling else x
     return np.minimum(x, ceiling)
-
-
-def maximum_for(like: Real) -> Callable[[Real, float], Real]:
-    """
-    Return the elementwise maximum for values of the kind of `like`, for a loop to reuse.
-
-    The builtin :func:`max` for a float (a C call, NaN kept as the first
-    argument), :func:`numpy.maximum` for an array: the choice of
-    :func:`maximum` made once instead of on every call.
-    """
-    return max if type(like) is float else np.maximum

@@ -5,7 +5,7 @@ Liquids, motor geometry and loss coefficients as frozen, validated records.
 Geometry and liquids are SI. The loss coefficients are the empirical fits of
 Śliwiński (2017), Table 1, and only mean something in the unit system they
 were fitted in; each field states that system (doc/PAPER_MODEL.md, "Units"). The
-equation functions in :mod:`satmotor_ros.model.losses` take SI arrays and do
+equation functions in :mod:`satmotor_ros.model.families.sliwinski2017.losses` take SI arrays and do
 the conversion, so no caller ever sees the paper's units.
 """
 
@@ -13,13 +13,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass, fields
 import math
-from typing import TYPE_CHECKING
+from typing import Any
 
 from satmotor_ros.model.errors import ConfigError
 from satmotor_ros.model.units import CM3_PER_REV
-
-if TYPE_CHECKING:
-    from satmotor_ros.model.effects import Effect
 
 
 class FieldError(ConfigError):
@@ -203,6 +200,47 @@ class ValidRange:
         _check('valid_range', 'speed_max', self.speed_max, 0.0, 1.0e6)
         _check('valid_range', 'dp_min', self.dp_min, 0.0, self.dp_max, closed_low=True)
         _check('valid_range', 'speed_min', self.speed_min, 0.0, self.speed_max, closed_low=True)
+
+
+@dataclass(frozen=True)
+class Effect:
+    """One effect of a coefficient set (or injected into the plant), SI (temperature in degC)."""
+
+    name: str  # id as in the YAML: a kind, or '<kind>:<suffix>' ('channel:aux', 'term:dp^2')
+    coefficient: float  # k, in the unit the kind implies (m^3/(s*Pa), m/s, -, ...)
+    regressor: str = ''  # channel or expression the effect reads
+    reference: float = 0.0  # x where the effect is zero (wear, channel) [unit of x]
+    law: str = ''  # viscosity_temperature: 'walther' or 'vogel'; '' the liquid's own
+    reference_temperature: float = math.nan  # where the viscosity is the liquid's [degC]
+    reference_viscosity: float = math.nan  # the viscosity there; NaN the liquid's [m^2/s]
+    vogel_c: float = 140.0  # Vogel C [K]
+    options: tuple[tuple[str, Any], ...] = ()  # further parameters of a new kind, by name
+    fitted_range: tuple[tuple[str, float, float], ...] = ()  # (quantity, min, max) of the data
+    # it was fitted on, SI, one per quantity of EffectKind.reads; () when not known (no flag)
+    direction: str = 'both'  # sign of dp = p_a - p_b where it acts: 'positive', 'negative'
+
+    @property
+    def kind(self) -> str:
+        """Return the kind, without a ``:<suffix>``."""
+        return self.name.split(':', 1)[0]
+
+    @property
+    def key(self) -> str:
+        """Return the id with its direction, ``threshold:dp@negative``: unique in a set."""
+        return self.name if self.direction == 'both' else f'{self.name}@{self.direction}'
+
+    def acts(self, negative: bool) -> bool:
+        """Return whether the effect acts where dp < 0 (`negative`) or dp >= 0."""
+        return self.direction == 'both' or (self.direction == 'negative') == negative
+
+    @property
+    def suffix(self) -> str:
+        """Return what follows ``<kind>:`` in the name, or ''."""
+        return self.name.partition(':')[2]
+
+    def option(self, key: str, default: Any = None) -> Any:
+        """Return the kind-specific parameter `key` of :attr:`options`, or `default`."""
+        return dict(self.options).get(key, default)
 
 
 @dataclass(frozen=True)

@@ -19,28 +19,28 @@ with ``errors='raise'`` (the default) the first bad element raises
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterable, Mapping
+from dataclasses import replace
 from typing import Any, Literal
 
 import numpy as np
 
 from satmotor_ros.model._typing import ArrayLike, FloatArray, Real
-from satmotor_ros.model.coefficients import (CoefficientSet, Liquid, MotorGeometry,
-                                             ValidRange)
-from satmotor_ros.model.conditioned import ConditionedModel, map_points
-from satmotor_ros.model.config import load_motor, MotorSpec
-from satmotor_ros.model.core import ModelCore
-from satmotor_ros.model.effects import kind_of, true_flow, true_speed
+from satmotor_ros.model.coefficients import CoefficientSet, Liquid, MotorGeometry, ValidRange
+from satmotor_ros.model.effects import check_effects, Effect, kind_of, true_flow, true_speed
+from satmotor_ros.model.engine.conditioned import ConditionedModel, map_points
+from satmotor_ros.model.engine.core import ModelCore
+from satmotor_ros.model.engine.forward import absorbency_map
+from satmotor_ros.model.engine.inverse import speed_map
+from satmotor_ros.model.engine.point import as_float, invalid_point
+from satmotor_ros.model.engine.quadrants import chamber_drop, Channels, Quadrants, signed_map
+from satmotor_ros.model.engine.screening import Errors
+from satmotor_ros.model.engine.valves import Valves
 from satmotor_ros.model.errors import ModelError
 from satmotor_ros.model.families import DEFAULT_FAMILY, Family
 from satmotor_ros.model.families.defaults import default_motor
-from satmotor_ros.model.forward import absorbency_map
-from satmotor_ros.model.inverse import speed_map
-from satmotor_ros.model.point import as_float, invalid_point
-from satmotor_ros.model.quadrants import chamber_drop, Channels, Quadrants, signed_map
+from satmotor_ros.model.io.config import load_motor, MotorSpec
 from satmotor_ros.model.results import LossBreakdown, OperatingPoints, Point, PointStatus
-from satmotor_ros.model.screening import Errors
-from satmotor_ros.model.valves import Valves
 
 DisplacementLaw = Literal['eq33', 'eq39']
 
@@ -155,8 +155,6 @@ class MotorModel:
     c_b = _derived('c_b', 'C_b of eq. (13), [1/(MPa*rev)].')
     c_lumped = _derived('c_lumped', 'C of eq. (33) for this liquid (``coef.c`` is the fitted '
                         'one), [1/(MPa*rev)].')
-    c = _derived('c_lumped', 'Alias of :attr:`c_lumped`, kept for existing callers, '
-                 '[1/(MPa*rev)].')
     dp_limit = _derived('dp_limit', 'Chamber drop where eq. (1) would start to fall with '
                         'pressure, [Pa].')
 
@@ -602,3 +600,32 @@ class MotorModel:
 
         """
         return true_speed(self.effects, reading)
+
+
+def with_effects(model: MotorModel, effects: Iterable[Effect]) -> MotorModel:
+    """
+    Return the model with `effects` added to its coefficient set.
+
+    Parameters
+    ----------
+    model : MotorModel
+        The motor, [-]
+    effects : iterable of Effect
+        Motor effects to add, [-]
+
+    Returns
+    -------
+    MotorModel
+        The same motor, liquid and law, evaluating the effects (`model` when there are none).
+
+    """
+    effects = tuple(effects)
+    if not effects:
+        return model
+    spec = model.coefficient_set
+    coef = spec.coefficients
+    for effect in effects:
+        coef = kind_of(effect).coefficients(effect, coef)
+    combined = check_effects((*spec.effects, *effects), 'effects', model.family.name)
+    return type(model)(model.geometry, replace(spec, coefficients=coef, effects=combined),
+                       model.valid_range, model.liquid, model.displacement_law, model.name)

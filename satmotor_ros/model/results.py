@@ -10,9 +10,32 @@ from typing import NamedTuple
 import numpy as np
 import numpy.typing as npt
 
-from satmotor_ros.model._typing import FloatArray
+from satmotor_ros.model._typing import FloatArray, Real
 from satmotor_ros.model.coefficients import MotorGeometry
-from satmotor_ros.model.speed import speed_loss
+
+
+def speed_loss(flow: Real, speed: Real, qt: float) -> Real:
+    r"""
+    Compute the loss of speed against the theoretical speed, eq. (41).
+
+    .. math:: n_i = \frac{Q}{q_t} - n
+
+    Parameters
+    ----------
+    flow : float or ndarray
+        Flow into the motor Q, [m^3/s]
+    speed : float or ndarray
+        Effective shaft speed n, [rad/s]
+    qt : float
+        Theoretical displacement q_t, [m^3/rad]
+
+    Returns
+    -------
+    float or ndarray
+        Speed loss n_i, [rad/s]
+
+    """
+    return flow / qt - speed
 
 
 class PointStatus(enum.IntFlag):

@@ -13,6 +13,7 @@ from __future__ import annotations
 import math
 import re
 
+from satmotor_ros.model._typing import Real
 from satmotor_ros.model.errors import UnitError
 
 LPM = 1.0e-3 / 60.0
@@ -35,6 +36,47 @@ CM3_PER_REV = 1.0e-6 / (2.0 * math.pi)
 
 ATMOSPHERE = 101325.0
 """Standard atmosphere in Pa: absolute (sensor_msgs/FluidPressure) minus this is gauge."""
+
+
+def gauge(absolute: Real) -> Real:
+    """
+    Return an absolute pressure as gauge, the one conversion of readings (float or array).
+
+    Parameters
+    ----------
+    absolute : float or ndarray
+        Absolute pressure, [Pa]
+
+    Returns
+    -------
+    float or ndarray
+        absolute - :data:`ATMOSPHERE`, below 0 under vacuum, [Pa]
+
+    """
+    return absolute - ATMOSPHERE
+
+
+def channel_gauge(absolute: Real) -> Real:
+    """
+    Return an absolute pressure as the gauge channel an effect reads: never below 0.
+
+    Below atmosphere nothing is driven out of the motor; NaN stays NaN (it is
+    flagged where it is read).
+
+    Parameters
+    ----------
+    absolute : float or ndarray
+        Absolute pressure, [Pa]
+
+    Returns
+    -------
+    float or ndarray
+        max(:func:`gauge`, 0), [Pa]
+
+    """
+    p = gauge(absolute)
+    return p * (p > 0.0) + 0.0  # + 0.0: -0.0 below atmosphere is 0.0; NaN * False is NaN
+
 
 INCH = 0.0254
 """One inch in m (exact, by definition)."""

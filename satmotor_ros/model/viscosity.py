@@ -23,14 +23,12 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 import math
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from satmotor_ros.model._typing import ArrayLike, FloatArray
+from satmotor_ros.model.coefficients import Liquid
 
-if TYPE_CHECKING:
-    from satmotor_ros.model.coefficients import Liquid
 
 KELVIN = 273.15
 """0 degC in K."""

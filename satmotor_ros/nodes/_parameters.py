@@ -22,9 +22,9 @@ from rcl_interfaces.msg import (FloatingPointRange, IntegerRange, ParameterDescr
 from rclpy.exceptions import InvalidParameterTypeException, InvalidParameterValueException
 from rclpy.node import Node
 from rclpy.parameter import AllowableParameterValue, Parameter
-from satmotor_ros.interface import DISPLACEMENT_LAWS, MotorOptions
 from satmotor_ros.model.coefficients import displacement_problem, DISPLACEMENT_RANGE
 from satmotor_ros.model.families import FAMILY_NAMES
+from satmotor_ros.options import DISPLACEMENT_LAWS, MotorOptions
 
 RosParameter: TypeAlias = Parameter[AllowableParameterValue]
 """A parameter as rclpy hands it to the set-parameter callbacks."""
@@ -157,22 +157,7 @@ def check(specs: Mapping[str, ParamSpec], params: Iterable[RosParameter]) -> Set
 
 
 def values(node: Node, specs: Iterable[ParamSpec]) -> dict[str, Any]:
-    """
-    Read the current values of the table's parameters.
-
-    Parameters
-    ----------
-    node : rclpy.node.Node
-        The node, [-]
-    specs : iterable of ParamSpec
-        The table, [-]
-
-    Returns
-    -------
-    dict
-        Name -> value.
-
-    """
+    """Return the current value of each parameter of the table `specs` on `node`, by name."""
     return {spec.name: node.get_parameter(spec.name).value for spec in specs}
 
 

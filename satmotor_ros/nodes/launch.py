@@ -37,3 +37,8 @@ def virtual_motor() -> None:
 def speed_controller() -> None:
     """Run the speed_controller node."""
     _launch('speed_controller')
+
+
+def motor_monitor() -> None:
+    """Run the motor_monitor node."""
+    _launch('motor_monitor')

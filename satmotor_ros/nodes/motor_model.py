@@ -27,8 +27,9 @@ from rclpy.publisher import Publisher
 from rclpy.qos import qos_profile_sensor_data, QoSProfile
 from rclpy.time import Time
 from rclpy.timer import Timer
-from satmotor_ros.interface import (CHANNELS, JOINT_NAME, LOSS_COMPONENTS, LOSSES_ARRAY,
-                                    LOSSES_PREFIX, PREDICTED_JOINT_STATE, SPEED_RESIDUAL)
+from satmotor_ros.interface import (CHANNELS, DIAGNOSTICS, JOINT_NAME, LOSS_COMPONENTS,
+                                    LOSSES_ARRAY, LOSSES_PREFIX, PREDICTED_JOINT_STATE,
+                                    SPEED_RESIDUAL)
 from satmotor_ros.model import describe_status, ModelError, MotorModel
 from satmotor_ros.nodes import _diagnostics as diag
 from satmotor_ros.nodes import _parameters as params
@@ -132,7 +133,7 @@ class MotorModelNode(Node):
         self._depth = depth
         self._pub_joint = self._publisher(JointState, PREDICTED_JOINT_STATE)
         self._pub_residual = self._publisher(Float64, SPEED_RESIDUAL)
-        self._pub_diag = self._publisher(DiagnosticArray, '/diagnostics')
+        self._pub_diag = self._publisher(DiagnosticArray, DIAGNOSTICS)
         self._pub_losses: list[Publisher[Float64]] = []
         self._pub_losses_array: Publisher[Float64MultiArray] | None = None
         self._joint_msg = JointState(name=[self._joint])  # refilled per prediction

@@ -21,7 +21,7 @@ from rcl_interfaces.msg import SetParametersResult
 from rclpy.node import Node
 from rclpy.qos import qos_profile_sensor_data
 from rclpy.time import Time
-from satmotor_ros.interface import CHANNELS, JOINT_NAME
+from satmotor_ros.interface import CHANNELS, DIAGNOSTICS, JOINT_NAME, SPEED_SETPOINT
 from satmotor_ros.model.units import RPM
 from satmotor_ros.nodes import _diagnostics as diag
 from satmotor_ros.nodes import _parameters as params
@@ -97,14 +97,14 @@ class SpeedControllerNode(Node):
         self._rejected_since = 0
         self._next_diagnostics = 0.0
         self._pub = self.create_publisher(Float64, CHANNELS['flow'].topic, 10)
-        self._diag = self.create_publisher(DiagnosticArray, '/diagnostics', 10)
+        self._diag = self.create_publisher(DiagnosticArray, DIAGNOSTICS, 10)
         sensor = qos_profile_sensor_data
         self.create_subscription(JointState, CHANNELS['measured_speed'].topic, self._on_joint,
                                  sensor)
         self.create_subscription(FluidPressure, CHANNELS['p_in'].topic, self._on_inlet, sensor)
         self.create_subscription(FluidPressure, CHANNELS['p_out'].topic, self._on_outlet,
                                  sensor)
-        self.create_subscription(Float64, 'speed_setpoint', self._on_setpoint, 10)
+        self.create_subscription(Float64, SPEED_SETPOINT, self._on_setpoint, 10)
         self._timer = self.create_timer(1.0 / self.values['rate'], self._control)
 
     @staticmethod

@@ -18,6 +18,11 @@ wall time is taken anyway (counted as ``unanswered_steps`` in the diagnostics). 
 command feeds port B and turns the shaft backwards (doc/quadrants.md); a bad command (NaN,
 beyond ``max_flow_command`` either way)
 is refused: the last good one is held, the reason logged and put on ``/diagnostics``.
+
+The motor can age: a wear that grows with the plant's running time
+(``effects.clearance_wear_rate``, ``effects.leakage_wear_rate``) and a step fault
+(``fault.time``, ``fault.effect``, ``fault.value``), on the plant's own clock, so in
+``sim`` mode hours of operation pass in minutes; ``/diagnostics`` says when the fault struck.
 """
 
 from __future__ import annotations
@@ -38,7 +43,7 @@ from rclpy.qos import qos_profile_sensor_data, QoSProfile
 from rclpy.time import Time as RosTime
 from rclpy.timer import Timer
 from rosgraph_msgs.msg import Clock as ClockMsg
-from satmotor_ros.interface import CHANNELS, JOINT_NAME, PRESSURE_TOPICS
+from satmotor_ros.interface import CHANNELS, CLOCK_TOPIC, DIAGNOSTICS, JOINT_NAME, PRESSURE_TOPICS
 from satmotor_ros.model import describe_status
 from satmotor_ros.model.units import LPM
 from satmotor_ros.nodes import _diagnostics as diag
@@ -185,9 +190,9 @@ class VirtualMotorNode(Node):
                                                 sensor, event_callbacks=quiet)
         self._temp_pub = self.create_publisher(Temperature, CHANNELS['temperature'].topic, sensor,
                                                event_callbacks=quiet)
-        self._diag_pub = self.create_publisher(DiagnosticArray, '/diagnostics', 10,
+        self._diag_pub = self.create_publisher(DiagnosticArray, DIAGNOSTICS, 10,
                                                event_callbacks=quiet)
-        self._clock_pub = self.create_publisher(ClockMsg, '/clock', QoSProfile(depth=10),
+        self._clock_pub = self.create_publisher(ClockMsg, CLOCK_TOPIC, QoSProfile(depth=10),
                                                 event_callbacks=quiet)
         self._pressure = {name: FluidPressure() for name in PRESSURE_TOPICS}
         self._flow, self._joint, self._temperature = Float64(), JointState(), Temperature()
@@ -403,6 +408,14 @@ class VirtualMotorNode(Node):
             self._next_diagnostics = reading.time + values['diagnostics_period']
             self._diagnose(stamp)
 
+    def _fault(self) -> str:
+        """Say what the step fault of ``fault.*`` is and whether it has struck."""
+        fault = self.plant.params.fault
+        if not fault.effect:
+            return 'none'
+        when = 'struck at' if self.plant.fault_struck else 'strikes at'
+        return f'effects.{fault.effect} = {fault.value:g}: {when} {fault.time:g} s'
+
     def _controllers(self) -> int:
         """Count the publishers of flow_command (as remapped)."""
         return self.count_publishers(self._command_sub.topic_name)
@@ -455,7 +468,8 @@ class VirtualMotorNode(Node):
             'unanswered_steps': self.unanswered_steps, 'flow_command publishers': controllers,
             'relief_flow [l/min]': diag.human(flows.relief, 'm^3/s')[1],
             'model_status': describe_status(plant.model_status),
-            'model_rebuilds': plant.rebuilds, 'liquid': self._setup.values['liquid'],
+            'model_rebuilds': plant.rebuilds, 'fault': self._fault(),
+            'liquid': self._setup.values['liquid'],
             'liquid_name': plant.model.liquid.name, 'liquid_source': self._liquid_source,
         }
         status = diag.status(f'{self.get_fully_qualified_name()}: plant', plant.model.name,

@@ -19,13 +19,13 @@ from typing import Any, NamedTuple
 from satmotor_ros.model.effects import Effect, KINDS, ranked
 from satmotor_ros.model.errors import ConfigError
 from satmotor_ros.plant.errors import PlantError
-from satmotor_ros.plant.params import (CaseParams, LineParams, PlantParams, ReliefParams,
-                                       SENSOR_CHANNELS, SensorParams, SensorSet, ShaftParams,
-                                       ThermalParams)
+from satmotor_ros.plant.params import (CaseParams, FaultParams, LineParams, PlantParams,
+                                       ReliefParams, SENSOR_CHANNELS, SensorParams, SensorSet,
+                                       ShaftParams, ThermalParams)
 
 GROUPS: dict[str, type] = {
     'lines': LineParams, 'relief': ReliefParams, 'shaft': ShaftParams,
-    'thermal': ThermalParams, 'case': CaseParams,
+    'thermal': ThermalParams, 'case': CaseParams, 'fault': FaultParams,
 }
 """Records of :class:`PlantParams` by their field name (the parameter prefix)."""
 
@@ -55,7 +55,8 @@ def _specs_of(record: type, prefix: str, defaults: Any) -> list[ParameterSpec]:
             continue
         low, high = f.metadata['range'] or (None, None)
         specs.append(ParameterSpec(prefix + f.name, getattr(defaults, f.name),
-                                   f.metadata['description'], f.metadata['unit'], low, high))
+                                   f.metadata['description'], f.metadata['unit'], low, high,
+                                   f.metadata['choices']))
     return specs
 
 

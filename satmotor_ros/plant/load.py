@@ -9,6 +9,7 @@ implicitly. Positive torque opposes positive rotation.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 import math
 from typing import Protocol
@@ -117,8 +118,8 @@ class SpeedProportionalLoad:
         return self.offset, self.coefficient
 
 
-LOAD_KINDS = {'constant': ConstantLoad, 'step': StepLoad, 'ramp': RampLoad,
-              'speed': SpeedProportionalLoad}
+LOAD_KINDS: dict[str, Callable[..., LoadProfile]] = {
+    'constant': ConstantLoad, 'step': StepLoad, 'ramp': RampLoad, 'speed': SpeedProportionalLoad}
 """Load profile by the name the node's ``load.kind`` parameter uses."""
 
 

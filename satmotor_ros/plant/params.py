@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: Apache-2.0
 """
-Parameter records of the virtual motor: lines, relief valve, shaft, heat, case and effects.
+Parameter records of the virtual motor: lines, relief valve, shaft, heat, case, effects, fault.
 
 Every record is frozen and checks its fields on construction; an error names the
 field and the value. Each field carries its description, unit and closed range as
@@ -16,14 +16,14 @@ from dataclasses import dataclass, field, fields
 import math
 from typing import Any
 
-from satmotor_ros.model.effects import check_effects, Effect, kind_of
+from satmotor_ros.model.effects import check_effects, Effect, kind_of, PlantParameter, ranked
 from satmotor_ros.model.errors import ConfigError
 from satmotor_ros.model.units import ATMOSPHERE, LPM, MPA
 from satmotor_ros.plant.errors import PlantError
 
 
 def parameter(default: Any, description: str, unit: str = '-', low: float | None = None,
-              high: float | None = None) -> Any:
+              high: float | None = None, choices: tuple[str, ...] = ()) -> Any:
     """
     Declare a record field with its description, unit and closed range.
 
@@ -37,16 +37,18 @@ def parameter(default: Any, description: str, unit: str = '-', low: float | None
         SI unit; ``'unit of the channel'`` for a sensor's noise and bias, [-]
     low, high : float, optional
         Closed range a number must lie in, [unit]
+    choices : tuple of str
+        Values a string may take (checked by its record), [-]
 
     Returns
     -------
     dataclasses.Field
-        The field, with ``description``, ``unit`` and ``range`` in its metadata.
+        The field, with ``description``, ``unit``, ``range`` and ``choices`` in its metadata.
 
     """
     span = None if low is None else (low, high)
-    return field(default=default,
-                 metadata={'description': description, 'unit': unit, 'range': span})
+    return field(default=default, metadata={'description': description, 'unit': unit,
+                                            'range': span, 'choices': choices})
 
 
 class Bounded:
@@ -153,6 +155,46 @@ class SensorParams(Bounded):
         0.0, 'samples per second; 0 samples at every read', 'Hz', 0.0, 1.0e6)
 
 
+def fault_parameters() -> dict[str, PlantParameter]:
+    """Return the numeric ``effects.<name>`` node parameters a fault may step, by name."""
+    return {p.name: p for kind in ranked() for p in kind.plant_parameters if not p.choices}
+
+
+@dataclass(frozen=True)
+class FaultParams(Bounded):
+    """
+    A step fault: one ``effects.<name>`` parameter steps to `value` at `time` of the plant.
+
+    The plant runs with its configured effects until its clock reaches `time`, then with
+    the same effects but that one parameter at `value` (a seal that starts passing:
+    ``external_leakage``; a flowmeter knocked: ``flow_sensor_gain``; ...), the state
+    carried over. The value is checked against the effect parameter's own range.
+    """
+
+    time: float = parameter(0.0, 'plant time at which the fault strikes', 's', 0.0, 1.0e12)
+    effect: str = parameter('', "the effects.<name> parameter that steps; '' no fault",
+                            choices=('', *fault_parameters()))
+    value: float = parameter(0.0, 'what that parameter steps to, in its own unit',
+                             'unit of the effect parameter', -1.0e9, 1.0e9)
+
+    def __post_init__(self) -> None:
+        """Reject an unknown effect parameter or a value outside its range, naming them."""
+        super().__post_init__()
+        if not self.effect:
+            return
+        target = fault_parameters().get(self.effect)
+        if target is None:
+            msg = (f'FaultParams.effect = {self.effect!r}: use one of '
+                   f'{", ".join(fault_parameters())}')
+            raise PlantError(msg)
+        low = -math.inf if target.low is None else target.low
+        high = math.inf if target.high is None else target.high
+        if not low <= self.value <= high:
+            msg = (f'FaultParams.value = {self.value!r} is outside [{low:g}, {high:g}] '
+                   f'{target.unit} of effects.{self.effect}')
+            raise PlantError(msg)
+
+
 SENSOR_CHANNELS = ('inlet_pressure', 'outlet_pressure', 'case_pressure', 'flow', 'speed',
                    'temperature')
 """The sensed channels, in the order of :class:`SensorSet` (SI units; temperature degC)."""
@@ -190,6 +232,7 @@ class PlantParams(Bounded):
     thermal: ThermalParams = field(default_factory=ThermalParams)
     case: CaseParams = field(default_factory=CaseParams)
     effects: tuple[Effect, ...] = ()  # injected effects, at most one per kind
+    fault: FaultParams = field(default_factory=FaultParams)  # a step in one effect at a time
     sensors: SensorSet = field(default_factory=SensorSet)
     active_load: bool = parameter(
         False, 'load torque drives the shaft (True) or brakes it (False)')

@@ -22,7 +22,8 @@ absolute), shaft speed omega and angle theta, liquid temperature T. Per step of 
 3. dry friction sticks and slips (Karnopp): a resting shaft stays at rest
    while the net torque is within the static limit;
 4. the temperature follows the lost power (P8), explicitly;
-5. drifting effects (viscosity, wear) rebuild the motor when their value moved.
+5. drifting effects (viscosity, wear) rebuild the motor when their value moved;
+6. a step fault (``params.fault``) swaps in its effects once the clock reaches its time.
 
 Effects are injected through their kinds (:mod:`satmotor_ros.model.effects`):
 the plant's motor model evaluates the motor effects at the plant's channels,
@@ -39,12 +40,14 @@ import numpy as np
 
 from satmotor_ros.model import MotorModel
 from satmotor_ros.model._inline import inline_equations
-from satmotor_ros.model.effects import (check_effects, Conditions, kind_of, plant_injection,
-                                        PlantInjection, sensor_error, with_effects)
+from satmotor_ros.model.effects import (check_effects, Conditions, Effect, kind_of,
+                                        plant_injection, PlantInjection, sensor_error)
 from satmotor_ros.model.errors import ConfigError
+from satmotor_ros.model.motor import with_effects
 from satmotor_ros.model.revolutions import revolutions
-from satmotor_ros.model.units import ATMOSPHERE
+from satmotor_ros.model.units import channel_gauge
 from satmotor_ros.model.viscosity import standard_law
+from satmotor_ros.plant.config import params_from_flat
 from satmotor_ros.plant.equations import (case_pressure, driving_torque, friction_torque,
                                           return_flow, temperature_rate)
 from satmotor_ros.plant.errors import PlantError
@@ -130,18 +133,37 @@ class Plant:
         self.params = params if params is not None else PlantParams()
         self.load = load if load is not None else ConstantLoad()
         self._base = model
+        self._struck = False
+        self._prepare_fault()
         self._build_motor()
         self._set_constants()
         self.reset()
 
+    def _prepare_fault(self) -> None:
+        """Build and check the effects of the step fault now, so a bad one fails at set-up."""
+        fault = self.params.fault
+        self._fault_at = math.inf  # plant time of a fault still to strike [s]
+        self._faulted: tuple[Effect, ...] = self.params.effects
+        if fault.effect:
+            self._faulted = params_from_flat({f'effects.{fault.effect}': fault.value},
+                                             self.params).effects
+            try:
+                check_effects(self._faulted, 'fault', self._base.family.name)
+            except ConfigError as err:
+                raise PlantError(str(err)) from None
+            self._fault_at = fault.time
+
     def _build_motor(self) -> None:
         """Inject the effects: the motor ones into the model, the rest sorted by kind."""
+        motor = getattr(self, '_motor', None)
+        self._rebuilt = getattr(self, '_rebuilt', 0) + (motor.rebuilds if motor else 0)
         p, base = self.params, self._base
+        effects = self._faulted if self._struck else p.effects
         try:
-            check_effects(p.effects, 'PlantParams.effects', base.family.name)
+            check_effects(effects, 'PlantParams.effects', base.family.name)
         except ConfigError as err:
             raise PlantError(str(err)) from None
-        bound = p.effects
+        bound = effects
         if bound:  # effects that leave the law to the liquid take its standard one
             law = standard_law(base.liquid, base.coefficient_set.name)
             bound = tuple(kind_of(e).bind(e, law, p.thermal.reference) for e in bound)
@@ -223,6 +245,11 @@ class Plant:
         self._w = 0.0 if self._locked else float(speed)
         self._theta = 0.0
         self._temp = self.params.thermal.initial if temperature is None else float(temperature)
+        if self._struck:  # back to t = 0: the motor as configured, the fault to come
+            self._struck = False
+            self._build_motor()
+            self._set_constants()
+        self._prepare_fault()
         self._revolutions = 0.0
         self._q_guess = None
         self._lin = (0.0, 0.0, 0.0, 0.0)  # last good (G, h, channel drop, model Q_ex)
@@ -247,9 +274,11 @@ class Plant:
         """
         self.params = params
         injected = (params.effects, params.thermal.reference)
+        self._base = model or self._base
+        self._prepare_fault()  # a fault already due strikes again at the next step
         if (model is not None or params.rebuild_tolerance != self._motor.tolerance
-                or injected != self._injected):
-            self._base = model or self._base
+                or injected != self._injected or self._struck):
+            self._struck = False
             self._build_motor()
             self._drift()
         self._set_constants()
@@ -259,7 +288,11 @@ class Plant:
 
     def _make_sensors(self) -> None:
         p = self.params
-        rng = np.random.default_rng(p.seed)
+        self._rng = np.random.default_rng(p.seed)
+        self._sensors_for(self._rng)
+
+    def _sensors_for(self, rng: np.random.Generator) -> None:
+        p = self.params
         s, effects = p.sensors, self._injection.sensors
         self._sensors = (
             Sensor(s.inlet_pressure, rng), Sensor(s.outlet_pressure, rng),
@@ -272,9 +305,14 @@ class Plant:
         return self._motor.model
 
     @property
+    def fault_struck(self) -> bool:
+        """Whether the step fault of ``params.fault`` has struck."""
+        return self._struck
+
+    @property
     def rebuilds(self) -> int:
         """How many times the drifting effects rebuilt the motor model."""
-        return self._motor.rebuilds
+        return self._rebuilt + self._motor.rebuilds
 
     @property
     def state(self) -> PlantState:
@@ -312,6 +350,16 @@ class Plant:
         self._settle(pv if pv > p else p, pv if pv > r else r, w_new, lin[2], flow)  # max()
         if self._drifting:
             self._drift()
+        if self._t >= self._fault_at:
+            self._strike()
+
+    def _strike(self) -> None:
+        """Swap in the fault's effects; the state, the sensors' noise stream carry on."""
+        self._struck, self._fault_at = True, math.inf
+        self._build_motor()
+        self._drift()
+        self._set_constants()
+        self._sensors_for(self._rng)
 
     def _load_torques(self, load_torque: float | None) -> tuple[float, float, float]:
         """Return the load torque, its slope over speed and the dry friction it adds to."""
@@ -519,9 +567,9 @@ class Plant:
 
     def _channels(self) -> dict[str, float]:
         """Return what a calibrated coefficient set's effects read (gauge Pa, degC, s, rev)."""
-        return {'p_case': max(self.case_pressure() - ATMOSPHERE, 0.0),
-                'p_in': max(self._p_in - ATMOSPHERE, 0.0),
-                'p_out': max(self._p_out - ATMOSPHERE, 0.0), 'temperature': self._temp,
+        return {'p_case': channel_gauge(self.case_pressure()),
+                'p_in': channel_gauge(self._p_in),
+                'p_out': channel_gauge(self._p_out), 'temperature': self._temp,
                 'time': self._t, 'revolutions': self._revolutions}
 
     def measure(self) -> Measurement:

@@ -22,7 +22,7 @@ import numpy.typing as npt
 from satmotor_ros.model import (COMPONENTS, describe_status, INVALID, MotorModel, Point,
                                 PointStatus)
 from satmotor_ros.model.revolutions import revolutions
-from satmotor_ros.model.units import ATMOSPHERE, LPM, MPA
+from satmotor_ros.model.units import channel_gauge, LPM, MPA
 from satmotor_ros.prediction.rule import (describe_input, FIELDS, input_level, INPUTS,
                                           InputState, Level, Snapshot, SnapshotBatch)
 
@@ -153,7 +153,7 @@ def _leakage_channel(model: MotorModel) -> str | None:
 
 def _gauge(p: Any) -> Any:
     """Absolute pressure made gauge, floored at 0 (float or array), [Pa]."""
-    return pick(p > ATMOSPHERE, p - ATMOSPHERE, 0.0)
+    return channel_gauge(p)
 
 
 def _channels(needed: tuple[str, ...], snap: Snapshot | SnapshotBatch,
@@ -207,20 +207,7 @@ class Prediction(NamedTuple):
         return self.level < Level.ERROR
 
     def output(self, name: str) -> float:
-        """
-        Return one output by name.
-
-        Parameters
-        ----------
-        name : str
-            One of :data:`OUTPUTS`, [-]
-
-        Returns
-        -------
-        float
-            Its value, [SI]
-
-        """
+        """Return the output `name` (one of :data:`OUTPUTS`), [SI]."""
         return self.outputs[OUTPUTS.index(name)]
 
 
@@ -244,57 +231,19 @@ class PredictionBatch(NamedTuple):
         return self.level < Level.ERROR
 
     def output(self, name: str) -> npt.NDArray[np.float64]:
-        """
-        Return one output by name.
-
-        Parameters
-        ----------
-        name : str
-            One of :data:`OUTPUTS`, [-]
-
-        Returns
-        -------
-        ndarray
-            Its values, [SI]
-
-        """
-        return self.outputs[OUTPUTS.index(name)]
+        """Return the output `name` (one of :data:`OUTPUTS`) of every prediction, [SI]."""
+        row: npt.NDArray[np.float64] = self.outputs[OUTPUTS.index(name)]  # numpy types it as Any
+        return row
 
     def snapshot(self, i: int) -> Snapshot:
-        """
-        Return the inputs of prediction `i` as the live node would hold them.
-
-        Parameters
-        ----------
-        i : int
-            Index of the prediction, [-]
-
-        Returns
-        -------
-        Snapshot
-            Its inputs.
-
-        """
+        """Return the inputs of prediction `i` as the live node would hold them."""
         s = self.snapshots
         return Snapshot(int(s.stamp_ns[i]), tuple(float(v) for v in s.values[:, i]),
                         tuple(float(a) for a in s.ages[:, i]),
                         tuple(int(x) for x in s.states[:, i]))
 
     def message(self, i: int) -> str:
-        """
-        Spell out prediction `i`'s problems, as the node's :class:`Prediction` does.
-
-        Parameters
-        ----------
-        i : int
-            Index of the prediction, [-]
-
-        Returns
-        -------
-        str
-            ``'OK'`` or the problems.
-
-        """
+        """Spell out prediction `i`'s problems (``'OK'`` if none), as :class:`Prediction` does."""
         return describe(self.snapshot(i), self.timeout, int(self.status[i]), self.channels)[1]
 
 

@@ -25,7 +25,7 @@ import numpy.typing as npt
 
 from satmotor_ros.interface import CHANNELS, PREDICTION_INPUTS
 from satmotor_ros.limits import RATE_MAX_PREDICTIONS
-from satmotor_ros.model.screening import CEILINGS
+from satmotor_ros.model.engine.screening import CEILINGS
 
 INPUTS = PREDICTION_INPUTS
 """The inputs of a prediction, in the order of every per-input tuple and array."""
@@ -275,7 +275,7 @@ def driving_times(rule: Rule, flow_t_ns: npt.NDArray[np.int64], first_ns: int,
 
     """
     if rule.mode == 'on_flow':
-        return np.asarray(flow_t_ns, dtype=np.int64).copy()
+        return np.array(flow_t_ns, dtype=np.int64)
     if last_ns < first_ns:
         return np.zeros(0, dtype=np.int64)
     count = (last_ns - first_ns) // rule.period_ns + 1
@@ -328,20 +328,9 @@ def combine_batch(rule: Rule, stamps_ns: npt.NDArray[np.int64],
 
 def input_level(name: str, state: int) -> Level:
     """
-    Rate an input's state: what it means for the prediction.
+    Rate the :class:`InputState` of input `name` by what it means for the prediction.
 
-    Parameters
-    ----------
-    name : str
-        Input name, [-]
-    state : int
-        Its :class:`InputState`, [-]
-
-    Returns
-    -------
-    Level
-        ERROR when no prediction may be made, WARN when it is made without this input.
-
+    ERROR when no prediction may be made, WARN when it is made without this input, else OK.
     """
     if state == InputState.FRESH:
         return Level.OK

@@ -37,31 +37,27 @@ An effect that a calibration fitted carries ``fitted_range``: the least and
 largest value of each quantity its law reads (:meth:`EffectKind.reads`) over
 the data it was fitted on (:func:`measured_range`). The model flags a point
 EXTRAPOLATED where it evaluates the effect outside that range
-(:func:`satmotor_ros.model.screening.outside_fitted`); an effect without one (a
+(:func:`satmotor_ros.model.engine.screening.outside_fitted`); an effect without one (a
 hand-written file) is never flagged for it.
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
-from dataclasses import replace
+from dataclasses import fields, replace
 import importlib
 import math
 import pkgutil
-from typing import Any, TYPE_CHECKING
+from typing import Any
 
 import numpy as np
 
 from satmotor_ros.model._typing import FloatArray, Real
-from satmotor_ros.model.effects._base import (Candidate, CandidateData, Conditions,
-                                              CORE_CHANNELS, DIRECTIONS, DOCUMENTARY, Effect,
-                                              EffectKind, finite, KINDS, Modifier,
-                                              PlantInjection, PlantParameter, SensorError,
-                                              Shape, Synthetic)
+from satmotor_ros.model.effects._base import (Candidate, CandidateData, Conditions, CORE_CHANNELS,
+                                              DIRECTIONS, DOCUMENTARY, Effect, EffectKind, finite,
+                                              KINDS, Modifier, PlantInjection, PlantParameter,
+                                              Sampled, SensorError, Shape, Synthetic)
 from satmotor_ros.model.errors import ConfigError
-
-if TYPE_CHECKING:
-    from satmotor_ros.model.motor import MotorModel
 
 
 def register(kind: EffectKind) -> EffectKind:
@@ -363,33 +359,58 @@ def check_effects(effects: Iterable[Effect], where: str,
     return effects
 
 
-def with_effects(model: MotorModel, effects: Iterable[Effect]) -> MotorModel:
+def coefficients_without(effects: Iterable[Effect], coef: Any) -> Any:
     """
-    Return the model with `effects` added to its coefficient set.
+    Return a set's coefficients without what its effects set in them (e.g. eq. (24)'s k_ex).
+
+    Each kind's :meth:`EffectKind.coefficients` applied at a coefficient of 0: the
+    coefficients the set would hold without those effects.
 
     Parameters
     ----------
-    model : MotorModel
-        The motor, [-]
     effects : iterable of Effect
-        Motor effects to add, [-]
+        The effects to take out, [-]
+    coef : dataclass
+        The family's coefficients, [-]
 
     Returns
     -------
-    MotorModel
-        The same motor, liquid and law, evaluating the effects (`model` when there are none).
+    dataclass
+        The coefficients, of the same type.
 
     """
-    effects = tuple(effects)
-    if not effects:
-        return model
-    spec = model.coefficient_set
-    coef = spec.coefficients
     for effect in effects:
-        coef = kind_of(effect).coefficients(effect, coef)
-    combined = check_effects((*spec.effects, *effects), 'effects', model.family.name)
-    return type(model)(model.geometry, replace(spec, coefficients=coef, effects=combined),
-                       model.valid_range, model.liquid, model.displacement_law, model.name)
+        coef = kind_of(effect).coefficients(replace(effect, coefficient=0.0), coef)
+    return coef
+
+
+def check_coefficients(effects: Iterable[Effect], coef: Any, where: str) -> None:
+    """
+    Refuse a set whose coefficients hold another value than an effect sets in them.
+
+    Parameters
+    ----------
+    effects : iterable of Effect
+        The set's effects, [-]
+    coef : dataclass
+        The set's coefficients, [-]
+    where : str
+        Key path of the effects for the message, [-]
+
+    Raises
+    ------
+    ConfigError
+        Naming the effect, the coefficient and both values.
+
+    """
+    for effect in effects:
+        applied = kind_of(effect).coefficients(effect, coef)
+        for field in fields(coef):
+            held, set_ = getattr(coef, field.name), getattr(applied, field.name)
+            if held != set_ and not math.isclose(held, set_, rel_tol=1e-9):
+                msg = (f'{where}.{effect.name}.coefficient = {effect.coefficient!r} differs from '
+                       f'coefficients.{field.name} = {held!r}: the set holds one value of it')
+                raise ConfigError(msg)
 
 
 def plant_injection(effects: Iterable[Effect]) -> PlantInjection:
@@ -509,8 +530,9 @@ SENSOR_KINDS = tuple(k.name for k in ranked() if k.sensor)
 
 __all__ = ['Candidate', 'CandidateData', 'Conditions', 'DIRECTION', 'DIRECTIONS', 'Effect',
            'EffectKind', 'KINDS',
-           'Modifier', 'PlantInjection', 'PlantParameter', 'SENSOR_KINDS', 'SensorError',
+           'Modifier', 'PlantInjection', 'PlantParameter', 'Sampled', 'SENSOR_KINDS',
+           'SensorError',
            'Shape', 'Synthetic', 'build_candidates', 'check_effects', 'effect_from_mapping',
            'effect_to_mapping', 'FITTED_RANGE', 'flow_reading', 'kind_of', 'measured_range',
            'plant_injection', 'ranked', 'register', 'sensor_error', 'true_flow', 'true_speed',
-           'unregister', 'with_effects']
+           'unregister', 'check_coefficients', 'coefficients_without']

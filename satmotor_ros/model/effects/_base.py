@@ -21,17 +21,15 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, replace
 import math
-from typing import Any, NamedTuple, Protocol, TYPE_CHECKING
+from typing import Any, NamedTuple, Protocol
 
 import numpy as np
 
 from satmotor_ros.model._typing import FloatArray, Real
+from satmotor_ros.model.coefficients import Effect, LossCoefficients
 from satmotor_ros.model.errors import ConfigError
 from satmotor_ros.model.units import LPM
-
-if TYPE_CHECKING:
-    from satmotor_ros.model.coefficients import LossCoefficients
-    from satmotor_ros.model.viscosity import ViscosityLaw
+from satmotor_ros.model.viscosity import ViscosityLaw
 
 
 class Loss(Protocol):
@@ -55,52 +53,6 @@ MIN_SPREAD = 1.0e-3
 
 CORE_CHANNELS = ('p_in', 'speed', 'flow')
 """Columns of every bench table, never a regressor of their own effect."""
-
-
-@dataclass(frozen=True)
-class Effect:
-    """One effect of a coefficient set (or injected into the plant), SI (temperature in degC)."""
-
-    name: str  # id as in the YAML: a kind, or '<kind>:<suffix>' ('channel:aux', 'term:dp^2')
-    coefficient: float  # k, in the unit the kind implies (m^3/(s*Pa), m/s, -, ...)
-    regressor: str = ''  # channel or expression the effect reads
-    reference: float = 0.0  # x where the effect is zero (wear, channel) [unit of x]
-    law: str = ''  # viscosity_temperature: 'walther' or 'vogel'; '' the liquid's own
-    reference_temperature: float = math.nan  # where the viscosity is the liquid's [degC]
-    reference_viscosity: float = math.nan  # the viscosity there; NaN the liquid's [m^2/s]
-    vogel_c: float = 140.0  # Vogel C [K]
-    options: tuple[tuple[str, Any], ...] = ()  # further parameters of a new kind, by name
-    fitted_range: tuple[tuple[str, float, float], ...] = ()  # (quantity, min, max) of the data
-    # it was fitted on, SI, one per quantity of EffectKind.reads; () when not known (no flag)
-    direction: str = 'both'  # sign of dp = p_a - p_b where it acts: 'positive', 'negative'
-
-    @property
-    def kind(self) -> str:
-        """Return the kind, without a ``:<suffix>``."""
-        return self.name.split(':', 1)[0]
-
-    @property
-    def key(self) -> str:
-        """Return the id with its direction, ``threshold:dp@negative``: unique in a set."""
-        return self.name if self.direction == 'both' else f'{self.name}@{self.direction}'
-
-    def acts(self, negative: bool) -> bool:
-        """Return whether the effect acts where dp < 0 (`negative`) or dp >= 0."""
-        return self.direction == 'both' or (self.direction == 'negative') == negative
-
-    @property
-    def suffix(self) -> str:
-        """Return what follows ``<kind>:`` in the name, or ''."""
-        return self.name.partition(':')[2]
-
-    @property
-    def channel(self) -> str | None:
-        """Return the measured channel the model needs for this effect, or None."""
-        return self.regressor if KINDS[self.kind].reads_channel else None
-
-    def option(self, key: str, default: Any = None) -> Any:
-        """Return the kind-specific parameter `key` of :attr:`options`, or `default`."""
-        return dict(self.options).get(key, default)
 
 
 class Conditions(NamedTuple):
@@ -249,6 +201,15 @@ class CandidateData(NamedTuple):
     law: ViscosityLaw  # the liquid's viscosity law, pinned at its viscosity
     covered: frozenset[str]  # channels a named kind reads (no generic channel: candidate)
     family: str = ''  # the model family of the parts; '' offers every kind
+    samples: Sampled | None = None  # the points are bins of a time series' samples: the
+    # samples' own port drop, so a kind nonlinear in it is averaged as the model will be
+
+
+class Sampled(NamedTuple):
+    """The samples each point (a bin of a time series) averages, for kinds that read dp."""
+
+    dp: FloatArray  # signed port drop p_a - p_b at every sample (NaN where unusable) [Pa]
+    mean: Callable[[FloatArray], FloatArray]  # a quantity at every sample -> its bin means
 
 
 class Synthetic(NamedTuple):
@@ -388,7 +349,7 @@ class EffectKind:
     reverse: bool = False  # its loss() applies only while the shaft turns backwards (n < 0)
     directional: bool = False  # it may act for one sign of dp only (Effect.direction)
     bypass: bool = False  # its loss() is a valve across the ports: f(n, port dp), beside the
-    # motor's chambers and channels (satmotor_ros.model.valves)
+    # motor's chambers and channels (satmotor_ros.model.engine.valves)
     unit: str = '-'  # unit of the coefficient
     source: str = ''  # the physics or standard the term comes from
     evaluation: str = ''  # what the model does with it (written into the YAML)

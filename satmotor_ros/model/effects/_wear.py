@@ -1,5 +1,11 @@
 # SPDX-License-Identifier: Apache-2.0
-"""What the two wear kinds share: a growth w (x - reference) >= 0, x the time or revolutions."""
+"""
+What the two wear kinds share: a growth w (x - reference) >= 0, x the time or revolutions.
+
+In the virtual motor a wear grows with the shaft's revolutions (``effects.<name>``) or with
+the plant's running time, its operating hours (``effects.<name>_rate``, per second): one of
+the two.
+"""
 
 from __future__ import annotations
 
@@ -12,6 +18,7 @@ from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.effects._base import (Candidate, CandidateData, Effect, EffectKind,
                                               maker, Modifier, Parts, Synthetic, varies,
                                               why_not)
+from satmotor_ros.model.errors import ConfigError
 
 
 class Wear(EffectKind):
@@ -50,14 +57,37 @@ class Wear(EffectKind):
                                  make=maker(self.name, name, start)))
         return out, skipped
 
+    @property
+    def rate_parameter(self) -> str:
+        """Name the node parameter of the growth per second of running time."""
+        return f'{self.name}_rate'
+
     def from_plant(self, values: Mapping[str, Any]) -> Effect | None:
-        """Wear per revolution of the plant's shaft since its start; None at 0."""
-        k = values[self.name]
-        return Effect(self.name, k, 'revolutions') if k else None
+        """
+        Wear per revolution of the plant's shaft, or per second of its time; None at 0.
+
+        Raises
+        ------
+        ConfigError
+            If both are set: a wear grows with one exposure.
+
+        """
+        per_rev, per_s = values[self.name], values[self.rate_parameter]
+        if per_rev and per_s:
+            msg = (f'effects.{self.name} = {per_rev!r} and effects.{self.rate_parameter} = '
+                   f'{per_s!r}: a wear grows with revolutions or with time, set one')
+            raise ConfigError(msg)
+        if per_s:
+            return Effect(self.name, per_s, 'time')
+        return Effect(self.name, per_rev, 'revolutions') if per_rev else None
 
     def plant_values(self, effect: Effect | None) -> dict[str, Any]:
-        """Return the wear rate of `effect`."""
-        return {self.name: 0.0 if effect is None else effect.coefficient}
+        """Return the wear rate of `effect`, per revolution or per second."""
+        values: dict[str, Any] = {self.name: 0.0, self.rate_parameter: 0.0}
+        if effect is not None:
+            key = self.rate_parameter if effect.regressor == 'time' else self.name
+            values[key] = effect.coefficient
+        return values
 
     def scaled(self, name: str, magnitude: float, regressor: str, data: Synthetic) -> Effect:
         """Grow the part by `magnitude` over the span of the regressor."""

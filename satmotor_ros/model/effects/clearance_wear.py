@@ -24,7 +24,10 @@ class ClearanceWear(Wear):
     evaluation = ('h_R and h_S grow by w (x - reference), x = time [s] or cumulative '
                   'revolutions [rev], in eqs. (1), (2) and (5)')
     plant_parameters = (PlantParameter('clearance_wear', 0.0, 'growth of h_R and h_S per '
-                                       'shaft revolution', 'm/rev', 0.0, 1.0e-6),)
+                                       'shaft revolution', 'm/rev', 0.0, 1.0e-6),
+                        PlantParameter('clearance_wear_rate', 0.0, 'growth of h_R and h_S per '
+                                       "second of the plant's running time (operating hours); "
+                                       'not with clearance_wear', 'm/s', 0.0, 1.0e-6))
 
     def condition(self, effect: Effect, x: float, now: Conditions) -> Conditions:
         """Grow the clearances by k (x - reference), never below 0."""

@@ -15,18 +15,17 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import replace
-from typing import Any, TYPE_CHECKING
+from typing import Any
 
 import numpy as np
 
 from satmotor_ros.model._typing import FloatArray
+from satmotor_ros.model.coefficients import LossCoefficients
 from satmotor_ros.model.effects._base import (additive, Candidate, CandidateData, Conditions,
                                               Effect, EffectKind, maker, PlantInjection,
                                               PlantParameter, varies, why_not)
 from satmotor_ros.model.errors import ConfigError
 
-if TYPE_CHECKING:
-    from satmotor_ros.model.coefficients import LossCoefficients
 
 _DRIVERS = {'case': 'p_case', 'outlet': 'p_out'}
 

@@ -35,7 +35,11 @@ class LeakageWear(Wear):
                   'cumulative revolutions [rev]')
     plant_parameters = (PlantParameter('leakage_wear', 0.0, 'relative growth of the leakage '
                                        'per shaft revolution (balawender, paszota)', '1/rev',
-                                       0.0, 1.0e-2),)
+                                       0.0, 1.0e-2),
+                        PlantParameter('leakage_wear_rate', 0.0, 'relative growth of the '
+                                       "leakage per second of the plant's running time "
+                                       '(operating hours; balawender, paszota); not with '
+                                       'leakage_wear', '1/s', 0.0, 1.0e-2))
 
     def condition(self, effect: Effect, x: float, now: Conditions) -> Conditions:
         """Multiply the leakage by 1 + max(0, w (x - reference))."""

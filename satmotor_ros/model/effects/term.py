@@ -14,6 +14,7 @@ from satmotor_ros.model._typing import FloatArray, Real
 from satmotor_ros.model.effects._base import (Candidate, CandidateData, Effect, EffectKind,
                                               finite, Loss, Modifier, Shape)
 from satmotor_ros.model.errors import ConfigError
+from satmotor_ros.model.units import LPM
 
 FORMS = (('dp',), ('n',), ('dp', 'n'))
 """The candidates offered: dp_i^a, n^b and dp_i^a n^b, each with its exponents fitted."""
@@ -174,7 +175,7 @@ class Term(EffectKind):
         shape = tuple(Shape(f'{name} exponent', (0.5, 2.0), BOUNDS[name]) for name in form)
         label = '*'.join(f'{name}^{"ab"[("dp", "n").index(name)]}' for name in form)
         return Candidate(f'{self.name}:{label}', '*'.join(form), self.unit, self.source,
-                         columns[form[0]], modify, 1.0e-3 / 60.0, make=make, shape=shape)
+                         columns[form[0]], modify, LPM, make=make, shape=shape)
 
 
 KIND = Term()

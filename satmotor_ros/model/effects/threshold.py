@@ -3,7 +3,7 @@
 ``threshold:dp``: a valve across the ports passing k max(0, |dp| - x_c)^e, dp the port drop.
 
 A relief, bypass or anti-cavitation valve opens on the drop between the ports, and its flow
-runs beside the motor's chambers and channels (:mod:`satmotor_ros.model.valves`); it may
+runs beside the motor's chambers and channels (:mod:`satmotor_ros.model.engine.valves`); it may
 open for one sign of dp = p_a - p_b only (``direction``).
 """
 
@@ -16,11 +16,12 @@ import numpy as np
 
 from satmotor_ros.model._typing import FloatArray, Real
 from satmotor_ros.model.effects._base import (Candidate, CandidateData, DIRECTIONS, Effect,
-                                              EffectKind, finite, Loss, Modifier,
-                                              negative_rows, PlantParameter, Shape, Synthetic,
+                                              EffectKind, finite, Loss, Modifier, negative_rows,
+                                              PlantParameter, Sampled, Shape, Synthetic,
                                               two_sided)
 from satmotor_ros.model.effects.term import MAX_EXPONENT
 from satmotor_ros.model.errors import ConfigError
+from satmotor_ros.model.units import LPM
 
 MIN_ABOVE = {'both': (0.15, 4), 'positive': (0.01, 8), 'negative': (0.01, 8)}
 """Least share of the points, and least number, above a fitted threshold, [-]: a one-sided
@@ -30,8 +31,9 @@ STARTS = {'both': (0.3, 0.7), 'positive': (0.6, 0.9, 0.98), 'negative': (0.6, 0.
 """Starts of the fitted threshold: shares of the range it may take (both sides), quantiles of
 the side's drops (one side: a valve cracks near the top of its side's range), [-]."""
 
-EXPONENTS = (0.5, 3.0)
-"""Range of the fitted exponent e, [-]."""
+EXPONENTS = (0.05, 3.0)
+"""Range of the fitted exponent e, [-]: below 1 down to a near step, a relief valve at its
+pressure override, whose drop hardly rises while the flow it passes (set by the demand) does."""
 
 
 class Threshold(EffectKind):
@@ -136,7 +138,7 @@ class Threshold(EffectKind):
         out, skipped = [], []
         for direction, at in sides:
             # data of one sign are one side: the threshold may also sit near its top
-            candidate = self._candidate(dp, at, direction, both)
+            candidate = self._candidate(dp, at, direction, both, data.samples)
             if candidate is None:
                 skipped.append(f'{self.name}:dp ({direction}): too few points to place a '
                                'threshold')
@@ -145,13 +147,16 @@ class Threshold(EffectKind):
         return out, skipped
 
     def _candidate(self, dp: FloatArray, at: np.ndarray, direction: str,
-                   two: bool = True) -> Candidate | None:
+                   two: bool = True, samples: Sampled | None = None) -> Candidate | None:
         """
         Return the candidate acting at `at` only, the threshold among those points.
 
         On data of one sign of dp (`two` false) the candidate on both sides is a one-sided
         valve too: its threshold may sit as near the top as a side's, and starts both
-        within the range and at the side's quantiles.
+        within the range and at the side's quantiles. When the points are bins of a time
+        series' `samples`, the valve's flow is computed at every sample and averaged over
+        each bin, as the model evaluates it: the flow of a bin whose drop crosses the crack
+        is not the flow at the bin's mean drop.
         """
         ordered = np.sort(dp[at])
         share, least = MIN_ABOVE[direction if two else 'negative']
@@ -163,9 +168,16 @@ class Threshold(EffectKind):
         if not top > high > low:
             return None
         acts = at.astype(float)
+        if samples is not None:
+            over = _at_samples(samples, direction)
 
-        def modify(k: float, x_c: float, e: float) -> Modifier:
-            return Modifier(additive=acts * k * (np.maximum(dp - x_c, 0.0) / (top - x_c)) ** e)
+            def modify(k: float, x_c: float, e: float) -> Modifier:
+                flow = samples.mean((np.maximum(over - x_c, 0.0) / (top - x_c)) ** e)
+                return Modifier(additive=acts * k * flow)
+        else:
+            def modify(k: float, x_c: float, e: float) -> Modifier:
+                return Modifier(additive=acts * k * (np.maximum(dp - x_c, 0.0)
+                                                     / (top - x_c)) ** e)
 
         def make(k: float, x_c: float, e: float) -> Effect:
             return Effect(f'{self.name}:dp', k / (top - x_c) ** e, 'dp', x_c,
@@ -178,7 +190,7 @@ class Threshold(EffectKind):
         shape = (Shape('threshold', starts, (0.0, 1.0), 'Pa', (low, high - low)),
                  Shape('exponent', (1.0,), EXPONENTS))
         return Candidate(f'{self.name}:dp', 'dp', self.unit, self.source, dp, modify,
-                         1.0e-3 / 60.0, (0.0, np.inf), 0.1e-3 / 60.0, make, shape, direction)
+                         LPM, (0.0, np.inf), 0.1 * LPM, make, shape, direction)
 
     def scaled(self, name: str, magnitude: float, regressor: str, data: Synthetic) -> Effect:
         """Inject `magnitude` [m^3/s] at the largest drop; ``reference``, ``exponent`` in shape."""
@@ -187,6 +199,15 @@ class Threshold(EffectKind):
         drop = data.dp if data.dp is not None else data.dp_i  # the valve reads the port drop
         peak = float(np.max(np.maximum(np.abs(drop) - x_c, 0.0) ** e))
         return Effect(name, magnitude / max(peak, 1e-300), 'dp', x_c, options=(('exponent', e),))
+
+
+def _at_samples(samples: Sampled, direction: str) -> FloatArray:
+    """Return |dp| at the samples where a valve of `direction` may open (0 elsewhere), [Pa]."""
+    dp = samples.dp
+    if direction == 'both':
+        return np.abs(dp)
+    side = 1.0 if direction == 'positive' else -1.0
+    return np.where(np.isnan(dp), np.nan, np.maximum(side * dp, 0.0))
 
 
 KIND = Threshold()

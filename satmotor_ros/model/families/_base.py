@@ -5,7 +5,7 @@ What a model family provides, and the composition shared by the families without
 A family is one loss model of the paper: its equations (a module of kernels),
 its coefficient dataclass, and a :class:`Family` object that composes the
 kernels for one motor and liquid into the callables the point path and the
-array maps use (the interface of :class:`~satmotor_ros.model.composition.Equations`).
+array maps use (the interface of :class:`~.sliwinski2017.composition.Equations`).
 """
 
 from __future__ import annotations
@@ -13,24 +13,39 @@ from __future__ import annotations
 from abc import ABC, abstractmethod
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, replace
-from typing import Any, NamedTuple, TYPE_CHECKING
+from typing import Any, NamedTuple, Protocol
 
 from satmotor_ros.model._numeric import maximum, minimum
 from satmotor_ros.model._typing import FloatArray, Real
 from satmotor_ros.model.coefficients import CoefficientSet, Liquid, MotorGeometry, ValidRange
 from satmotor_ros.model.errors import ModelError
+from satmotor_ros.model.results import LossBreakdown
 from satmotor_ros.model.units import CM3_PER_REV
 
-if TYPE_CHECKING:
-    from satmotor_ros.model.motor import MotorModel
 
 Residual = Callable[[Real], tuple[Real, Real]]
-"""x -> (f(x), df/dx) for :mod:`satmotor_ros.model.solve`."""
+"""x -> (f(x), df/dx) for :mod:`satmotor_ros.model.engine.solve`."""
 
 _TINY_DROP = 1e-300  # [Pa]; below the resolution of any dp_i but 0
 
 SM_DISPLACEMENT = 32.94 * CM3_PER_REV
 """The SM-0,75/25's q_t, 32.94 cm^3/rev: the motor the defaults were fitted on, [m^3/rad]."""
+
+
+class FamilyModel(Protocol):
+    """What :meth:`Family.linear_losses` reads of a model (``MotorModel``, one layer up)."""
+
+    @property
+    def coef(self) -> Any:
+        """Return the family's coefficients, [-]."""
+
+    @property
+    def equations(self) -> Any:
+        """Return the family's composed equations, [-]."""
+
+    def breakdown(self, speed: FloatArray, dp_i: FloatArray,
+                  p_ex: FloatArray | float = 0.0) -> LossBreakdown:
+        """Return the loss components at (n, dp_i), eq. (31), [m^3/s]."""
 
 
 class LinearPart(NamedTuple):
@@ -141,7 +156,7 @@ class Terms:
 
 class SplitEquations:
     """
-    The callables of :class:`~satmotor_ros.model.composition.Equations`, from :class:`Terms`.
+    The callables of :class:`~.sliwinski2017.composition.Equations`, from :class:`Terms`.
 
     Parameters
     ----------
@@ -285,7 +300,7 @@ class Family(ABC):
         Returns
         -------
         object
-            The callables of :class:`~satmotor_ros.model.composition.Equations`, its
+            The callables of :class:`~.sliwinski2017.composition.Equations`, its
             ``derived`` constants and ``law``.
 
         """
@@ -307,14 +322,14 @@ class Family(ABC):
 
         """
 
-    def linear_losses(self, model: MotorModel, speed: FloatArray, dp_i: FloatArray,
+    def linear_losses(self, model: FamilyModel, speed: FloatArray, dp_i: FloatArray,
                       p_ex: FloatArray | float = 0.0) -> dict[str, FloatArray]:
         """
         Return Q_vl at given (n, dp_i) as the named :meth:`linear_parts`; their sum is Q_vl.
 
         Parameters
         ----------
-        model : MotorModel
+        model : FamilyModel
             A model of this family (without effects), [-]
         speed : ndarray
             Shaft speed n, [rad/s]

@@ -48,84 +48,6 @@ above it (not fully developed turbulent): k_s is continuous at this drop.
 """
 
 
-def losses_oil(pressure_speed: Real, laminar: Real, turbulent: Real, external: Real) -> Real:
-    r"""
-    Add up the volumetric losses of a motor supplied with oil, eq. (15).
-
-    .. math:: Q_{vl,O} = \Delta Q_{vl,O} + Q_{l,O} + Q_{t,O} + Q_{ex,O}
-
-    Parameters
-    ----------
-    pressure_speed : float or ndarray
-        Delta Q_vl,O of eq. (17), [m^3/s]
-    laminar : float or ndarray
-        Q_l,O of eq. (20), [m^3/s]
-    turbulent : float or ndarray
-        Q_t,O of eq. (21), [m^3/s]
-    external : float or ndarray
-        Q_ex,O of eq. (24), [m^3/s]
-
-    Returns
-    -------
-    float or ndarray
-        Q_vl,O, [m^3/s]
-
-    """
-    return pressure_speed + laminar + turbulent + external
-
-
-def losses_low_viscosity(pressure_speed: Real, clearance: Real, external: Real) -> Real:
-    r"""
-    Add up the volumetric losses of a motor supplied with a low-viscosity liquid, eq. (16).
-
-    .. math:: Q_{vl,E} = \underbrace{k_c\,\Delta Q_{vl,O}}_{\Delta Q_{vl,E}}
-        + \underbrace{k_s\,(Q_{l,O} + Q_{t,O})}_{Q_{l-t,E}}
-        + \underbrace{k_{ex}\,Q_{ex,O}}_{Q_{ex,E}}
-
-    Parameters
-    ----------
-    pressure_speed : float or ndarray
-        Delta Q_vl,E of eq. (18), [m^3/s]
-    clearance : float or ndarray
-        Q_l-t,E = k_s (Q_l,O + Q_t,O), eqs. (20)-(23), [m^3/s]
-    external : float or ndarray
-        Q_ex,E = k_ex Q_ex,O, eq. (24), [m^3/s]
-
-    Returns
-    -------
-    float or ndarray
-        Q_vl,E, [m^3/s]
-
-    """
-    return pressure_speed + clearance + external
-
-
-def pressure_speed_loss_oil(dp_i: Real, omega: Real, q: float, c_vl: float) -> Real:
-    r"""
-    Compute the loss proportional to pressure and speed with oil, eq. (17).
-
-    .. math:: \Delta Q_{vl,O} = C_{vl,O}\,\frac{q_t}{2\pi}\,\Delta p_{i,O}\,\omega
-
-    Parameters
-    ----------
-    dp_i : float or ndarray
-        Pressure drop in the working chambers, [Pa]
-    omega : float or ndarray
-        Shaft speed, [rad/s]
-    q : float
-        Displacement q_t/(2 pi), [m^3/rad]
-    c_vl : float
-        C_vl,O, [1/Pa]
-
-    Returns
-    -------
-    float or ndarray
-        Delta Q_vl,O, [m^3/s]
-
-    """
-    return c_vl * q * dp_i * omega
-
-
 def pressure_speed_loss_low_viscosity(dp_i: Real, omega: Real, q: float, c_vl: float,
                                       k_c: float) -> Real:
     r"""
@@ -347,28 +269,6 @@ def external_leakage_oil(p_2: Real, mu: float, q: float, c_ex: float) -> Real:
 
     """
     return c_ex / mu * q * p_2
-
-
-def chamber_pressure_drop_oil(dp: Real, dp_ich: Real) -> Real:
-    r"""
-    Compute the pressure drop in the working chambers with oil, eq. (25).
-
-    .. math:: \Delta p_{i,O} = \Delta p - \Delta p_{ich,O}
-
-    Parameters
-    ----------
-    dp : float or ndarray
-        Pressure drop between the ports, [Pa]
-    dp_ich : float or ndarray
-        Pressure drop in the internal channels, eq. (27), [Pa]
-
-    Returns
-    -------
-    float or ndarray
-        Delta p_i,O, [Pa]
-
-    """
-    return dp - dp_ich
 
 
 def chamber_pressure_drop_low_viscosity(dp: Real, dp_ich_oil: Real, k_h: Real) -> Real:

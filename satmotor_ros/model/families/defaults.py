@@ -16,9 +16,9 @@ from __future__ import annotations
 from dataclasses import replace
 
 from satmotor_ros.model.coefficients import displacement_problem, MotorGeometry, ValidRange
-from satmotor_ros.model.config import load_motor, MotorSpec
 from satmotor_ros.model.errors import ConfigError
 from satmotor_ros.model.families import DEFAULT_FAMILY, family_named
+from satmotor_ros.model.io.config import load_motor, MotorSpec
 from satmotor_ros.model.units import CM3_PER_REV
 
 

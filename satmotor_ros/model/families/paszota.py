@@ -23,7 +23,8 @@ from satmotor_ros.model.coefficients import (CoefficientSet, FieldError, Liquid,
 from satmotor_ros.model.families import paszota_losses as eq
 from satmotor_ros.model.families._base import (Bounds, bounds, Family, inverse_dp, LinearPart,
                                                SM_DISPLACEMENT, SplitEquations, Terms)
-from satmotor_ros.model.losses import channel_coefficients, channel_pressure_drop
+from satmotor_ros.model.families.sliwinski2017.losses import (channel_coefficients,
+                                                              channel_pressure_drop)
 from satmotor_ros.model.units import MPA, RPM
 
 

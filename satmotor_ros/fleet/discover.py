@@ -1,0 +1,271 @@
+# SPDX-License-Identifier: Apache-2.0
+"""
+Find a fleet's recordings under ROOT, name their motor and order them in time.
+
+A recording is a rosbag2 directory (one with ``metadata.yaml`` or a storage file; not
+entered), a bench CSV, or, for a motor whose fleet.yaml entry gives ``columns``, any other
+text log. Its motor is the first fleet.yaml pattern that matches it (or a parent directory), else
+the first directory level under ROOT. Its time is the bag's start time, else the first
+value of a ``time`` column when it holds epoch seconds, else a date (and time) in its
+path, else -- said as such -- the file's modification time. Only what these need is read
+here (a bag's metadata, a CSV's first two lines), nothing of the data.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from datetime import datetime, timezone
+import os
+from pathlib import Path
+import re
+
+from satmotor_ros.bounded_yaml import read_yaml, YamlLimitError
+from satmotor_ros.fleet.config import FLEET_FILE, FleetConfig, MotorRule
+
+BAG_START = 'bag start time'
+TIME_COLUMN = 'time column (epoch s)'
+PATH_DATE = 'date in the path'
+MTIME = 'file modification time (no time in the data or the path)'
+"""How a recording's time was found, in the order they are tried (as the report says it)."""
+
+LOG_SUFFIXES = ('.csv', '.tsv', '.txt', '.log', '.dat', '.exp')
+"""Text logs read through a motor's column mapping; without one, only ``.csv``."""
+
+EPOCH_RANGE = (9.0e8, 4.2e9)
+"""A ``time`` value in this range is epoch seconds (1998 to 2103), [s]."""
+
+BAG_FILES = ('.mcap', '.db3')
+"""A directory holding one of these is a bag (one without metadata.yaml is refused by its
+reader, with the reason, not passed over)."""
+
+_HEAD_BYTES = 1 << 16
+_DATE = re.compile(r'(?<![0-9])(?P<y>(?:19|20)[0-9]{2})-?(?P<m>[01][0-9])-?(?P<d>[0-3][0-9])'
+                   r'(?:[T_ -]?(?P<H>[0-2][0-9])[:-]?(?P<M>[0-5][0-9])'
+                   r'(?:[:-]?(?P<S>[0-5][0-9]))?)?(?![0-9])')
+
+
+@dataclass(frozen=True)
+class Recording:
+    """One recording of the fleet, placed."""
+
+    path: str  # absolute path of the file or bag directory
+    relative: str  # POSIX path from ROOT
+    motor: str  # motor id
+    kind: str  # 'bag' | 'csv' | 'log'
+    time: float  # start, epoch [s] (UTC)
+    time_source: str  # one of BAG_START, TIME_COLUMN, PATH_DATE, MTIME
+    name: str  # its directory under DIR/<motor>/
+
+    @property
+    def date(self) -> str:
+        """Return the start as an ISO 8601 UTC timestamp."""
+        return datetime.fromtimestamp(self.time, timezone.utc).isoformat(timespec='seconds')
+
+
+@dataclass(frozen=True)
+class Motor:
+    """A motor of the fleet: its rule (what fleet.yaml says) and its recordings in time."""
+
+    motor: str
+    rule: MotorRule
+    recordings: tuple[Recording, ...]
+
+
+def discover(root: str | Path, config: FleetConfig, skip: tuple[Path, ...] = ()) -> list[Motor]:
+    """
+    Find and place every recording under `root`.
+
+    Parameters
+    ----------
+    root : str or pathlib.Path
+        The fleet's tree, [-]
+    config : FleetConfig
+        fleet.yaml (empty rules: every motor is its first directory level), [-]
+    skip : tuple of pathlib.Path
+        Directories not to enter (the output directory when it is under `root`), [-]
+
+    Returns
+    -------
+    list of Motor
+        The motors by id, each with its recordings ordered in time (then by path).
+
+    """
+    base = Path(root).resolve()
+    skipped = {p.resolve() for p in skip}
+    found: dict[str, list[Recording]] = {}
+    rules: dict[str, MotorRule] = {}
+    for path, kind in _walk(base, skipped):
+        relative = path.relative_to(base).as_posix()
+        rule = config.rule_for(relative)
+        if rule is None:
+            top = relative.split('/')[0] if '/' in relative else base.name
+            rule = MotorRule('', _motor_id(top))
+        if kind == 'text':
+            if path.suffix.lower() != '.csv' and not (rule.columns or rule.columns_inline):
+                continue
+            kind = 'log' if rule.columns or rule.columns_inline else 'csv'
+        rules.setdefault(rule.motor, rule)
+        time, source = recording_time(path, kind)
+        found.setdefault(rule.motor, []).append(
+            Recording(str(path), relative, rule.motor, kind, time, source,
+                      _name(relative, rule)))
+    motors = []
+    for motor in sorted(found):
+        ordered = tuple(sorted(found[motor], key=lambda r: (r.time, r.relative)))
+        motors.append(Motor(motor, rules[motor], _unique(ordered)))
+    return motors
+
+
+def _walk(base: Path, skipped: set[Path]) -> list[tuple[Path, str]]:
+    out: list[tuple[Path, str]] = []
+    for directory, dirs, files in os.walk(base):
+        here = Path(directory)
+        storage = any(f.endswith(BAG_FILES) for f in files)
+        if here != base and ((here / 'metadata.yaml').is_file() or storage):
+            out.append((here, 'bag'))
+            dirs[:] = []
+            continue
+        dirs[:] = sorted(d for d in dirs if not d.startswith('.')
+                         and (here / d).resolve() not in skipped)
+        for name in sorted(files):
+            if name.startswith('.') or name == FLEET_FILE:
+                continue
+            if Path(name).suffix.lower() in LOG_SUFFIXES:
+                out.append((here / name, 'text'))
+    return out
+
+
+def _motor_id(text: str) -> str:
+    """Make a name safe as a motor id (it names a directory under --out)."""
+    return re.sub(r'[^A-Za-z0-9._-]', '_', text).lstrip('.') or 'motor'
+
+
+def _name(relative: str, rule: MotorRule) -> str:
+    """Name the recording's directory under DIR/<motor>/: its path below the motor's own."""
+    parts = relative.split('/')
+    if not rule.pattern:
+        fixed = 1
+    else:  # the pattern's directories up to its first wildcard: the motor's own directory
+        literal = rule.pattern.strip('/').split('/')
+        fixed = next((i for i, p in enumerate(literal) if any(c in p for c in '*?[')),
+                     len(literal))
+        if parts[:fixed] != literal[:fixed]:
+            fixed = 0
+    parts = parts[min(fixed, len(parts) - 1):]
+    return _motor_id('__'.join(parts))
+
+
+def _unique(recordings: tuple[Recording, ...]) -> tuple[Recording, ...]:
+    seen: dict[str, int] = {}
+    out = []
+    for rec in recordings:
+        n = seen.get(rec.name, 0)
+        seen[rec.name] = n + 1
+        if n:
+            rec = Recording(rec.path, rec.relative, rec.motor, rec.kind, rec.time,
+                            rec.time_source, f'{rec.name}~{n}')
+        out.append(rec)
+    return tuple(out)
+
+
+def recording_time(path: Path, kind: str) -> tuple[float, str]:
+    """
+    Find when a recording started, and how.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The file or bag directory, [-]
+    kind : str
+        ``'bag'``, ``'csv'`` or ``'log'``, [-]
+
+    Returns
+    -------
+    tuple of (float, str)
+        Epoch seconds (UTC) and how it was found (:data:`BAG_START` ... :data:`MTIME`).
+
+    """
+    if kind == 'bag':
+        found = _bag_start(path)
+        if found is not None:
+            return found, BAG_START
+    elif kind == 'csv':
+        found = _time_column(path)
+        if found is not None:
+            return found, TIME_COLUMN
+    found = path_date(str(path))
+    if found is not None:
+        return found, PATH_DATE
+    try:
+        return path.stat().st_mtime, MTIME
+    except OSError:
+        return 0.0, MTIME
+
+
+def _bag_start(path: Path) -> float | None:
+    try:
+        info = read_yaml(path / 'metadata.yaml')['rosbag2_bagfile_information']
+        ns = info['starting_time']['nanoseconds_since_epoch']
+    except (OSError, YamlLimitError, KeyError, TypeError):
+        return None
+    if isinstance(ns, bool) or not isinstance(ns, int) or ns <= 0:
+        return None
+    return ns / 1e9
+
+
+def _time_column(path: Path) -> float | None:
+    """Return the first ``time`` value of a CSV when it is epoch seconds, else None."""
+    try:
+        with path.open('rb') as file:
+            head = file.read(_HEAD_BYTES).decode('utf-8', errors='replace')
+    except OSError:
+        return None
+    lines = [line for line in head.splitlines() if line.strip()]
+    if len(lines) < 2:
+        return None
+    names = [cell.split('[')[0].strip().lower() for cell in lines[0].split(',')]
+    if 'time' not in names:
+        return None
+    cells = lines[1].split(',')
+    try:
+        value = float(cells[names.index('time')])
+    except (ValueError, IndexError):
+        return None
+    return value if EPOCH_RANGE[0] <= value <= EPOCH_RANGE[1] else None
+
+
+def path_date(text: str) -> float | None:
+    """
+    Read the last date (and time) written in a path, as epoch seconds (UTC).
+
+    Parameters
+    ----------
+    text : str
+        The path, [-]
+
+    Returns
+    -------
+    float or None
+        The epoch, or None when the path holds no valid date.
+
+    Examples
+    --------
+    >>> path_date('rig/2026-03-01/run_20260302T0830.csv') - path_date('x/2026-03-02')
+    30600.0
+    >>> path_date('rig/run7.csv') is None
+    True
+
+    """
+    for found in reversed(list(_DATE.finditer(text))):
+        try:
+            when = datetime(int(found['y']), int(found['m']), int(found['d']),
+                            int(found['H'] or 0), int(found['M'] or 0), int(found['S'] or 0),
+                            tzinfo=timezone.utc)
+        except ValueError:
+            continue
+        return when.timestamp()
+    return None
+
+
+__all__ = ['BAG_FILES', 'BAG_START', 'EPOCH_RANGE', 'LOG_SUFFIXES', 'MTIME', 'Motor', 'PATH_DATE',
+           'Recording', 'TIME_COLUMN', 'discover', 'path_date', 'recording_time']

@@ -1,0 +1,236 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Write ``fleet.json``, ``fleet.md`` and the plots, each whole (temporary name, then rename)."""
+
+from __future__ import annotations
+
+from datetime import datetime, timezone
+import json
+import os
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from satmotor_ros.cli._output import png_metadata
+
+PLOTS = 'plots'
+"""The plots' directory under DIR: one PNG per motor and ``fleet.png``."""
+
+
+def _replace(path: Path, text: str) -> None:
+    temporary = path.with_name(f'.{path.name}.partial-{os.getpid()}')
+    temporary.write_text(text, encoding='utf-8')
+    os.replace(temporary, path)
+
+
+def write_report(out: Path, motors: list[dict[str, Any]], header: dict[str, Any]) -> None:
+    """
+    Write the fleet's report into `out`.
+
+    Parameters
+    ----------
+    out : pathlib.Path
+        DIR, [-]
+    motors : list of dict
+        The motors' entries, ranked, [-]
+    header : dict
+        Run facts for the report's head (root, when, counts, cluster), [-]
+
+    """
+    (out / PLOTS).mkdir(parents=True, exist_ok=True)
+    for motor in motors:
+        plot_motor(out / PLOTS / f"{motor['motor']}.png", motor)
+    plot_fleet(out / PLOTS / 'fleet.png', motors)
+    _replace(out / 'fleet.json', json.dumps({**header, 'motors': motors}, indent=1) + '\n')
+    _replace(out / 'fleet.md', markdown(motors, header))
+
+
+def _days(value: float | None) -> str:
+    return 'not drifting to it' if value is None else f'{value:.1f}'
+
+
+def _trend(value: float | None) -> str:
+    return 'n/a (fewer than 3 recordings)' if value is None else f'{value:+.4f}'
+
+
+def markdown(motors: list[dict[str, Any]], header: dict[str, Any]) -> str:
+    """
+    Render fleet.md: the ranking, then each motor's figures, alarms and refusals.
+
+    Parameters
+    ----------
+    motors : list of dict
+        The motors' entries, ranked, [-]
+    header : dict
+        Run facts, [-]
+
+    Returns
+    -------
+    str
+        The Markdown text.
+
+    """
+    lines = [f"# Fleet report: {header['root']}", '',
+             f"{header['recordings']} recordings of {len(motors)} motors; "
+             f"{header['refused']} refused; {header['ran']} processed in this run, "
+             f"{header['reused']} already done. Written {header['written']}.", '',
+             f"Leakage factor: measured volumetric losses over the motor's baseline "
+             f"(estimator {header['estimator']}); limit {header['limit']:g}. Motors ranked "
+             'soonest to the limit first.', '',
+             '![fleet](plots/fleet.png)', '',
+             '| rank | motor | recordings | refused | last leakage factor [95 % interval] '
+             '| trend per day | days to limit | alarms |',
+             '| --- | --- | --- | --- | --- | --- | --- | --- |']
+    for i, m in enumerate(motors, 1):
+        last = m['leakage_factor'][-1] if m['leakage_factor'] else None
+        shown = (f"{last['value']:.3f} [{last['ci95'][0]:.3f}, {last['ci95'][1]:.3f}]"
+                 if last else 'none')
+        lines.append(f"| {i} | {m['motor']} | {m['recordings']} | {len(m['refused'])} | "
+                     f"{shown} | {_trend(m['trend_per_day'])} | {_days(m['days_to_limit'])} | "
+                     f"{len(m['alarms'])} |")
+    for m in motors:
+        lines += ['', f"## {m['motor']}", '',
+                  f"Liquid {m['liquid'] or 'as each recording records it'}; baseline: "
+                  f"{m['baseline']}; recording times from: {', '.join(m['time_sources'])}.", '',
+                  f"![{m['motor']}](plots/{m['motor']}.png)", '']
+        lines.append('Alarms:' if m['alarms'] else 'No alarm.')
+        lines += [f"- {a['date']} **{a['kind']}**: {a['what']}" for a in m['alarms']]
+        if m['refused']:
+            lines += ['', 'Refused recordings (whole, not salvaged):']
+            lines += [f"- `{r['path']}`: {r['reason']}" for r in m['refused']]
+        if m['leakage_factor']:
+            lines += ['', '| date | recording | leakage factor | 95 % interval |',
+                      '| --- | --- | --- | --- |']
+            lines += [f"| {p['date']} | `{p['recording']}` | {p['value']:.4f} | "
+                      f"[{p['ci95'][0]:.4f}, {p['ci95'][1]:.4f}] |" for p in m['leakage_factor']]
+    return '\n'.join(lines) + '\n'
+
+
+def _pyplot() -> Any:
+    import matplotlib
+    matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+    return plt
+
+
+def _dates(series: list[dict[str, Any]]) -> list[datetime]:
+    return [datetime.fromisoformat(p['date']).astimezone(timezone.utc).replace(tzinfo=None)
+            for p in series]
+
+
+def _save(fig: Any, path: Path) -> None:
+    temporary = path.with_name(f'.{path.name}.partial-{os.getpid()}')
+    fig.savefig(temporary, dpi=80, format='png', metadata=png_metadata('fleet'))
+    os.replace(temporary, path)
+
+
+def plot_motor(path: Path, motor: dict[str, Any]) -> None:
+    """
+    Plot one motor: the leakage factor with its interval, the trend to the limit, alarms.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The PNG, [-]
+    motor : dict
+        Its fleet.json entry, [-]
+
+    """
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(8, 4.2))
+    try:
+        series = motor['leakage_factor']
+        if series:
+            dates = _dates(series)
+            values = np.array([p['value'] for p in series])
+            lo = values - np.array([p['ci95'][0] for p in series])
+            hi = np.array([p['ci95'][1] for p in series]) - values
+            ax.errorbar(dates, values, yerr=[lo, hi], fmt='o-', ms=4, capsize=2,
+                        label='leakage factor, 95 % interval')
+            _draw_projection(ax, motor, dates, values)
+        ax.axhline(motor['limit'], color='tab:red', ls='--', lw=1,
+                   label=f"limit {motor['limit']:g}")
+        ax.axhline(1.0, color='0.6', lw=0.8)
+        for i, alarm in enumerate(motor['alarms']):
+            when = datetime.fromisoformat(alarm['date']).replace(tzinfo=None)
+            ax.axvline(when, color='tab:orange' if alarm['kind'] == 'change' else 'tab:red',
+                       lw=1, label=f"{alarm['kind']} alarm" if i == 0 else None)
+        days = motor['days_to_limit']
+        title = f"{motor['motor']}: " + (
+            f'{days:.1f} days to the limit' if days is not None
+            else 'not drifting toward the limit')
+        if motor['refused']:
+            title += f", {len(motor['refused'])} recording(s) refused"
+        ax.set_title(title)
+        ax.set_ylabel('leakage factor (measured / baseline Q_vl) [-]')
+        ax.set_xlabel('date (UTC)')
+        ax.legend(loc='upper left', fontsize=8)
+        fig.autofmt_xdate()
+        fig.tight_layout()
+        _save(fig, path)
+    finally:
+        plt.close(fig)
+
+
+def _draw_projection(ax: Any, motor: dict[str, Any], dates: list[datetime],
+                     values: np.ndarray) -> None:
+    from datetime import timedelta
+    trend, days = motor['trend_per_day'], motor['days_to_limit']
+    if trend is None or days is None or days <= 0:
+        return
+    end = dates[-1] + timedelta(days=days)
+    ax.plot([dates[-1], end], [values[-1], motor['limit']], ':', color='tab:red',
+            label=f'trend {trend:+.3f}/day to the limit')
+
+
+def plot_fleet(path: Path, motors: list[dict[str, Any]]) -> None:
+    """
+    Plot the fleet: every motor's leakage factor over dates, and the days to the limit.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The PNG, [-]
+    motors : list of dict
+        The motors' entries, ranked, [-]
+
+    """
+    plt = _pyplot()
+    fig, (ax, bars) = plt.subplots(1, 2, figsize=(12, 4.5),
+                                   gridspec_kw={'width_ratios': [2.2, 1]})
+    try:
+        limit = motors[0]['limit'] if motors else 2.0
+        for m in motors:
+            if m['leakage_factor']:
+                ax.plot(_dates(m['leakage_factor']), [p['value'] for p in m['leakage_factor']],
+                        'o-', ms=3, label=m['motor'])
+        ax.axhline(limit, color='tab:red', ls='--', lw=1, label=f'limit {limit:g}')
+        ax.set_ylabel('leakage factor [-]')
+        ax.set_xlabel('date (UTC)')
+        ax.set_title('Leakage factor of every motor')
+        hits = [p for m in motors for a in m['alarms'] for p in m['leakage_factor']
+                if p['recording'] == a.get('recording')]
+        if hits:
+            ax.plot(_dates(hits), [p['value'] for p in hits], 'x', color='k', ms=9,
+                    label='alarm')
+        ax.legend(fontsize=7, ncol=2)
+        names = [m['motor'] for m in motors][::-1]
+        days = [m['days_to_limit'] or 0.0 for m in motors][::-1]
+        bars.barh(names, days, color='tab:red')
+        for y, m in enumerate(motors[::-1]):
+            if m['days_to_limit'] is None:
+                last = 'no figure' if m['last'] is None else f"now {m['last']:.2f}"
+                bars.text(0.0, y, f' not drifting toward it ({last})', va='center', fontsize=8)
+            elif m['alarms']:
+                bars.text(m['days_to_limit'], y, f" {len(m['alarms'])} alarm(s)",
+                          va='center', fontsize=8)
+        bars.set_xlabel('days to the limit from the last recording')
+        bars.set_title('Ranking, soonest first (top)')
+        fig.autofmt_xdate()
+        fig.tight_layout()
+        _save(fig, path)
+    finally:
+        plt.close(fig)
+
+
+__all__ = ['PLOTS', 'markdown', 'plot_fleet', 'plot_motor', 'write_report']

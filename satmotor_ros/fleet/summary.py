@@ -1,0 +1,233 @@
+# SPDX-License-Identifier: Apache-2.0
+"""
+The fleet's view: per motor the leakage factor over dates, its trend, alarms, ranking.
+
+Where the motor's recordings are time series, its one health monitor
+(:mod:`~satmotor_ros.fleet.chain`, ``satmotor monitor``'s estimator run over them in time
+order) gives the leakage factor after each recording, the trend, the hours to the limit and
+the alarms. Otherwise (steady-point tables, which the monitor cannot watch): the trend is a
+least-squares line through the recordings since the motor's last change
+alarm (a step is not wear); the days to the limit are where that line meets it, counted
+from the last recording. A change is a step between consecutive recordings larger than
+both their intervals and the motor's own day-to-day scatter allow
+(:data:`CHANGE_SIGMAS`), with the wear trend taken out.
+"""
+
+from __future__ import annotations
+
+from datetime import datetime, timezone
+from typing import Any
+
+import numpy as np
+
+DAY = 86400.0
+"""Seconds in a day, [s]."""
+
+LIMIT = 2.0
+"""Default limit of the leakage factor, as the health monitor's ``limit_leakage_factor``."""
+
+CHANGE_SIGMAS = 4.0
+"""A step between consecutive recordings this many standard deviations out is a change."""
+
+MIN_STEP = 0.05
+"""Smallest step of the leakage factor called a change, whatever the noise, [-]."""
+
+MIN_TREND_POINTS = 3
+"""Fewest recordings a trend is fitted on, [-]."""
+
+
+def motor_view(motor: str, liquid: str, markers: list[dict[str, Any]],
+               baseline: dict[str, Any] | None, limit: float = LIMIT,
+               steps: list[dict[str, Any]] | None = None) -> dict[str, Any]:
+    """
+    Build one motor's entry of fleet.json.
+
+    Parameters
+    ----------
+    motor : str
+        Motor id, [-]
+    liquid : str
+        Its liquid ('' when each recording settles its own), [-]
+    markers : list of dict
+        Its recordings' done-markers in time order, [-]
+    baseline : dict or None
+        Its baseline (which recording, or the motor file), [-]
+    limit : float
+        Limit of the leakage factor, [-]
+    steps : list of dict, optional
+        Its monitor chain's step markers in time order, [-]
+
+    Returns
+    -------
+    dict
+        The DESIGN.md "Fleet output" entry, plus ``baseline``, ``limit``, ``time_sources``,
+        ``last`` (the latest leakage factor) and ``estimator`` ('monitor' or 'ratio').
+
+    """
+    points = [m for m in markers if m.get('status') == 'done' and m.get('result')]
+    watched = [s for s in steps or () if s.get('status') == 'done' and s.get('result')]
+    if any(s['result']['leakage_factor'].get('value') is not None for s in watched):
+        return _monitored(motor, liquid, markers, watched, baseline, limit)
+    series = [{'date': m['date'], 'value': m['result']['leakage_factor'],
+               'ci95': m['result']['ci95'], 'recording': m['recording']} for m in points]
+    times = np.array([m['time'] for m in points], dtype=float)
+    values = np.array([s['value'] for s in series], dtype=float)
+    half = np.array([(s['ci95'][1] - s['ci95'][0]) / 2.0 for s in series], dtype=float)
+    alarms, start = _changes(series, times, values, half)
+    crossed = next((s for s in series if s['value'] >= limit), None)
+    if crossed is not None:
+        alarms.append({'date': crossed['date'], 'kind': 'limit',
+                       'what': f"leakage factor {crossed['value']:.3g} reached the limit "
+                               f'{limit:g}', 'recording': crossed['recording']})
+    alarms.sort(key=lambda a: a['date'])
+    trend, days = _trend(times[start:], values[start:], limit)
+    return _view(motor, liquid, markers, series, trend, days, alarms, baseline, limit, 'ratio')
+
+
+def _view(motor: str, liquid: str, markers: list[dict[str, Any]],
+          series: list[dict[str, Any]], trend: float | None, days: float | None,
+          alarms: list[dict[str, Any]], baseline: dict[str, Any] | None, limit: float,
+          estimator: str) -> dict[str, Any]:
+    refused = [{'path': m['recording'], 'reason': m.get('reason', ''),
+                'status': m.get('status')} for m in markers if m.get('status') != 'done']
+    sources = sorted({m.get('time_source', '') for m in markers})
+    return {'motor': motor, 'liquid': liquid, 'recordings': len(markers), 'refused': refused,
+            'leakage_factor': series, 'trend_per_day': trend, 'days_to_limit': days,
+            'alarms': alarms, 'limit': limit, 'last': series[-1]['value'] if series else None,
+            'baseline': _baseline_line(baseline), 'time_sources': sources,
+            'estimator': estimator}
+
+
+def _monitored(motor: str, liquid: str, markers: list[dict[str, Any]],
+               watched: list[dict[str, Any]], baseline: dict[str, Any] | None,
+               limit: float) -> dict[str, Any]:
+    """Build the view from the motor's one monitor: its figure after each recording."""
+    dates = {m['recording']: m['date'] for m in markers}
+    series = [{'date': dates.get(s['recording'], ''), 'recording': s['recording'],
+               **s['result']['leakage_factor']} for s in watched
+              if s['result']['leakage_factor'].get('value') is not None]
+    last = watched[-1]['result']
+    alarms = []
+    for alarm in last.get('alarms', []):  # the snapshot's: each with its final name
+        at = alarm.get('time_s') or 0.0
+        where = [s for s in watched if s['result'].get('span_s')
+                 and s['result']['span_s'][0] <= at] or watched[:1]
+        recording = where[-1]['recording']
+        alarms.append({'date': dates.get(recording, ''), 'kind': alarm.get('kind', 'change'),
+                       'what': f"{alarm.get('what', 'unexplained')} (in {recording})",
+                       'recording': recording, 'source': 'monitor'})
+    per_hour, hours = last.get('trend_per_hour'), last.get('hours_to_limit')
+    return _view(motor, liquid, markers, series,
+                 None if per_hour is None else 24.0 * per_hour,
+                 None if hours is None else hours / 24.0, alarms, baseline, limit, 'monitor')
+
+
+def _baseline_line(baseline: dict[str, Any] | None) -> str:
+    if not baseline:
+        return 'none'
+    if baseline.get('recording'):
+        return f"calibrated on {baseline['recording']}"
+    if baseline.get('coefficients'):
+        return f"motor file {baseline['coefficients']}"
+    return str(baseline.get('reason', 'none'))
+
+
+def _changes(series: list[dict[str, Any]], times: np.ndarray, values: np.ndarray,
+             half: np.ndarray) -> tuple[list[dict[str, Any]], int]:
+    """
+    Return the change alarms and the index the current regime starts at.
+
+    A day-to-day step is a change when it stands out of the motor's other steps (their
+    median is the wear rate, their spread the noise) by :data:`CHANGE_SIGMAS` of the two
+    recordings' intervals and that spread, and by :data:`MIN_STEP` at least.
+    """
+    alarms: list[dict[str, Any]] = []
+    start = 0
+    se = half / 1.96
+    steps = np.diff(values) / np.maximum(np.diff(times) / DAY, 1.0 / 24.0)
+    for i in range(1, len(series)):
+        others = np.delete(steps, i - 1)
+        days = max((times[i] - times[i - 1]) / DAY, 1.0 / 24.0)
+        typical = float(np.median(others)) * days if others.size >= 2 else 0.0
+        spread = 1.4826 * float(np.median(np.abs(others - np.median(others)))) * days \
+            if others.size >= 2 else 0.0
+        step = values[i] - values[i - 1] - typical
+        sigma = float(np.hypot(np.hypot(se[i], se[i - 1]), spread))
+        if abs(step) > max(CHANGE_SIGMAS * sigma, MIN_STEP):
+            before = values[i - 1]
+            alarms.append({'date': series[i]['date'], 'kind': 'change',
+                           'what': f'leakage factor {before:.3g} -> {values[i]:.3g} '
+                                   f'({100 * (values[i] / before - 1):+.0f} %) since '
+                                   f"{series[i - 1]['date'][:10]}, "
+                                   f'{abs(step) / max(sigma, 1e-12):.0f} sigma beyond the trend',
+                           'recording': series[i]['recording']})
+            start = i
+    return alarms, start
+
+
+def _trend(t: np.ndarray, v: np.ndarray, limit: float) -> tuple[float | None, float | None]:
+    """
+    Return the trend per day and the days from the last recording to the limit.
+
+    The days are None when the slope's one-sided 97.5 % Student bound is not above zero:
+    a motor whose drift the data cannot tell from noise is not given a date (with three
+    recordings the bound is 12.7 standard errors, not 2).
+    """
+    from scipy.stats import t as student  # only when a fleet is summarised
+    slope, se = _slope(t, v)
+    if v.size and v[-1] >= limit:
+        return slope, 0.0
+    if slope is None or slope - float(student.ppf(0.975, v.size - 2)) * se <= 0.0:
+        return slope, None
+    days = t / DAY
+    now = float(np.mean(v) + slope * (days[-1] - np.mean(days)))
+    return slope, max((limit - now) / slope, 0.0)
+
+
+def _slope(t: np.ndarray, v: np.ndarray) -> tuple[float | None, float]:
+    """Return the least-squares slope per day and its standard error."""
+    if v.size < MIN_TREND_POINTS or np.ptp(t) <= 0:
+        return None, 0.0
+    days = t / DAY - np.mean(t / DAY)
+    slope = float(days @ (v - np.mean(v)) / (days @ days))
+    scatter = float(np.sum((v - np.mean(v) - slope * days) ** 2)) / (v.size - 2)
+    return slope, (scatter / float(days @ days)) ** 0.5
+
+
+def rank(motors: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """
+    Order motors soonest to the limit first.
+
+    A motor past its limit comes first (0 days), then by days to the limit; motors not
+    drifting toward it follow, by their latest leakage factor (highest first), and those
+    with no figure at all last.
+
+    Parameters
+    ----------
+    motors : list of dict
+        :func:`motor_view` entries, [-]
+
+    Returns
+    -------
+    list of dict
+        The same entries, ranked.
+
+    """
+    def key(m: dict[str, Any]) -> tuple[int, float, float, str]:
+        days = m['days_to_limit']
+        last = m['last']
+        if days is not None:
+            return (0, days, 0.0, m['motor'])
+        if last is not None:
+            return (1, 0.0, -last, m['motor'])
+        return (2, 0.0, 0.0, m['motor'])
+    return sorted(motors, key=key)
+
+
+def iso_now() -> str:
+    """Return the current UTC time, ISO 8601 to the second."""
+    return datetime.now(timezone.utc).isoformat(timespec='seconds')
+
+
+__all__ = ['CHANGE_SIGMAS', 'DAY', 'LIMIT', 'MIN_STEP', 'MIN_TREND_POINTS', 'iso_now',
+           'motor_view', 'rank']

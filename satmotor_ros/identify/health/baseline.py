@@ -1,0 +1,251 @@
+# SPDX-License-Identifier: Apache-2.0
+"""
+The baseline the monitor measures against: the model's volumetric losses at every sample.
+
+The measured loss is Q_vl = Q - q_t n and the baseline's is the model's, both taken in the
+frame where the loss runs forward, exactly as calibration and validation take them
+(:func:`~satmotor_ros.identify.parts.loss_parts`, the prediction of
+:class:`~satmotor_ros.identify.effects.CalibratedModel` with its effects and instruments):
+nothing physical is written here.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+import hashlib
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from satmotor_ros.identify.coverage import calibrated_envelope, outside
+from satmotor_ros.identify.effects import CalibratedModel
+from satmotor_ros.identify.health.records import HealthSamples
+from satmotor_ros.identify.parts import loss_parts
+from satmotor_ros.identify.table import BenchTable
+from satmotor_ros.model import load_motor, MotorModel
+from satmotor_ros.model._typing import FloatArray
+from satmotor_ros.model.viscosity import standard_law
+
+OK, STALLED, OUTSIDE_ENVELOPE, OUTSIDE_MODEL, STALE, NON_FINITE = range(6)
+"""Codes of :attr:`Losses.reason`, in the order of :data:`.records.SKIP_REASONS` plus OK."""
+
+
+@dataclass(frozen=True)
+class Losses:
+    """The losses at every sample of a block (NaN where not usable)."""
+
+    measured: FloatArray  # Q - q_t n, in the loss's forward frame [m^3/s]
+    baseline: FloatArray  # the model's Q_vl there [m^3/s]
+    displacement: FloatArray  # |q_t n| [m^3/s]
+    speed: FloatArray  # |n| [rad/s]
+    dp: FloatArray  # |dp| [Pa]
+    reason: np.ndarray  # int: OK or why the sample is skipped
+
+
+class Baseline:
+    """
+    A motor model held as the healthy motor.
+
+    Parameters
+    ----------
+    model : MotorModel
+        The model, effects included (a calibrated ``coefficients.yaml``'s), [-]
+    envelope : dict, optional
+        The envelope it was calibrated on (:func:`calibrated_envelope`); samples outside
+        are skipped, [-]
+    source : str
+        Where it came from, for reports, [-]
+
+    """
+
+    def __init__(self, model: MotorModel, envelope: dict[str, Any] | None = None,
+                 source: str = '') -> None:
+        """Hold the model, its bare copy (which places the points) and the envelope."""
+        self.model = model
+        self.envelope = envelope
+        self.source = source or model.name
+        self.calibrated = CalibratedModel(model)
+        self._bare = MotorModel(model.geometry, replace(model.coefficient_set, effects=()),
+                                model.valid_range, model.liquid, model.displacement_law,
+                                model.name)
+        self.law = standard_law(model.liquid, model.coefficient_set.name)
+        self.uses_temperature = 'temperature' in model.channels
+        self._thinned: dict[float, CalibratedModel] = {}
+
+    @classmethod
+    def load(cls, path: str | Path, liquid: str) -> Baseline:
+        """
+        Load a motor file (a calibrated ``coefficients.yaml`` or a motor YAML).
+
+        Parameters
+        ----------
+        path : str or pathlib.Path
+            The file, [-]
+        liquid : str
+            Its coefficient set, [-]
+
+        Returns
+        -------
+        Baseline
+            The model with the envelope the file records (if any).
+
+        """
+        model = MotorModel.from_spec(load_motor(path), liquid)
+        return cls(model, calibrated_envelope(path), str(path))
+
+    @classmethod
+    def for_family(cls, family: str, displacement: float, liquid: str = 'oil') -> Baseline:
+        """
+        Use a family's documented defaults at a displacement.
+
+        Parameters
+        ----------
+        family : str
+            The model family, [-]
+        displacement : float
+            q_t/(2 pi), [m^3/rad]
+        liquid : str
+            ``'oil'`` or ``'water'``, [-]
+
+        Returns
+        -------
+        Baseline
+            The model, without an envelope.
+
+        """
+        model = MotorModel.for_displacement(displacement, family, liquid)
+        return cls(model, None, f'{family} defaults at {displacement:.4g} m^3/rad')
+
+    @property
+    def fingerprint(self) -> str:
+        """
+        Return a short digest of the model: a state made against another one is refused.
+
+        The family, geometry, coefficient set (effects included) and liquid as the model
+        holds them, not the path they were read from.
+        """
+        model = self.model
+        text = repr((model.name, model.family.name, model.geometry, model.coefficient_set,
+                     model.liquid, model.displacement_law, self.envelope))
+        return f'{model.name}#{hashlib.sha256(text.encode()).hexdigest()[:12]}'
+
+    @property
+    def displacement(self) -> float:
+        """Return q_t/(2 pi), [m^3/rad]."""
+        return float(self.model.geometry.displacement)
+
+    def _at_viscosity(self, factor: float) -> CalibratedModel:
+        """Return the model with its liquid's viscosity times `factor` (built once)."""
+        if factor not in self._thinned:
+            model = self.model
+            liquid = replace(model.liquid,
+                             kinematic_viscosity=model.liquid.kinematic_viscosity * factor)
+            self._thinned[factor] = CalibratedModel(MotorModel(
+                model.geometry, model.coefficient_set, model.valid_range, liquid,
+                model.displacement_law, model.name))
+        return self._thinned[factor]
+
+    def _warm(self, reading: FloatArray, speed: FloatArray, channels: dict[str, FloatArray],
+              dp_i: FloatArray, temperature: FloatArray, reference: float) -> FloatArray:
+        """
+        Return the flow reading at the oil's temperature, for a model that does not read it.
+
+        The liquid's standard law (:func:`~satmotor_ros.model.viscosity.standard_law`)
+        moves the viscosity by nu(T)/nu(reference); the model itself is evaluated at the
+        viscosity over 2 and times 2 (vectorised, as at its own) and the reading
+        interpolated piecewise linearly in log2 of that ratio (extrapolated by the end
+        segments past them): the family's own equations say how each loss moves with the
+        viscosity, nothing is assumed here.
+        """
+        law = self.law
+        ratio = (law.viscosity(temperature, law.standard_slope)
+                 / law.viscosity(reference, law.standard_slope))
+        x = np.where(np.isfinite(ratio) & (ratio > 0), np.log2(np.where(ratio > 0, ratio, 1.0)),
+                     0.0)
+        thin, _ = self._at_viscosity(0.5).measured_flow(speed, channels, dp_i=dp_i)
+        thick, _ = self._at_viscosity(2.0).measured_flow(speed, channels, dp_i=dp_i)
+        upper = np.where(np.isfinite(thick), thick, reading)
+        lower = np.where(np.isfinite(thin), thin, reading)
+        return np.where(x >= 0.0, reading + x * (upper - reading),
+                        reading - x * (lower - reading))
+
+    def losses(self, block: HealthSamples, min_speed: float = 0.0,
+               reference_temperature: float = math.nan) -> Losses:
+        """
+        Evaluate the measured and the baseline losses at every sample.
+
+        Parameters
+        ----------
+        block : HealthSamples
+            The samples, [-]
+        min_speed : float
+            Below this |n| a sample is stalled, [rad/s]
+        reference_temperature : float
+            The temperature the baseline holds at, for a model that does not read the
+            temperature itself (NaN: no correction), [degC]
+
+        Returns
+        -------
+        Losses
+            Arrays as long as the block, with the reason a sample is skipped.
+
+        """
+        n = len(block)
+        reason = np.full(n, OK, dtype=np.int8)
+        finite = (np.isfinite(block.time) & np.isfinite(block.speed) & np.isfinite(block.flow)
+                  & np.isfinite(block.p_in) & np.isfinite(block.p_out))
+        channels: dict[str, FloatArray] = {'time': block.time}
+        needs = set(self.model.channels)
+        if 'p_case' in needs:
+            # no case pressure measured: the case drains to the outlet, whose pressure drives
+            channels['p_case'] = block.p_out if block.p_case is None else block.p_case
+            finite &= np.isfinite(channels['p_case'])
+        if block.temperature is not None:
+            channels['temperature'] = block.temperature
+            if self.uses_temperature:
+                finite &= np.isfinite(block.temperature)
+        reason[~finite] = NON_FINITE
+        with np.errstate(invalid='ignore'):
+            reason[finite & (np.abs(block.speed) < min_speed)] = STALLED
+        if self.envelope is not None:
+            out = outside(self.envelope, block.p_in - block.p_out, block.speed)
+            reason[(reason == OK) & out] = OUTSIDE_ENVELOPE
+        measured = np.full(n, np.nan)
+        base, disp, speed, dp = measured.copy(), measured.copy(), measured.copy(), measured.copy()
+        ok = reason == OK
+        if ok.any():
+            table = BenchTable(block.speed[ok], block.flow[ok], block.p_in[ok], block.p_out[ok],
+                               {k: v[ok] for k, v in channels.items()}, time_series=True)
+            try:
+                parts, usable = loss_parts(self._bare, table)
+            except ValueError:
+                usable = np.zeros(int(ok.sum()), dtype=bool)
+            idx = np.flatnonzero(ok)
+            reason[idx[~usable]] = OUTSIDE_MODEL
+            if usable.any():
+                kept = table.select(usable)
+                channels_kept = {**kept.channels, 'p_in': kept.p_in, 'p_out': kept.p_out}
+                speed_signed, dp_i = parts.rotation * parts.speed, parts.sign * parts.dp_i
+                reading, _ = self.calibrated.measured_flow(speed_signed, channels_kept,
+                                                           dp_i=dp_i)
+                if (block.temperature is not None and not self.uses_temperature
+                        and math.isfinite(reference_temperature)):
+                    reading = self._warm(reading, speed_signed, channels_kept, dp_i,
+                                         kept.channels['temperature'], reference_temperature)
+                at = idx[usable]
+                good = np.isfinite(reading)
+                reason[at[~good]] = OUTSIDE_MODEL
+                at = at[good]
+                sign = np.broadcast_to(parts.sign, reading.shape)[good]
+                measured[at] = parts.loss[good]
+                base[at] = sign * reading[good] - parts.displacement[good]
+                disp[at] = np.abs(parts.displacement[good])
+                speed[at], dp[at] = parts.speed[good], parts.dp[good]
+        if block.stale is not None:
+            reason[(reason == OK) & block.stale] = STALE
+        return Losses(measured, base, disp, speed, dp, reason)
+
+
+__all__ = ['Baseline', 'Losses']

@@ -1,0 +1,145 @@
+# SPDX-License-Identifier: Apache-2.0
+"""
+One monitor over whole recordings, in time order: what ``satmotor monitor`` and fleet run.
+
+Recordings are taken in the order given. Each one's own time column is kept where it runs on
+after the one before (epoch times, a log that continues); a recording whose clock starts
+again (each bench CSV at 0 s, each bag at its first message) is placed after the one before,
+:data:`GAP_S` later, so no operation is counted across the gap and no sample goes back in
+time. Epoch clocks (beyond :data:`EPOCH_S`) are reported from their first sample, with
+``t0_epoch``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+import math
+
+import numpy as np
+
+from satmotor_ros.identify.errors import DataError
+from satmotor_ros.identify.health.baseline import Baseline
+from satmotor_ros.identify.health.monitor import HealthMonitor
+from satmotor_ros.identify.health.records import (HealthPoint, HealthSamples, HealthSettings,
+                                                  HealthSnapshot)
+from satmotor_ros.identify.table import BenchTable
+
+BLOCK = 200_000
+"""Samples handed to the monitor at a time (its cost is per sample; this bounds memory)."""
+
+GAP_S = 60.0
+"""Time put between a recording and the next when the next one's clock starts again, [s]."""
+
+EPOCH_S = 1.0e8
+"""A time column beyond this (about three years in seconds) is an epoch clock, [s]."""
+
+
+@dataclass(frozen=True)
+class Recording:
+    """Where one recording's samples went on the monitor's clock."""
+
+    source: str  # the file or bag
+    samples: int  # [-]
+    start_s: float  # its first sample on the monitor's clock, from the first recording's [s]
+    end_s: float  # its last [s]
+    shifted_s: float  # added to its own time column (0: its clock used as it is) [s]
+
+
+@dataclass(frozen=True)
+class MonitorRun:
+    """The monitor after every recording: its snapshot, its time series, the recordings."""
+
+    snapshot: HealthSnapshot
+    points: tuple[HealthPoint, ...]
+    recordings: tuple[Recording, ...]
+    settings: HealthSettings
+    baseline: str  # where the baseline came from
+    t0_epoch: float | None = None  # epoch seconds of the first sample, where the data give them
+    notes: tuple[str, ...] = field(default=())
+
+
+STALE_SHARE = 0.5
+"""A recording more of whose samples than this do not advance in time has no time column."""
+
+
+def _in_time_order(tables: list[BenchTable], notes: list[str]) -> list[BenchTable]:
+    """Sort recordings whose clocks are all epoch clocks by their first sample."""
+    firsts = []
+    for table in tables:
+        time = np.asarray(table.channels.get('time', []), dtype=float)
+        finite = time[np.isfinite(time)]
+        firsts.append(float(finite[0]) if finite.size else math.nan)
+    if not tables or not all(f > EPOCH_S for f in firsts):
+        return tables
+    order = sorted(range(len(tables)), key=lambda i: firsts[i])
+    if order != list(range(len(tables))):
+        notes.append('the recordings were given out of time order; taken by their epoch '
+                     'clocks: ' + ', '.join(tables[i].source for i in order))
+    return [tables[i] for i in order]
+
+
+def monitor_recordings(tables: Sequence[BenchTable], baseline: Baseline,
+                       settings: HealthSettings | None = None,
+                       monitor: HealthMonitor | None = None) -> MonitorRun:
+    """
+    Run one monitor over recordings in the order given.
+
+    Parameters
+    ----------
+    tables : sequence of BenchTable
+        Time series (a ``time`` channel each), [-]
+    baseline : Baseline
+        The healthy motor, [-]
+    settings : HealthSettings, optional
+        The monitor's settings, [-]
+    monitor : HealthMonitor, optional
+        A monitor to continue (resumed from a state file); a new one otherwise, [-]
+
+    Returns
+    -------
+    MonitorRun
+        The figures after the last sample, the time series and where each recording went.
+
+    """
+    monitor = monitor or HealthMonitor(baseline, settings)
+    points: list[HealthPoint] = []
+    recordings: list[Recording] = []
+    notes: list[str] = []
+    last = monitor.t_last
+    first_time = math.nan
+    tables = _in_time_order(list(tables), notes)
+    for table in tables:
+        samples = HealthSamples.from_table(table)
+        time = samples.time
+        finite = time[np.isfinite(time)]
+        if not finite.size:
+            continue
+        shift = 0.0
+        if math.isfinite(last) and finite[0] <= last:
+            shift = last + GAP_S - float(finite[0])
+            notes.append(f'{table.source}: its clock starts again; placed {GAP_S:.0f} s after '
+                         'the recording before it')
+        if shift:
+            samples = HealthSamples(time + shift, samples.speed, samples.flow, samples.p_in,
+                                    samples.p_out, samples.p_case, samples.temperature)
+        if math.isnan(first_time):
+            first_time = float(finite[0] + shift)
+        stale = monitor.skipped['stale']
+        for start in range(0, len(samples), BLOCK):
+            monitor.update(samples.take(slice(start, start + BLOCK)))
+            points += monitor.pop_points()
+        if monitor.skipped['stale'] - stale > STALE_SHARE * len(samples):
+            msg = (f'{table.source}: time: {monitor.skipped["stale"] - stale} of '
+                   f'{len(samples)} samples do not advance in time: is it the time column?')
+            raise DataError(msg)
+        origin = monitor.t0
+        recordings.append(Recording(table.source, len(samples), float(finite[0] + shift - origin),
+                                    float(finite[-1] + shift - origin), shift))
+        last = float(finite[-1] + shift)
+    epoch = monitor.t0 if math.isfinite(monitor.t0) and monitor.t0 > EPOCH_S else None
+    return MonitorRun(monitor.snapshot(), tuple(points), tuple(recordings), monitor.settings,
+                      baseline.source, epoch, tuple(notes))
+
+
+__all__ = ['BLOCK', 'EPOCH_S', 'GAP_S', 'monitor_recordings', 'MonitorRun', 'Recording']

@@ -1,0 +1,531 @@
+# SPDX-License-Identifier: Apache-2.0
+"""
+The ``motor_monitor`` node: the motor's health over time, live, on its topics.
+
+Subscribes ``flow_measured`` (else ``flow_command``), ``inlet_pressure``,
+``outlet_pressure``, ``joint_states`` and, when they are published, ``case_pressure``
+and ``fluid_temperature`` (names and types from :mod:`satmotor_ros.interface`);
+publishes ``health/leakage_factor``, ``health/volumetric_efficiency`` (at the current
+operating point), ``health/hours_to_limit`` (std_msgs/Float64; inf when not drifting)
+and ``/diagnostics``: OK; WARN when the trend reaches the limit within ``warn_hours``
+or an input is missing or bad; ERROR on a detected change or a crossed limit.
+
+A sample is taken on every ``joint_states`` message (its header stamp is the sample's
+time, on the data's own clock), with the latest value of each other topic; a topic not
+heard for ``input_timeout`` makes the sample stale (counted and skipped by the
+estimator, never folded in). Samples go to the estimator a block per ``update_period``.
+The node holds no physics and no statistics: the estimator is
+:class:`satmotor_ros.identify.health.HealthMonitor`, the one ``satmotor monitor`` runs.
+With ``state_file`` its state is resumed at start and saved every ``save_period`` and at
+shutdown, whole or not at all, so hours of history survive a restart; a file that is not
+a health state is reported and never written over.
+"""
+
+from __future__ import annotations
+
+from array import array
+import math
+from pathlib import Path
+from typing import Any
+
+from diagnostic_msgs.msg import DiagnosticArray
+import numpy as np
+from rcl_interfaces.msg import SetParametersResult
+from rclpy.event_handler import PublisherEventCallbacks, SubscriptionEventCallbacks
+from rclpy.node import Node
+from rclpy.qos import qos_profile_sensor_data
+from rclpy.time import Time
+from satmotor_ros.identify.coverage import calibrated_envelope
+from satmotor_ros.identify.errors import DataError
+from satmotor_ros.identify.health import (Baseline, HealthMonitor, HealthSamples,
+                                          HealthSettings, HealthSnapshot)
+from satmotor_ros.interface import CHANNELS, DIAGNOSTICS, HEALTH_TOPICS, JOINT_NAME
+from satmotor_ros.model import ModelError
+from satmotor_ros.model.units import gauge
+from satmotor_ros.nodes import _diagnostics as diag
+from satmotor_ros.nodes import _parameters as params
+from satmotor_ros.nodes._parameters import ParamSpec, RosParameter
+from satmotor_ros.nodes._spin import node_main
+from sensor_msgs.msg import FluidPressure, JointState, Temperature
+from std_msgs.msg import Float64
+
+INPUTS = ('flow_measured', 'flow', 'p_in', 'p_out', 'p_case', 'temperature')
+"""The held channels by their :data:`~satmotor_ros.interface.CHANNELS` name."""
+
+REQUIRED = ('p_in', 'p_out')
+"""Held channels a sample cannot do without (and a flow: measured, else commanded)."""
+
+SETTINGS = (
+    ParamSpec('false_alarm_hours', 1000.0, 'mean operating hours between false change '
+              'alarms; sets the detector threshold', 'h', 1.0, 1.0e9),
+    ParamSpec('limit_leakage_factor', 2.0, 'leakage factor at which the motor is worn out',
+              '-', 1.0e-3, 1.0e3),
+    ParamSpec('limit_volumetric_efficiency', 0.0, 'instead: volumetric efficiency at the '
+              'reference point at which it is worn out; 0 uses the leakage factor', '-',
+              0.0, 0.999),
+    ParamSpec('change_fraction', 0.2, 'relative change of the losses the detector is tuned '
+              'to', '-', 1.0e-3, 10.0),
+    ParamSpec('learn_hours', 0.25, 'operation that teaches the noise model and the level',
+              'h', 1.0e-4, 1.0e4),
+    ParamSpec('bin_s', 10.0, 'samples are pooled into bins this long', 's', 0.01, 3600.0),
+    ParamSpec('window_s', 300.0, 'window of the windowed leakage factor', 's', 0.01, 1.0e6),
+    ParamSpec('trend_hours', 200.0, 'forgetting time constant of the trend', 'h', 1.0e-3,
+              1.0e6),
+    ParamSpec('min_speed', 0.5, 'below it a sample is stalled', 'rad/s', 0.0, 1.0e4),
+)
+"""Parameters handed to :class:`HealthSettings` (same names)."""
+
+PARAMETERS = (
+    *params.MOTOR_PARAMETERS,
+    *SETTINGS,
+    ParamSpec('warn_hours', 100.0, 'WARN when the trend reaches the limit within this',
+              'h', 0.0, 1.0e9),
+    ParamSpec('joint_name', JOINT_NAME, 'joint whose velocity in joint_states is the speed'),
+    ParamSpec('input_timeout', 0.5, 'a held topic older than this makes a sample stale', 's',
+              0.001, 3600.0),
+    ParamSpec('update_period', 1.0, 'samples go to the estimator (and the health topics '
+              'out) this often', 's', 0.01, 3600.0),
+    ParamSpec('diagnostics_period', 1.0, 'period of /diagnostics', 's', 0.01, 3600.0),
+    ParamSpec('state_file', '', 'estimator state: resumed at start, saved every '
+              "save_period and at shutdown; '' keeps no state"),
+    ParamSpec('save_period', 60.0, 'how often the state is saved', 's', 1.0, 1.0e6),
+    ParamSpec('max_block', 100000, 'most samples held between updates (the oldest dropped '
+              'beyond, counted)', '-', 10, 10000000, read_only=True),
+)
+"""The node's parameters: name, default, description, unit and accepted values."""
+
+_SPECS = {spec.name: spec for spec in PARAMETERS}
+_REBUILD = {*params.MOTOR_KEYS, *(s.name for s in SETTINGS)}
+_QUIET = PublisherEventCallbacks(use_default_callbacks=False)
+_QUIET_SUBSCRIPTION = SubscriptionEventCallbacks(use_default_callbacks=False)
+_COLUMNS = ('time', 'speed', 'flow', 'p_in', 'p_out', 'p_case', 'temperature', 'stale')
+
+
+def settings_from(values: dict[str, Any]) -> HealthSettings:
+    """
+    Build the estimator's settings from the node parameters.
+
+    Parameters
+    ----------
+    values : dict
+        Parameter name -> value (see :data:`PARAMETERS`), [SI, hours]
+
+    Returns
+    -------
+    HealthSettings
+        The settings; a 0 ``limit_volumetric_efficiency`` is none.
+
+    """
+    given = {s.name: values[s.name] for s in SETTINGS}
+    given['limit_volumetric_efficiency'] = given['limit_volumetric_efficiency'] or None
+    return HealthSettings(**given)
+
+
+def baseline_from(values: dict[str, Any]) -> Baseline:
+    """
+    Build the healthy motor the parameters name: a motor file, or a family at a displacement.
+
+    Parameters
+    ----------
+    values : dict
+        Parameter name -> value, [-]
+
+    Returns
+    -------
+    Baseline
+        With the envelope a calibrated ``coefficients.yaml`` records.
+
+    Raises
+    ------
+    ModelError
+        If the options do not make a motor (a family the file is not, ...), naming it.
+
+    """
+    model = params.motor_options(values).build_model()
+    path = values['motor_file']
+    if not path:
+        return Baseline(model)
+    return Baseline(model, calibrated_envelope(path), path)
+
+
+class MotorMonitorNode(Node):
+    """
+    Track the motor's health from its topics.
+
+    Parameters
+    ----------
+    node_name : str
+        Name of the node, [-]
+    **kwargs : Any
+        Passed to :class:`rclpy.node.Node` (namespace, context, parameter_overrides, ...), [-]
+
+    """
+
+    def __init__(self, node_name: str = 'motor_monitor', **kwargs: Any) -> None:
+        """Declare parameters, build or resume the estimator, open the topics."""
+        super().__init__(node_name, **kwargs)
+        self._problems = params.declare(self, PARAMETERS)
+        for problem in self._problems.values():
+            self.get_logger().error(f'parameter {problem}')
+        values = self._values = params.values(self, PARAMETERS)
+        self.monitor: HealthMonitor | None = None
+        self._error = ''  # why there is no estimator, or why it failed
+        self._state_note = ''  # what happened to the state file
+        self._may_save = True  # False: the state file is someone else's
+        self._build(values, resume=True)
+        self._held = {name: math.nan for name in INPUTS}
+        self._heard = {name: -math.inf for name in INPUTS}  # node clock at reception [s]
+        self._block: dict[str, array[float]] = {c: array('d') for c in _COLUMNS}
+        self._optional = {'p_case': False, 'temperature': False}  # ever heard
+        self._last_time = -math.inf  # of the last sample, on the data's clock [s]
+        self._last_heard_joint = -math.inf  # node clock [s]
+        self.taken = self.dropped = self.out_of_order = self.bad = self.no_joint = 0
+        self.received = 0  # messages of the held topics taken
+        self.last_bad = ''
+        self._alarms_seen = 0
+        self._pub = {topic: self.create_publisher(Float64, topic, 10, event_callbacks=_QUIET)
+                     for topic in HEALTH_TOPICS}
+        self._pub_diag = self.create_publisher(DiagnosticArray, DIAGNOSTICS, 10,
+                                               event_callbacks=_QUIET)
+        sensor = qos_profile_sensor_data
+        for kind, name, callback in (
+                (Float64, 'flow_measured', self._on_float('flow_measured')),
+                (Float64, 'flow', self._on_float('flow')),
+                (FluidPressure, 'p_in', self._on_pressure('p_in')),
+                (FluidPressure, 'p_out', self._on_pressure('p_out')),
+                (FluidPressure, 'p_case', self._on_pressure('p_case')),
+                (Temperature, 'temperature', self._on_temperature),
+                (JointState, 'measured_speed', self._on_joint_states)):
+            self.create_subscription(kind, CHANNELS[name].topic, callback, sensor,
+                                     event_callbacks=_QUIET_SUBSCRIPTION)
+        self._update_timer = self.create_timer(values['update_period'], self.update)
+        self._diag_timer = self.create_timer(values['diagnostics_period'], self.diagnose)
+        self._save_timer = self.create_timer(values['save_period'], self.save)
+        self.add_on_set_parameters_callback(self._check_parameters)
+        self.add_post_set_parameters_callback(self._apply_parameters)
+
+    # -- the estimator ----------------------------------------------------------------------
+
+    def _build(self, values: dict[str, Any], resume: bool) -> None:
+        try:
+            baseline = baseline_from(values)
+            settings = settings_from(values)
+        except (ModelError, DataError, OSError, ValueError) as err:
+            self.monitor, self._error = None, f'no baseline: {err}'
+            self.get_logger().error(self._error)
+            return
+        self._error = ''
+        path = values['state_file']
+        if resume and path and Path(path).exists():
+            try:
+                self.monitor = HealthMonitor.resume(path, baseline)
+                self._state_note = f'resumed from {path}'
+                self.get_logger().info(self._state_note)
+                return
+            except DataError as err:
+                self._may_save = False
+                self._state_note = f'{err}; starting afresh and not saving over it'
+                self.get_logger().error(self._state_note)
+        self.monitor = HealthMonitor(baseline, settings)
+
+    def _check_parameters(self, request: list[RosParameter]) -> SetParametersResult:
+        result = params.check(_SPECS, request)
+        if not result.successful:
+            return result
+        proposed = dict(self._values)
+        proposed.update({p.name: p.value for p in request if p.name in _SPECS})
+        try:
+            settings_from(proposed)
+            if any(p.name in params.MOTOR_KEYS for p in request):
+                baseline_from(proposed)
+        except (ModelError, DataError, OSError, ValueError) as err:
+            return SetParametersResult(successful=False, reason=str(err))
+        return SetParametersResult(successful=True)
+
+    def _apply_parameters(self, changed: list[RosParameter]) -> None:
+        names = {p.name for p in changed}
+        for name in names:
+            self._problems.pop(name, None)
+        values = self._values = params.values(self, PARAMETERS)
+        if names & _REBUILD:  # a new baseline or new settings: the history means another motor
+            self.get_logger().warning(f'{", ".join(sorted(names & _REBUILD))} changed: the '
+                                      'estimator starts afresh')
+            self._build(values, resume=False)
+        for timer, key, callback in ((self._update_timer, 'update_period', self.update),
+                                     (self._diag_timer, 'diagnostics_period', self.diagnose),
+                                     (self._save_timer, 'save_period', self.save)):
+            if key in names:
+                self.destroy_timer(timer)
+                setattr(self, f'_{key.split("_")[0]}_timer',
+                        self.create_timer(values[key], callback))
+        if 'state_file' in names:
+            self._may_save, self._state_note = True, ''
+
+    # -- inputs -----------------------------------------------------------------------------
+
+    def _now(self) -> float:
+        return self.get_clock().now().nanoseconds * 1.0e-9
+
+    def _hold(self, name: str, value: float, what: str) -> None:
+        if not math.isfinite(value):  # a NaN held would spoil every sample until the next
+            self.bad += 1
+            self.last_bad = f'{what} = {value!r}: not finite'
+            self.get_logger().warning(f'{self.last_bad}; ignored', throttle_duration_sec=5.0)
+            return
+        self._held[name] = value
+        self._heard[name] = self._now()
+        self.received += 1
+
+    def _on_float(self, name: str) -> Any:
+        topic = CHANNELS[name].topic
+
+        def on_float(msg: Float64) -> None:
+            self._hold(name, msg.data, f'{topic}.data')
+        return on_float
+
+    def _on_pressure(self, name: str) -> Any:
+        topic = CHANNELS[name].topic
+
+        def on_pressure(msg: FluidPressure) -> None:
+            if name in self._optional:
+                self._optional[name] = True
+            self._hold(name, gauge(msg.fluid_pressure), f'{topic}.fluid_pressure')
+        return on_pressure
+
+    def _on_temperature(self, msg: Temperature) -> None:
+        self._optional['temperature'] = True
+        self._hold('temperature', msg.temperature, 'fluid_temperature.temperature')
+
+    def _on_joint_states(self, msg: JointState) -> None:
+        try:
+            speed = msg.velocity[msg.name.index(self._values['joint_name'])]
+        except (ValueError, IndexError):
+            self.no_joint += 1  # no such joint, or no velocity for it: not a measurement
+            return
+        stamp = msg.header.stamp
+        now = self._last_heard_joint = self._now()
+        t = stamp.sec + 1.0e-9 * stamp.nanosec if (stamp.sec or stamp.nanosec) else now
+        if not t > self._last_time:
+            self.out_of_order += 1  # the estimator takes samples in time order only
+            return
+        self._last_time = t
+        self.take(t, speed, now)
+
+    def take(self, t: float, speed: float, now: float) -> None:
+        """
+        Add one sample at time `t` with the held values of the other topics.
+
+        Parameters
+        ----------
+        t : float
+            The sample's time on the data's clock, [s]
+        speed : float
+            Shaft speed, [rad/s]
+        now : float
+            The node clock, for the inputs' ages, [s]
+
+        """
+        timeout = self._values['input_timeout']
+        fresh = {name: now - heard <= timeout for name, heard in self._heard.items()}
+        heard = self._heard  # the flowmeter while it speaks, else the latest of the two
+        flow = ('flow_measured' if fresh['flow_measured']
+                or heard['flow_measured'] >= heard['flow'] else 'flow')
+        stale = not (fresh[flow] and all(fresh[n] for n in REQUIRED))
+        for name, on in self._optional.items():
+            stale = stale or (on and not fresh[name])
+        block = self._block
+        for column, value in (('time', t), ('speed', speed), ('flow', self._held[flow]),
+                              ('p_in', self._held['p_in']), ('p_out', self._held['p_out']),
+                              ('p_case', self._held['p_case']),
+                              ('temperature', self._held['temperature']),
+                              ('stale', float(stale))):
+            block[column].append(value)
+        self.taken += 1
+        if len(block['time']) > self._values['max_block']:
+            for values in block.values():
+                del values[0]
+            self.dropped += 1
+
+    # -- the estimate -----------------------------------------------------------------------
+
+    def update(self, publish: bool = True) -> None:
+        """
+        Hand the samples held to the estimator and, with `publish`, publish the figures.
+
+        Parameters
+        ----------
+        publish : bool
+            False at shutdown: a signal may have invalidated the context already, [-]
+
+        """
+        block = self._block
+        if not block['time'] or self.monitor is None:
+            return
+        arrays = {c: np.frombuffer(v, dtype=float).copy() for c, v in block.items()}
+        for column in block.values():
+            del column[:]
+        samples = HealthSamples(
+            arrays['time'], arrays['speed'], arrays['flow'], arrays['p_in'], arrays['p_out'],
+            arrays['p_case'] if self._optional['p_case'] else None,
+            arrays['temperature'] if self._optional['temperature'] else None,
+            arrays['stale'] > 0.0)
+        try:
+            alarms = self.monitor.update(samples)
+        except DataError as err:  # the estimator refused the block: say so, keep running
+            self._error = f'estimator: {err}'
+            self.get_logger().error(self._error, throttle_duration_sec=5.0)
+            return
+        self.monitor.pop_points()  # the per-bin series is the CLI's; the node keeps no list
+        for alarm in alarms:
+            self.get_logger().error(f'{alarm.kind} alarm at {alarm.time_s:.1f} s: '
+                                    f'{alarm.what} (statistic {alarm.statistic:.3g})')
+        if publish:
+            self.publish(self.monitor.snapshot())
+
+    def publish(self, snap: HealthSnapshot) -> None:
+        """
+        Publish the health topics of a snapshot (what has no value yet is not published).
+
+        Parameters
+        ----------
+        snap : HealthSnapshot
+            The estimator's figures, [-]
+
+        """
+        for topic, value in zip(HEALTH_TOPICS, (snap.leakage_factor.value,
+                                                snap.volumetric_efficiency,
+                                                snap.hours_to_limit.value)):
+            if math.isfinite(value) or (topic == HEALTH_TOPICS[2] and value == math.inf):
+                self._pub[topic].publish(Float64(data=float(value)))
+
+    def save(self) -> None:
+        """Save the estimator's state to ``state_file`` (whole or not at all)."""
+        path = self._values['state_file']
+        if not path or self.monitor is None or not self._may_save:
+            return
+        try:
+            self.monitor.save(path)
+            self._state_note = f'saved to {path}'
+        except OSError as err:
+            self._state_note = f'cannot save {path}: {err}'
+            self.get_logger().error(self._state_note, throttle_duration_sec=60.0)
+
+    def destroy_node(self) -> None:
+        """Feed the last samples and save the state before the node goes."""
+        self.update(publish=False)
+        self.save()
+        super().destroy_node()
+
+    # -- diagnostics ------------------------------------------------------------------------
+
+    def level(self, snap: HealthSnapshot | None) -> tuple[int, str]:
+        """
+        Judge a snapshot and the inputs: OK, WARN or ERROR and why.
+
+        Parameters
+        ----------
+        snap : HealthSnapshot or None
+            The estimator's figures; None without an estimator, [-]
+
+        Returns
+        -------
+        tuple of (int, str)
+            The level (0, 1, 2) and the message.
+
+        """
+        if snap is None or self._error:
+            return 2, self._error or 'no estimator'
+        if self._problems:
+            return 2, f'parameter {"; ".join(self._problems.values())}'
+        if snap.alarms:
+            last = snap.alarms[-1]
+            if last.kind == 'change':
+                return 2, (f'change at {last.change_s:.1f} s (alarm at {last.time_s:.1f} s): '
+                           f'{last.what}')
+        if snap.leakage_factor.value >= snap.limit_leakage_factor or (
+                snap.alarms and snap.alarms[-1].kind == 'limit'):
+            return 2, f'limit crossed: leakage factor {snap.leakage_factor.value:.3g} ' \
+                      f'(limit {snap.limit_leakage_factor:.3g})'
+        if snap.hours_to_limit.value < self._values['warn_hours']:
+            return 1, f'limit within {snap.hours_to_limit.value:.3g} h'
+        quiet = self.quiet()
+        if quiet:
+            return 1, f'no recent message on {", ".join(quiet)}'
+        if not self._may_save:
+            return 1, self._state_note
+        if self.bad or self.out_of_order or self.no_joint:
+            return 1, f'inputs refused: {self.last_bad or "joint_states out of order"}'
+        return 0, 'learning' if snap.learning else 'healthy'
+
+    def quiet(self) -> list[str]:
+        """Name the topics a sample needs that were not heard within ``input_timeout``."""
+        now, timeout = self._now(), self._values['input_timeout']
+        quiet = [CHANNELS[n].topic for n in REQUIRED if now - self._heard[n] > timeout]
+        if now - max(self._heard['flow'], self._heard['flow_measured']) > timeout:
+            quiet.append('flow_measured (or flow_command)')
+        if now - self._last_heard_joint > timeout:
+            quiet.append(CHANNELS['measured_speed'].topic)
+        return quiet
+
+    def diagnose(self) -> None:
+        """Publish /diagnostics: the figures with intervals, the alarms, the inputs."""
+        snap = self.monitor.snapshot() if self.monitor is not None else None
+        level, message = self.level(snap)
+        values: dict[str, Any] = {}
+        if snap is not None:
+            values.update(_figures(snap))
+        now = self._now()
+        for name in INPUTS:
+            values[f'{CHANNELS[name].topic} age [s]'] = diag.human(now - self._heard[name],
+                                                                   's')[1]
+        values.update({'samples taken': self.taken, 'samples dropped': self.dropped,
+                       'joint_states out of order': self.out_of_order,
+                       'joint_states without joint': self.no_joint,
+                       'inputs refused': self.bad, 'last refused': self.last_bad,
+                       'state_file': self._values['state_file'] or 'none',
+                       'state': self._state_note})
+        name = f'{self.get_fully_qualified_name()}: motor health'
+        hardware = self.monitor.baseline.source if self.monitor is not None else 'motor'
+        self._pub_diag.publish(diag.array(Time(nanoseconds=int(now * 1e9)), [diag.status(
+            name, hardware, level, message, values)]))
+
+
+def _interval(e: Any) -> str:
+    return f'[{e.low:.4g}, {e.high:.4g}]'
+
+
+def _figures(snap: HealthSnapshot) -> dict[str, Any]:
+    """Return a snapshot's figures as diagnostics key/values (hours where a person reads)."""
+    last = snap.alarms[-1] if snap.alarms else None
+    return {
+        'leakage_factor [-]': f'{snap.leakage_factor.value:.4g}',
+        'leakage_factor ci95 [-]': _interval(snap.leakage_factor),
+        'trend_per_hour [1/h]': f'{snap.trend_per_hour.value:.4g}',
+        'trend_per_hour ci95 [1/h]': _interval(snap.trend_per_hour),
+        'hours_to_limit [h]': f'{snap.hours_to_limit.value:.4g}',
+        'hours_to_limit ci95 [h]': _interval(snap.hours_to_limit),
+        'limit_leakage_factor [-]': f'{snap.limit_leakage_factor:.4g}',
+        'volumetric_efficiency [-]': f'{snap.volumetric_efficiency:.4g}',
+        'volumetric_efficiency reference [-]':
+            f'{snap.volumetric_efficiency_reference.value:.4g}',
+        'volumetric_efficiency reference ci95 [-]':
+            _interval(snap.volumetric_efficiency_reference),
+        'operating_hours [h]': f'{snap.operating_hours:.4g}',
+        'learning': snap.learning, 'statistic [-]': f'{snap.statistic:.4g}',
+        'samples': snap.n_samples, 'skipped': snap.n_skipped,
+        **{f'skipped {reason}': count for reason, count in snap.skipped.items()},
+        'alarms': len(snap.alarms),
+        'last alarm': 'none' if last is None else f'{last.kind} at {last.time_s:.1f} s',
+        'change_time [s]': f'{snap.change_s:.1f}' if math.isfinite(snap.change_s) else 'none',
+        'what changed': snap.what_changed or 'none',
+    }
+
+
+main = node_main(MotorMonitorNode, 'motor_monitor')
+
+
+__all__ = ['HEALTH_TOPICS', 'MotorMonitorNode', 'PARAMETERS', 'main']
+
+
+if __name__ == '__main__':
+    main()

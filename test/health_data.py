@@ -1,0 +1,47 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Synthetic recordings for the health monitor's tests: a motor running, losses scaled."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from satmotor_ros.identify.health import Baseline, HealthSamples
+from satmotor_ros.model.units import LPM, MPA
+
+DISPLACEMENT = 2.0e-6
+"""q_t/(2 pi) of the test motor, [m^3/rad]."""
+
+
+def recording(hours: float, seed: int = 0, rate_hz: float = 5.0, noise_lpm: float = 0.05,
+              scale: Callable[[np.ndarray], np.ndarray] | None = None,
+              baseline: Baseline | None = None, t0: float = 0.0) -> HealthSamples:
+    """
+    Return a motor cycling through speeds and loads, its losses times `scale(t)`.
+
+    The noise is white plus a slow correlated part (an AR(1) of 2 s), as a real flowmeter's.
+    """
+    baseline = baseline or Baseline.for_family('paszota', DISPLACEMENT)
+    rng = np.random.default_rng(seed)
+    t = t0 + np.arange(int(hours * 3600 * rate_hz)) / rate_hz
+    speed = 60.0 + 40.0 * np.sin(2 * np.pi * t / 47.0) + 10.0 * np.sin(2 * np.pi * t / 13.0)
+    dp = (8.0 + 5.0 * np.sin(2 * np.pi * t / 31.0 + 1.0)) * MPA
+    model = baseline.model
+    flow = model.absorbency(speed, dp=dp, errors='mask').flow
+    loss = flow - model.geometry.displacement * speed
+    if scale is not None:
+        flow = flow + (scale(t) - 1.0) * loss
+    if noise_lpm:
+        colored = np.zeros(t.size)
+        shocks = rng.normal(0.0, noise_lpm * np.sqrt(1 - 0.9 ** 2), t.size)
+        for i in range(1, t.size):
+            colored[i] = 0.9 * colored[i - 1] + shocks[i]
+        flow = flow + (colored + rng.normal(0.0, 0.3 * noise_lpm, t.size)) * LPM
+    p_out = np.full(t.size, 0.5 * MPA)
+    return HealthSamples(t, speed, flow, p_out + dp, p_out)
+
+
+def blocks(samples: HealthSamples, size: int) -> list[HealthSamples]:
+    """Cut samples into blocks of `size`."""
+    return [samples.take(slice(i, i + size)) for i in range(0, len(samples), size)]

@@ -1,0 +1,311 @@
+# SPDX-License-Identifier: Apache-2.0
+"""The fleet's parts without a cluster: fleet.yaml, discovery, resume, trend and alarms."""
+
+from datetime import datetime, timezone
+import os
+
+import numpy as np
+import pytest
+
+from satmotor_ros.cli.main import main
+from satmotor_ros.fleet.config import FleetConfig, load_fleet
+from satmotor_ros.fleet.discover import (BAG_START, discover, MTIME, PATH_DATE, path_date,
+                                         TIME_COLUMN)
+from satmotor_ros.fleet.errors import FleetError
+from satmotor_ros.fleet.resume import is_done, options_key, stat_of, write_done
+from satmotor_ros.fleet.summary import DAY, motor_view, rank
+
+HEADER = 'time [s],speed [rpm],flow [l/min],p_in [MPa],p_out [MPa]\n'
+EPOCH = datetime(2026, 3, 1, tzinfo=timezone.utc).timestamp()
+
+
+def _csv(path, first_time=0.0):
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(HEADER + f'{first_time},1000,20,10,1\n{first_time + 1},1000,20,10,1\n')
+    return path
+
+
+@pytest.mark.parametrize(('text', 'said'), [
+    ('motors: [{pattern: "a/**", motor: m1, colour: red}]', "unknown key 'colour'"),
+    ('motors: [{pattern: "a/**"}]', 'motor is missing'),
+    ('motors: [{pattern: "a/**", motor: m1, liquid: beer}]', "liquid = 'beer'"),
+    ('motors: [{pattern: "a/**", motor: m1, displacement: 5 furlongs}]',
+     "displacement = '5 furlongs'"),
+    ('motors: [{pattern: "a/**", motor: "../up"}]', "motor = '../up'"),
+    ('motors: [{pattern: "a/**", motor: m1, motor_file: nope.yaml}]', 'no such file'),
+    ('vessels: []', 'need one key, motors'),
+    ('motors: [{pattern: [1], motor: m1}]', 'pattern = [1]'),
+])
+def test_fleet_yaml_is_read_strictly_one_line_naming_key_and_value(tmp_path, text, said):
+    path = tmp_path / 'fleet.yaml'
+    path.write_text(text)
+    with pytest.raises(FleetError, match='motors') as err:
+        load_fleet(path)
+    assert said in str(err.value) and '\n' not in str(err.value)
+
+
+def test_fleet_yaml_first_matching_pattern_wins_and_parents_match(tmp_path):
+    path = tmp_path / 'fleet.yaml'
+    path.write_text('motors:\n'
+                    '  - {pattern: "ships/*/pump_a", motor: special, displacement: 10cm^3/rev}\n'
+                    '  - {pattern: "ships/**", motor: other, liquid: oil}\n')
+    config = load_fleet(path)
+    assert config.rule_for('ships/kestrel/pump_a/2026-03-01.csv').motor == 'special'
+    assert config.rule_for('ships/kestrel/pump_b/x.csv').motor == 'other'
+    assert config.rule_for('rigs/x.csv') is None
+    assert config.rules[0].displacement == pytest.approx(10e-6 / (2 * np.pi))
+
+
+def test_discovery_groups_by_first_level_and_orders_by_time_and_says_how(tmp_path):
+    _csv(tmp_path / 'm1' / 'b.csv', EPOCH + DAY)  # epoch time column
+    _csv(tmp_path / 'm1' / 'a.csv', EPOCH + 2 * DAY)
+    _csv(tmp_path / 'm1' / 'sub' / 'run_2026-02-27T0930.csv')  # relative time: path date
+    undated = _csv(tmp_path / 'm2' / 'undated.csv')
+    os.utime(undated, (EPOCH, EPOCH))
+    bag = tmp_path / 'm2' / 'bag1'
+    bag.mkdir()
+    (bag / 'metadata.yaml').write_text(
+        'rosbag2_bagfile_information:\n  starting_time:\n'
+        f'    nanoseconds_since_epoch: {int((EPOCH + DAY) * 1e9)}\n')
+    (tmp_path / 'm2' / 'notes.txt').write_text('not a recording without a column mapping\n')
+    lost = tmp_path / 'm2' / 'lost_2026-01-01'  # its metadata.yaml never written: still found
+    lost.mkdir()
+    (lost / 'lost_0.mcap').write_bytes(b'\x89MCAP0\r\n')
+    motors = discover(tmp_path, FleetConfig())
+    assert [m.motor for m in motors] == ['m1', 'm2']
+    m1, m2 = motors
+    assert [r.relative for r in m1.recordings] == ['m1/sub/run_2026-02-27T0930.csv',
+                                                   'm1/b.csv', 'm1/a.csv']
+    assert [r.time_source for r in m1.recordings] == [PATH_DATE, TIME_COLUMN, TIME_COLUMN]
+    assert m1.recordings[0].date == '2026-02-27T09:30:00+00:00'
+    assert m1.recordings[0].name == 'sub__run_2026-02-27T0930.csv'
+    assert [(r.relative, r.kind, r.time_source) for r in m2.recordings] == [
+        ('m2/lost_2026-01-01', 'bag', PATH_DATE), ('m2/undated.csv', 'csv', MTIME),
+        ('m2/bag1', 'bag', BAG_START)]
+
+
+def test_path_date_takes_the_last_date_of_the_path():
+    assert path_date('2025-01-01/run_20260301_120000.csv') == EPOCH + 12 * 3600
+    assert path_date('unit7/run_99.csv') is None
+    assert path_date('2026-13-45.csv') is None
+
+
+def test_resume_is_done_by_stat_then_by_content_and_never_for_other_options(tmp_path):
+    data = _csv(tmp_path / 'r.csv')
+    out = tmp_path / 'out'
+    from satmotor_ros.fleet.resume import content_of
+    key = options_key({'calibrate': False})
+    write_done(out, {'options': key, 'stat': stat_of(data), 'content': content_of(data)})
+    assert is_done(out, data, key) is not None
+    os.utime(data, (EPOCH, EPOCH))  # touched: same content
+    assert is_done(out, data, key) is not None
+    assert is_done(out, data, options_key({'calibrate': True})) is None
+    data.write_text(HEADER + '0,1000,21,10,1\n')
+    assert is_done(out, data, key) is None
+    assert not list(out.glob('*.partial-*'))
+
+
+def test_a_recording_whose_output_was_deleted_is_not_done(tmp_path):
+    """The done-marker lists the outputs: one deleted since, the recording is redone."""
+    data = _csv(tmp_path / 'r.csv')
+    out = tmp_path / 'out'
+    (out / 'health').mkdir(parents=True)
+    (out / 'health' / 'health.json').write_text('{}')
+    key = options_key({'calibrate': False})
+    write_done(out, {'options': key, 'stat': stat_of(data)})
+    assert is_done(out, data, key) is not None
+    (out / 'health' / 'health.json').unlink()
+    assert is_done(out, data, key) is None
+
+
+def _markers(values, start=EPOCH, half=0.003):
+    return [{'status': 'done', 'recording': f'r{i}.csv', 'date': f'd{i:02d}',
+             'time': start + i * DAY, 'time_source': TIME_COLUMN,
+             'result': {'leakage_factor': v, 'ci95': [v - half, v + half], 'alarms': []}}
+            for i, v in enumerate(values)]
+
+
+def test_wear_gives_a_trend_and_days_to_limit_but_no_change_alarm():
+    rng = np.random.default_rng(1)
+    values = 1.0 + 0.05 * np.arange(10) + rng.normal(0, 0.002, 10)
+    view = motor_view('w', 'water', _markers(values), None, limit=2.0)
+    assert view['alarms'] == []
+    assert view['trend_per_day'] == pytest.approx(0.05, rel=0.05)
+    assert view['days_to_limit'] == pytest.approx((2.0 - 1.45) / 0.05, rel=0.1)
+
+
+def test_a_slope_three_recordings_cannot_tell_from_noise_gives_no_date():
+    """Three recordings, slope 5 standard errors up: with one degree of freedom that is noise."""
+    view = motor_view('h', 'water', _markers([1.0, 1.01, 1.03]), None, limit=2.0)
+    assert view['trend_per_day'] == pytest.approx(0.015)
+    assert view['days_to_limit'] is None
+
+
+def test_a_step_is_one_change_alarm_and_the_trend_restarts_after_it():
+    rng = np.random.default_rng(2)
+    values = np.r_[np.ones(5), 1.5 * np.ones(5)] + rng.normal(0, 0.002, 10)
+    view = motor_view('s', 'water', _markers(values), None, limit=2.0)
+    assert [(a['kind'], a['recording']) for a in view['alarms']] == [('change', 'r5.csv')]
+    assert '+50 %' in view['alarms'][0]['what']
+    assert view['days_to_limit'] is None  # flat since the step
+    crossed = motor_view('x', 'water', _markers([1.0, 1.5, 2.1]), None, limit=2.0)
+    assert crossed['days_to_limit'] == 0.0
+    assert [a['kind'] for a in crossed['alarms']] == ['change', 'change', 'limit']
+
+
+def test_ranking_is_soonest_to_the_limit_first():
+    views = [motor_view('flat', '', _markers([1.0, 1.0, 1.001, 1.0]), None),
+             motor_view('slow', '', _markers(1.0 + 0.01 * np.arange(5)), None),
+             motor_view('fast', '', _markers(1.0 + 0.1 * np.arange(5)), None),
+             motor_view('none', '', [], None)]
+    assert [v['motor'] for v in rank(views)] == ['fast', 'slow', 'flat', 'none']
+
+
+def test_fleet_command_refuses_a_bad_fleet_yaml_and_an_out_it_did_not_write(tmp_path, capsys):
+    _csv(tmp_path / 'root' / 'm1' / 'a.csv')
+    bad = tmp_path / 'bad.yaml'
+    bad.write_text('motors: [{pattern: "*", motor: m1, speed: 3}]')
+    assert main(['fleet', str(tmp_path / 'root'), '--out', str(tmp_path / 'o'),
+                 '--fleet', str(bad)]) == 1
+    err = capsys.readouterr().err
+    assert err.count('\n') == 1 and "unknown key 'speed'" in err
+    theirs = tmp_path / 'theirs'
+    theirs.mkdir()
+    (theirs / 'keep.txt').write_text('mine')
+    assert main(['fleet', str(tmp_path / 'root'), '--out', str(theirs)]) == 1
+    assert 'not an earlier output of satmotor fleet' in capsys.readouterr().err
+    assert main(['fleet', str(tmp_path / 'nothing'), '--out', str(tmp_path / 'o')]) == 1
+    assert 'not a directory' in capsys.readouterr().err
+
+
+@pytest.mark.slow
+def test_a_bag_recording_is_timed_by_its_start_and_watched_by_the_health_monitor(tmp_path):
+    from satmotor_ros.fleet.synthetic import make_fleet
+    from satmotor_ros.fleet.chain import monitor_step
+    from satmotor_ros.fleet.tasks import calibrate_baseline, process_recording, RunOptions
+    import json
+    root = make_fleet(tmp_path / 'root', days=2, points=20, bags=True, motors=())
+    (motor,) = discover(root, FleetConfig())
+    assert motor.motor == 'bagged' and [r.kind for r in motor.recordings] == ['bag', 'bag']
+    assert [r.time_source for r in motor.recordings] == [BAG_START, BAG_START]
+    assert motor.recordings[0].date.startswith('2026-03-01T08:00')
+    run = RunOptions(str(tmp_path / 'out'))  # the bags record their liquid
+    baseline = calibrate_baseline(motor, run)
+    assert baseline['recording'] == 'bagged/b00' and baseline['liquid'] == 'water'
+    marker = process_recording(motor.recordings[1], motor.rule, baseline, run)
+    assert marker['status'] == 'done', marker
+    assert marker['result']['leakage_factor'] == pytest.approx(1.0, abs=0.02)
+    step = monitor_step(motor.recordings[1], motor.rule, baseline, run, None)
+    assert step['status'] == 'done' and step['result']['n_samples'] > 1000
+    monitor = tmp_path / 'out' / 'bagged' / 'b01' / 'monitor'  # as `satmotor monitor` writes
+    assert json.loads((monitor / '.satmotor-output.json').read_text())['command'] == 'monitor'
+    assert json.loads((monitor / 'monitor.json').read_text())['n_samples'] > 1000
+
+
+def _series_csv(path, seed, start):
+    from satmotor_ros.identify.synthetic import generate_series, Injection, Plan, to_columns
+    from satmotor_ros.identify.table import write_csv
+    table = generate_series(Plan(liquid='water', n_points=20, duration_s=600.0), Injection(),
+                            seed, samples=3000, rate=5.0)
+    columns = to_columns(table)
+    columns['time'] = ('s', columns['time'][1] + start)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    write_csv(path, columns)
+
+
+def test_one_monitor_runs_through_the_motors_recordings_in_time_order(tmp_path):
+    from satmotor_ros.fleet.chain import monitor_step, valid_steps
+    from satmotor_ros.fleet.tasks import RunOptions
+    from satmotor_ros.identify.health.report import FILES
+    from satmotor_ros.model.io.config import default_config_path
+    for day in range(2):  # 10 min each: one alone never leaves learn_hours (0.25 h)
+        _series_csv(tmp_path / 'root' / 'm1' / f'r{day}.csv', day, EPOCH + day * 660.0)
+    motor = discover(tmp_path / 'root', FleetConfig())[0]
+    run = RunOptions(str(tmp_path / 'out'), liquid='water')
+    baseline = {'coefficients': str(default_config_path('sm075_25.yaml')), 'liquid': 'water',
+                'key': 'b'}
+    rule = motor.rule
+    steps = [monitor_step(motor.recordings[0], rule, baseline, run, None)]
+    steps.append(monitor_step(motor.recordings[1], rule, baseline, run, steps[0]))
+    assert [s['status'] for s in steps] == ['done', 'done']
+    assert [s['result']['learning'] for s in steps] == [True, False]  # the same monitor
+    assert steps[1]['prev'] == steps[0]['chain']
+    for rec in motor.recordings:  # what `satmotor monitor` writes, per recording
+        assert {p.name for p in (tmp_path / 'out' / 'm1' / rec.name / 'monitor').iterdir()} \
+            >= set(FILES)
+    assert valid_steps(motor, run, 'b') == steps
+    with open(motor.recordings[0].path, 'a') as file:  # a changed first: the chain redone
+        file.write(f'{EPOCH + 601},1000,20,10,1\n')
+    assert valid_steps(motor, run, 'b') == []
+
+
+def test_a_monitored_motors_view_is_the_monitors_figures_and_named_alarms():
+    steps = [{'recording': f'r{i}.csv', 'status': 'done', 'result': {
+        'leakage_factor': {'value': v, 'ci95': [v - 0.01, v + 0.01]}, 'learning': False,
+        'trend_per_hour': 0.01, 'hours_to_limit': 48.0, 'span_s': [i * 100.0, i * 100.0 + 90],
+        'alarms': [{'time_s': 150.0, 'kind': 'change', 'what': 'wear: leakage x1.3'}]
+        if i else []}} for i, v in enumerate((1.0, 1.3))]
+    markers = _markers([1.0, 1.0])
+    view = motor_view('m', 'water', markers, None, steps=steps)
+    assert [p['value'] for p in view['leakage_factor']] == [1.0, 1.3]
+    assert view['trend_per_day'] == pytest.approx(0.24) and view['days_to_limit'] == 2.0
+    assert [(a['kind'], a['recording']) for a in view['alarms']] == [('change', 'r1.csv')]
+    assert view['alarms'][0]['what'].startswith('wear: leakage x1.3')
+
+
+def test_without_a_baseline_the_damaged_keep_their_reason_and_the_sound_say_why(tmp_path):
+    from satmotor_ros.fleet.synthetic import make_fleet
+    from satmotor_ros.fleet.tasks import calibrate_baseline, process_recording, RunOptions
+    from satmotor_ros.fleet.tasks import NO_LIQUID, ZERO_PRESSURE
+    root = make_fleet(tmp_path / 'root', days=5, points=20, motors=('patchy',))
+    (motor,) = discover(root, load_fleet(root / 'fleet.yaml'))
+    run = RunOptions(str(tmp_path / 'out'))  # no liquid anywhere: no baseline
+    baseline = calibrate_baseline(motor, run)
+    assert baseline['reason'] == f'no baseline: tug_d/d00.csv was tried first and {NO_LIQUID}'
+    reasons = {rec.relative: process_recording(rec, motor.rule, baseline, run)['reason']
+               for rec in motor.recordings}
+    assert 'truncated mid-row' in reasons.pop('tug_d/d02.csv')
+    assert reasons.pop('tug_d/d04.csv') == ZERO_PRESSURE
+    assert 'UTF-8' in reasons.pop('tug_d/d99_garbage.csv')
+    assert set(reasons.values()) == {baseline['reason']}
+
+
+@pytest.mark.parametrize(('text', 'said'), [
+    ('motors: [{pattern: "a/**", motor: m1, liquid: oil}, '
+     '{pattern: "b/**", motor: m1, liquid: water}]',
+     "motors[1].liquid = 'water': motors[0] gives motor 'm1' 'oil'"),
+    ('motors: [{pattern: "a/**", motor: m1}, {pattern: "b/**", motor: m1, family: paszota}]',
+     "motors[1].family = 'paszota'"),
+    ('motors: [{pattern: "a/**", motor: m1, displacement: 1e308 m^3/rev}]',
+     "motors[0]: displacement = '1e308 m^3/rev': outside"),
+    ('motors: [{pattern: "a/**", motor: m1, motor_file: fleet.yaml}]',
+     "motors[0]: motor_file = 'fleet.yaml'"),
+])
+def test_fleet_yaml_contradictions_are_refused_at_load_in_one_line(tmp_path, text, said):
+    path = tmp_path / 'fleet.yaml'
+    path.write_text(text)
+    with pytest.raises(FleetError) as err:
+        load_fleet(path)
+    assert said in str(err.value) and '\n' not in str(err.value)
+
+
+def test_the_synthetic_fleet_program_says_one_line_and_replaces_only_its_own(tmp_path, capsys):
+    from satmotor_ros.fleet.synthetic import main as synthetic
+    root = tmp_path / 'fl'
+    for argv, said in [([str(root), '--days'], '--days'), ([], 'ROOT'),
+                       ([str(root), '--days', '0'], "--days: '0': need a whole number")]:
+        assert synthetic(argv) == 1
+        err = capsys.readouterr().err
+        assert said in err and err.count('\n') == 1, err
+    (tmp_path / 'a_file').write_text('mine')
+    theirs = tmp_path / 'theirs'
+    _csv(theirs / 'vessel_a' / 'day00.csv')
+    for target in (tmp_path / 'a_file', theirs):
+        assert synthetic([str(target), '--days', '1']) == 1
+        err = capsys.readouterr().err
+        assert str(target) in err and err.count('\n') == 1
+    assert (tmp_path / 'a_file').read_text() == 'mine'
+    assert (theirs / 'vessel_a' / 'day00.csv').read_text().startswith(HEADER)
+    assert synthetic([str(root), '--days', '1']) == 0
+    assert synthetic([str(root), '--days', '2']) == 0  # its own: replaced
+    assert sorted(p.name for p in (root / 'vessel_a').iterdir()) == ['day00.csv', 'day01.csv']

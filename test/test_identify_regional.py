@@ -1,0 +1,199 @@
+# SPDX-License-Identifier: Apache-2.0
+"""
+Effects confined to a region of a recording, judged where they act (issue 20).
+
+A relief valve opens at the top of the drop, in one direction, during a few per cent of a
+recording: its gain over every row is diluted by how long the recording does something else.
+The loop judges such an effect by its out-of-sample gain where it acts, recurring over
+separate events; a demand-set relief on a real MBARI trajectory must be named, a clean case
+on the same trajectory must stay ``none``.
+"""
+
+import contextlib
+from functools import lru_cache
+import io
+import json
+
+import numpy as np
+import pytest
+from satmotor_ros.cli.main import main
+from satmotor_ros.identify import regional
+from satmotor_ros.identify.fit import HUBER
+from satmotor_ros.identify.regional import acting, CONFINED, local_gain, LocalGain
+from satmotor_ros.identify.semireal import (build_case, demand_relief, estimate_noise,
+                                            load_trajectory, write_mbari_log)
+from satmotor_ros.model.units import LPM
+from vendored_data import data_path
+
+STEPPED = '2021.07.26T10.51.44.exp'
+BIAS = 'FrictionIDMovesWithBiasCurr.exp'
+SPANS = {STEPPED: (230.0, 400.0), BIAS: (240.0, 390.0)}
+"""The high-load part of each log, where its real relief valve clamps the drop [s]."""
+
+
+# -- where an effect acts, and its gain there ----------------------------------------------------
+
+
+def test_an_effect_acts_in_a_region_only_when_its_extra_loss_is_zero_elsewhere():
+    n = 100
+    assert acting(1.0e-5, n) is None  # a constant acts everywhere
+    assert acting(np.full(n, 1.0e-5), n) is None
+    assert acting(np.zeros(n), n) is None  # nowhere: nothing to judge
+    wide = np.zeros(n)
+    wide[:int(CONFINED * n) + 1] = 1.0e-5
+    assert acting(wide, n) is None
+    assert acting(wide[:-1], n - 1) is None
+    wide[int(CONFINED * n)] = 0.0  # a quarter of the rows exactly is still a region
+    assert acting(wide, n).sum() == CONFINED * n
+    valve = np.zeros(n)
+    valve[-5:] = 1.0e-5
+    assert acting(valve, n).tolist() == (valve != 0.0).tolist()
+
+
+def _errors(runs, improved, n=400, block=10):
+    """Return (at, baseline error, candidate error): `runs` events of 5 rows, apart."""
+    at = np.zeros(n, dtype=bool)
+    base = np.full(n, 0.1 * LPM)
+    error = base.copy()
+    for k in range(runs):
+        rows = np.arange(5) + k * 4 * block
+        at[rows] = True
+        base[rows] = 3.0 * LPM
+        error[rows] = (1.0 if k < improved else 3.5) * LPM
+    return at, base, error, np.full(n, 0.3 * LPM), np.arange(n), block
+
+
+def test_a_gain_that_recurs_over_separate_events_passes():
+    gain = local_gain(*_errors(5, 5))
+    assert (gain.rows, gain.events, gain.improved) == (25, 5, 5)
+    assert gain.chance == pytest.approx(1 / 32)  # five of five by chance
+    assert gain.weighted > 0.05 and gain.plain > 0.5 and gain.passes(0.05)
+    at, base, error, sigma, _, _ = _errors(5, 5)  # flows in SI: sums far below 1
+    z0, z1 = base[at] / sigma[at], error[at] / sigma[at]
+    assert gain.weighted == pytest.approx(1.0 - np.sqrt(_huber_sum(z1) / _huber_sum(z0)))
+    assert gain.plain == pytest.approx(1.0 - np.sqrt(np.sum(error[at] ** 2)
+                                                     / np.sum(base[at] ** 2)))
+    assert gain.says() == ('where it acts (25 rows in 5 events) it cuts the cross-validated '
+                           f'error by {100 * gain.weighted:.1f} % (plain {100 * gain.plain:.1f}'
+                           ' %), in 5 of the 5 events (by chance: 0.031)')
+    assert local_gain(*_errors(8, 7)).passes(0.05)  # 7 of 8: 9/256
+
+
+def test_one_event_or_a_gain_in_some_of_them_only_does_not_pass():
+    one = local_gain(*_errors(1, 1))  # a single transient a threshold bends to
+    assert one.events == 1 and one.plain > 0.5 and not one.passes(0.05)
+    # the starts of a few moves a threshold bends to: better in most, worse in some
+    for events, improved in ((4, 4), (6, 5), (6, 2)):
+        gain = local_gain(*_errors(events, improved))
+        assert (gain.events, gain.improved) == (events, improved)
+        assert gain.weighted > 0.05 and not gain.passes(0.0)
+
+
+def test_the_local_gain_must_reach_the_least_gain():
+    at, base, error, sigma, index, block = _errors(5, 5)
+    small = local_gain(at, base, np.where(at, 0.99 * base, base), sigma, index, block)
+    assert small.improved == 5 and not small.passes(0.05) and small.passes(0.0)
+
+
+def _huber_sum(z):
+    c = HUBER
+    return float(np.sum(np.where(np.abs(z) <= c, z * z, 2.0 * c * np.abs(z) - c * c)))
+
+
+def test_the_local_gain_is_the_huber_and_the_plain_cut_over_the_rows_where_it_acts():
+    """Exact figures, a noise other than 1 and errors past the Huber corner and below it."""
+    block = 3
+    at = np.zeros(20, dtype=bool)
+    at[[2, 5, 9, 10]] = True  # 2 and 5 are a block apart (one event), 9 one more (another)
+    base = np.full(20, 7.0)
+    error = base.copy()
+    base[at] = [4.0, -6.0, 9.0, 0.5]
+    error[at] = [1.0, -2.0, 12.0, 0.5]  # event 1 better, event 2 worse (0.5 is a tie)
+    sigma = np.full(20, 2.0)
+    gain = local_gain(at, base, error, sigma, np.arange(20), block)
+    assert (gain.rows, gain.events, gain.improved) == (4, 2, 1)
+    z0, z1 = base[at] / 2.0, error[at] / 2.0
+    assert gain.weighted == pytest.approx(1.0 - np.sqrt(_huber_sum(z1) / _huber_sum(z0)))
+    assert gain.plain == pytest.approx(1.0 - np.sqrt(np.sum(error[at] ** 2)
+                                                     / np.sum(base[at] ** 2)))
+    tie = local_gain(at, base, np.where(at, base, 0.0), sigma, np.arange(20), block)
+    assert tie.improved == 0 and tie.plain == 0.0 and tie.chance == 1.0  # no gain, no event
+    two = np.zeros(20, dtype=bool)
+    two[[4, 6]] = True  # two rows apart, with a block of one row: two events
+    assert local_gain(two, base, error, sigma, np.arange(20), 1).events == 2
+
+
+def test_nowhere_to_act_is_no_gain_and_the_bounds_are_inclusive(monkeypatch):
+    at, base, error, sigma, index, block = _errors(5, 5)
+    assert local_gain(np.zeros_like(at), base, error, sigma, index, block) == \
+        LocalGain(0, 0, 0, 0.0, 0.0)
+    one = np.zeros(100)
+    one[7] = 1.0e-5
+    assert acting(one, 100).tolist() == (one != 0.0).tolist()  # one row is a region too
+    gain = LocalGain(25, 5, 5, 0.2, 0.3)
+    assert gain.passes(0.2) and not gain.passes(0.2001)  # the weighted cut reaches the least
+    assert LocalGain(25, 5, 5, 0.3, 0.2).passes(0.2)  # and the plain one
+    assert not LocalGain(25, 5, 5, 0.3, 0.2).passes(0.2001)
+    monkeypatch.setattr(regional, 'RECUR_ALPHA', gain.chance)
+    assert not gain.passes(0.0)  # the sign test is strict
+
+
+# -- a demand-set relief on a real trajectory ---------------------------------------------
+
+
+@lru_cache(maxsize=None)
+def _whole(name):
+    return load_trajectory(data_path('real', 'mbari_pto', name))
+
+
+@lru_cache(maxsize=None)
+def _calibrated(tmp, name, valve, seed):
+    """Calibrate a case on the real trajectory with the log's noise; return (case, result)."""
+    trajectory = _whole(name).crop(*SPANS[name], 2)
+    effects = [demand_relief(trajectory, seed=seed)] if valve else []
+    case = build_case(trajectory, effects, noise=estimate_noise(_whole(name)), seed=seed,
+                      bad_rows=1)
+    path = write_mbari_log(f'{tmp}/{name}.{valve}.{seed}.exp', case)
+    errors = io.StringIO()
+    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(errors):
+        code = main(['calibrate', str(path), '--columns', 'mbari_pto', '--liquid', 'oil',
+                     '--displacement', '0.30 in^3/rev', '--out', f'{path}.cal'])
+    assert code == 0, errors.getvalue()
+    with open(f'{path}.cal/calibration.json') as file:
+        return case, json.load(file)
+
+
+@pytest.fixture(scope='module')
+def work(tmp_path_factory):
+    return str(tmp_path_factory.mktemp('regional'))
+
+
+def test_the_demand_relief_clamps_the_drop_and_its_flow_scatters_at_one_drop():
+    trajectory = _whole(STEPPED).crop(*SPANS[STEPPED], 2)
+    valve = demand_relief(trajectory, seed=3)
+    flow = -valve.flow(trajectory.p_a - trajectory.p_b, trajectory.speed, trajectory.time)
+    assert np.all(flow >= 0.0) and 0.0 < np.mean(flow > 0.0) < 0.1  # one way, a few per cent
+    full = flow[flow > 0.9 * np.max(flow)]
+    opened = flow[-(trajectory.p_a - trajectory.p_b) > valve.crack + valve.width]
+    assert opened.size >= 10 and np.ptp(opened) > 0.3 * np.mean(full)  # set by the demand
+    assert np.max(flow) <= (1.0 + valve.spread) * valve.full_flow + 1e-12
+
+
+@pytest.mark.slow  # a semi-real case calibrated
+@pytest.mark.parametrize(('name', 'seed'), [(STEPPED, 3), (BIAS, 1)])
+def test_a_demand_set_relief_on_a_real_trajectory_is_named_at_its_crack(work, name, seed):
+    case, result = _calibrated(work, name, True, seed)
+    valve = case.effects[0]
+    fitted = [e for e in result['effects'] if e['effect'].startswith('threshold')]
+    assert fitted, result['effects']
+    # the bias log's drops are nearly all of one sign: there a valve on both sides is one side
+    assert fitted[0]['direction'] in (('negative',) if name == STEPPED else ('negative', 'both'))
+    assert fitted[0]['threshold']['value'] == pytest.approx(valve.crack, rel=0.05)
+    assert result['error_after']['rmse_lpm'] < 0.9 * result['error_before']['rmse_lpm']
+
+
+@pytest.mark.slow  # a semi-real case calibrated
+@pytest.mark.parametrize('name', [STEPPED, BIAS])
+def test_a_clean_case_on_the_same_trajectory_stays_none(work, name):
+    _, result = _calibrated(work, name, False, 3)
+    assert result['effect'] == 'none' and result['effects'] == []
