@@ -20,7 +20,8 @@ twice or out of order), and the globals that expression reads are the same
 objects in the builder's module (or builtins) and are not names the builder
 binds (upper-case numbers, units, are put in as their values). A body of
 ``x = ...`` lines before the ``return`` folds in as ``(x := ...)`` where x is
-first read, if nothing in it is evaluated conditionally; each inlined call
+first read, if nothing in it is evaluated conditionally (``x: T = ...; return x``, a typed
+temporary, is its expression); each inlined call
 gets its own name for x, so calls nested in each other's arguments do not
 share it, and the calls an inlined expression makes are inlined in turn. A
 traceback points at the builder's line of the call.
@@ -108,6 +109,17 @@ def _bind(expr: ast.expr, name: str, value: ast.expr, local: str) -> ast.expr | 
     return folded
 
 
+def _assigned(statement: ast.stmt) -> tuple[str, ast.expr] | None:
+    """Return the name and value of ``x = e`` or ``x: T = e`` (a typed temporary), or None."""
+    if isinstance(statement, ast.Assign) and len(statement.targets) == 1:
+        target, value = statement.targets[0], statement.value
+    elif isinstance(statement, ast.AnnAssign) and statement.value is not None:
+        target, value = statement.target, statement.value
+    else:
+        return None
+    return (target.id, value) if isinstance(target, ast.Name) else None
+
+
 @functools.lru_cache(maxsize=None)
 def _expression(func: Callable[..., Any]) -> tuple[tuple[str, ...], ast.expr] | None:
     """Return the parameters and the return expression of a function of plain expressions."""
@@ -122,11 +134,14 @@ def _expression(func: Callable[..., Any]) -> tuple[tuple[str, ...], ast.expr] | 
         return None
     expr: ast.expr | None = body[-1].value
     for statement in reversed(body[:-1]):  # x = e; return f(x)  ->  f((x' := e))
-        if not (isinstance(statement, ast.Assign) and len(statement.targets) == 1
-                and isinstance(statement.targets[0], ast.Name) and expr is not None):
+        target = _assigned(statement)
+        if target is None or expr is None:
             return None
-        name = statement.targets[0].id
-        expr = _bind(expr, name, statement.value, f'_{func.__name__}_{name}')
+        name, value = target
+        if isinstance(expr, ast.Name) and expr.id == name:  # x: T = e; return x  ->  e
+            expr = value
+        else:
+            expr = _bind(expr, name, value, f'_{func.__name__}_{name}')
     return None if expr is None else (tuple(a.arg for a in node.args.args), expr)
 
 

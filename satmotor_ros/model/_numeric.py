@@ -27,11 +27,13 @@ def log(x: Real) -> Real:
     """Return the natural logarithm of `x`, elementwise."""
     if type(x) is float:
         return math.log(x)
-    return np.log(x)
+    out: Real = np.log(x)
+    return out
 
 
 def minimum(x: Real, ceiling: float) -> Real:
     """Return the smaller of `x` and `ceiling`, elementwise; NaN stays NaN, as in numpy."""
     if type(x) is float:
         return ceiling if x > ceiling else x
-    return np.minimum(x, ceiling)
+    out: Real = np.minimum(x, ceiling)
+    return out

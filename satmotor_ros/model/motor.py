@@ -65,7 +65,7 @@ class _Magnitudes:
     def __init__(self, core: ModelCore, conditioned: ConditionedModel | None) -> None:
         self.qt = core.geometry.displacement
         self._point, self._conditioned = core.point, conditioned
-        self._drop = core.eqs.channel_drop
+        self._drop: Callable[[float], float] = core.eqs.channel_drop
 
     def speed(self, flow: float, dp: float, port: bool, p_ex: float, channels: Channels,
               reverse: bool, negative: bool) -> Point:

@@ -104,7 +104,8 @@ class OperatingPoints:
     @property
     def invalid(self) -> npt.NDArray[np.bool_]:
         """Mask of the elements whose outputs are NaN."""
-        return (self.status & int(INVALID)) != 0
+        mask: npt.NDArray[np.bool_] = (self.status & int(INVALID)) != 0
+        return mask
 
 
 class Point(NamedTuple):

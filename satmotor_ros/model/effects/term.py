@@ -139,7 +139,8 @@ class Term(EffectKind):
         k = effect.coefficient
 
         def loss(n: Real, dp_i: Real) -> Real:
-            return k * abs(dp_i) ** a * abs(n) ** b
+            out: Real = k * abs(dp_i) ** a * abs(n) ** b
+            return out
         return loss
 
     def reads(self, effect: Effect) -> tuple[str, ...]:

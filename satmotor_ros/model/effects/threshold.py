@@ -114,7 +114,8 @@ class Threshold(EffectKind):
             if type(dp) is float:  # the point path: Python floats, no numpy scalar
                 over = abs(dp) - x_c
                 return k * over ** e if over > 0.0 else 0.0
-            return k * np.maximum(abs(dp) - x_c, 0.0) ** e
+            out: Real = k * np.maximum(abs(dp) - x_c, 0.0) ** e
+            return out
         return loss
 
     def reads(self, effect: Effect) -> tuple[str, ...]:

@@ -380,7 +380,8 @@ class ConditionedModel:
                                     first.status & _STALLED)
 
         def chamber(q: float) -> float:
-            return maximum(model.eqs.chamber_drop(dp, q), 0.0)
+            out: float = maximum(model.eqs.chamber_drop(dp, q), 0.0)
+            return out
 
         def excess(q: float) -> float:
             dp_i = chamber(q)

@@ -220,7 +220,8 @@ def stalled(speed: FloatArray) -> IntArray: ...
 
 def stalled(speed: Real) -> int | IntArray:
     """Return STALLED where the shaft does not turn."""
-    return (speed == 0.0) * _STALLED
+    flag: int | IntArray = (speed == 0.0) * _STALLED
+    return flag
 
 
 @overload

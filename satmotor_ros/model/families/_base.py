@@ -220,7 +220,8 @@ class SplitEquations:
             def absorbed(dp_i: Real) -> Real:
                 first, second = leak(dp_i)
                 fc, dch, bl, ine, rest = moving(speed, dp_i)
-                return base + ((first + second) + ((fc + dch) + (bl + ine) + rest))
+                out: Real = base + ((first + second) + ((fc + dch) + (bl + ine) + rest))
+                return out
 
             def residual(flow: Real) -> tuple[Real, Real]:
                 dp_i = dp_cap - channel(flow)

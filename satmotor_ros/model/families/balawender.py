@@ -152,7 +152,8 @@ def _terms(d: BalawenderConstants, c: BalawenderCoefficients) -> Terms:
             laminar, turbulent = oil_parts(dp_i)
             k_s = eq.leakage_ratio(dp_i, mu_o, mu_e)
             d_k_s = (dp_i > transition) * (eq.TURBULENT_EXPONENT * k_s * inverse_dp(dp_i))
-            return d_k_s * (laminar + turbulent) + k_s * oil_slope(dp_i, laminar, turbulent)
+            out: Real = d_k_s * (laminar + turbulent) + k_s * oil_slope(dp_i, laminar, turbulent)
+            return out
     else:
         def leak(dp_i: Real) -> tuple[Real, Real]:
             laminar, turbulent = oil_parts(dp_i)

@@ -158,7 +158,8 @@ def turbulent_leakage(dp_i: Real, rho: float, q: float, c_ot: float) -> Real:
         Q_t,O, [m^3/s]
 
     """
-    return c_ot * (2.0 * dp_i / rho) ** 0.5 * q ** (2.0 / 3.0)
+    out: Real = c_ot * (2.0 * dp_i / rho) ** 0.5 * q ** (2.0 / 3.0)
+    return out
 
 
 def leakage_ratio_turbulent(dp_i: Real, mu_oil: float, mu_liquid: float) -> Real:
@@ -195,7 +196,8 @@ def leakage_ratio_turbulent(dp_i: Real, mu_oil: float, mu_liquid: float) -> Real
     13.81
 
     """
-    return TURBULENT_FACTOR * mu_oil / mu_liquid * (dp_i / MPA) ** TURBULENT_EXPONENT
+    out: Real = TURBULENT_FACTOR * mu_oil / mu_liquid * (dp_i / MPA) ** TURBULENT_EXPONENT
+    return out
 
 
 def leakage_ratio_laminar(mu_oil: float, mu_liquid: float) -> float:
@@ -326,7 +328,8 @@ def channel_pressure_drop_oil(omega: Real, rho: float, q: float, c_ich: float) -
     the flow, as in eqs. (34)-(35) of the paper's own model.
 
     """
-    return c_ich * rho * omega * omega * q ** (2.0 / 3.0)
+    out: Real = c_ich * rho * omega * omega * q ** (2.0 / 3.0)
+    return out
 
 
 def channel_ratio(rho_liquid: float, rho_oil: float, flow_liquid: Real, flow_oil: Real) -> Real:

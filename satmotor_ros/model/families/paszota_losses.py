@@ -67,7 +67,8 @@ def motor_leakage(dp_i: Real, speed: Real, k_g: float, flow_t: float, p_n: float
     2e-05
 
     """
-    return k_g * flow_t * viscosity_factor * (dp_i / p_n) ** a_pv * (speed / n_t) ** a_nv
+    out: Real = k_g * flow_t * viscosity_factor * (dp_i / p_n) ** a_pv * (speed / n_t) ** a_nv
+    return out
 
 
 def pump_leakage(dp_i: Real, speed: Real, k_1: float, q: float, p_n: float, a_pv: float,
@@ -106,7 +107,8 @@ def pump_leakage(dp_i: Real, speed: Real, k_1: float, q: float, p_n: float, a_pv
     2.25e-05
 
     """
-    return k_1 * q * speed * viscosity_factor * (dp_i / p_n) ** a_pv
+    out: Real = k_1 * q * speed * viscosity_factor * (dp_i / p_n) ** a_pv
+    return out
 
 
 def viscosity_factor(nu: float, nu_n: float, a_vv: float) -> float:
@@ -135,4 +137,5 @@ def viscosity_factor(nu: float, nu_n: float, a_vv: float) -> float:
     1.0
 
     """
-    return (nu / nu_n) ** a_vv
+    out: float = (nu / nu_n) ** a_vv
+    return out

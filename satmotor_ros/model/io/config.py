@@ -18,7 +18,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 from satmotor_ros.bounded_yaml import read_yaml_or
 from satmotor_ros.model.coefficients import (CoefficientSet, field_names, FieldError, Liquid,
@@ -29,6 +29,8 @@ from satmotor_ros.model.errors import ConfigError, UnitError
 from satmotor_ros.model.families import DEFAULT_FAMILY, Family, family_named
 from satmotor_ros.model.families.sliwinski2017.losses import compressibility_coefficient
 from satmotor_ros.model.units import parse_quantity
+
+_T = TypeVar('_T')
 
 DEFAULT_MOTOR = 'sm075_25.yaml'
 """File name of the packaged SM-0,75/25 specification."""
@@ -210,8 +212,8 @@ def coefficient_set_from_mapping(doc: Any, name: str, geometry: MotorGeometry,
         raise ConfigError(msg)
     liquid = liquid_from_mapping(doc['liquid'], f'{where}.liquid', default_name=name)
     span = _viscosity_range(doc.get('viscosity_range'), f'{where}.viscosity_range')
-    coef = _record(family.coefficients_type, doc['coefficients'], f'{where}.coefficients',
-                   {**_COEFFICIENT_KINDS, **family.quantities})
+    coef: Any = _record(family.coefficients_type, doc['coefficients'], f'{where}.coefficients',
+                        {**_COEFFICIENT_KINDS, **family.quantities})
     if family.name != DEFAULT_FAMILY:
         effects = check_effects(_effects(doc.get('effects'), f'{where}.effects', coef),
                                 f'{where}.effects', family.name)
@@ -287,7 +289,8 @@ def _mapping(doc: Any, where: str, required: set[str] | None) -> Mapping[str, An
     return doc
 
 
-def _record(record: type, doc: Any, where: str, kinds: Mapping[str, tuple[str, str]]) -> Any:
+def _record(record: type[_T], doc: Any, where: str,
+            kinds: Mapping[str, tuple[str, str]]) -> _T:
     doc = _mapping(doc, where, None)
     names = field_names(record)
     return _construct(record, where, **_values(doc, where, names, kinds))
@@ -326,7 +329,7 @@ def _number(value: Any, where: str, kind: tuple[str, str] | None) -> float:
     raise ConfigError(msg)
 
 
-def _construct(record: type, where: str, **values: Any) -> Any:
+def _construct(record: type[_T], where: str, **values: Any) -> _T:
     try:
         return record(**values)
     except TypeError as err:

@@ -141,7 +141,8 @@ def flat_clearance_leakage(dp_i: Real, h: Real, k_lfg: float,
     Q_Lfg in l/min; beta = 1 is laminar flow, beta -> 0 turbulent.
 
     """
-    return k_lfg * (h * h * h * dp_i) ** e_lfg
+    out: Real = k_lfg * (h * h * h * dp_i) ** e_lfg
+    return out
 
 
 def flat_clearance_coefficients(liquid: Liquid, geometry: MotorGeometry,
@@ -209,7 +210,8 @@ def commutation_leakage(dp_i: Real, k_c: float, gamma: float) -> Real:
     is read as m^3/s. It stays below 0.012 l/min for the SM-0,75/25.
 
     """
-    return k_c * dp_i ** gamma
+    out: Real = k_c * dp_i ** gamma
+    return out
 
 
 def commutation_coefficient(liquid: Liquid, geometry: MotorGeometry,
@@ -337,7 +339,8 @@ def inertia_loss(speed: Real, k_id: float) -> Real:
         Delta Q_id, [m^3/s]
 
     """
-    return k_id * speed ** 0.5
+    out: Real = k_id * speed ** 0.5
+    return out
 
 
 def inertia_coefficient(c_id: float, geometry: MotorGeometry) -> float:
@@ -397,7 +400,8 @@ def displacement_change(dp_i: Real, speed: Real, k_p: float,
     2.0143
 
     """
-    return k_p * dp_i + k_id / speed ** 0.5
+    out: Real = k_p * dp_i + k_id / speed ** 0.5
+    return out
 
 
 def displacement_loss(dp_i: Real, speed: Real, k_p: float, k_id: float) -> Real:
@@ -477,7 +481,8 @@ def displacement_change_empirical(dp_i: Real, speed: Real, c1: float,
     0.3727
 
     """
-    return displacement_change_at_root(dp_i, 1.0 / (speed / RPM) ** 0.5, c1, c2)
+    out: Real = displacement_change_at_root(dp_i, 1.0 / (speed / RPM) ** 0.5, c1, c2)
+    return out
 
 
 def displacement_change_at_root(dp_i: Real, inv_sqrt_n: Real, c1: float, c2: float) -> Real:
@@ -503,7 +508,8 @@ def displacement_change_at_root(dp_i: Real, inv_sqrt_n: Real, c1: float, c2: flo
         Delta q, [m^3/rad]
 
     """
-    return c1 * inv_sqrt_n * (dp_i / MPA) ** (c2 * inv_sqrt_n) * CM3_PER_REV
+    out: Real = c1 * inv_sqrt_n * (dp_i / MPA) ** (c2 * inv_sqrt_n) * CM3_PER_REV
+    return out
 
 
 def empirical_drop(dp_i: Real) -> Real:

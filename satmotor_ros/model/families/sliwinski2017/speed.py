@@ -82,7 +82,7 @@ def effective_speed(flow: Real, dp_i: Real, leakage: Real, a0: float,
     x = maximum(flow - leakage, 0.0) * scale
     if b == 0.0:
         return x / two_a
-    root = x / ((two_a * x + b * b) ** 0.5 + b)
+    root: Real = x / ((two_a * x + b * b) ** 0.5 + b)
     return root * root
 
 
