@@ -50,13 +50,22 @@ def _derived(name: str, doc: str) -> property:
     return property(lambda model: getattr(model.derived, name), doc=doc)
 
 
-def _point_dp(dp: object, dp_i: object) -> tuple[bool, float]:
-    """Return whether the drop is between the ports, and the drop as a float, [Pa]."""
+def _point_args(name: str, value: object, dp: object, dp_i: object,
+                p_ex: object) -> tuple[float, bool, float, float]:
+    """
+    Check one point's arguments, as floats: `value` (flow or speed), port, drop and p_ex.
+
+    The drop is `dp` between the ports (port True) or `dp_i` in the chambers;
+    exactly one of them is given.
+    """
     if dp_i is None and dp is not None:
-        return True, dp if type(dp) is float else as_float('dp', dp)
-    if dp is None and dp_i is not None:
-        return False, dp_i if type(dp_i) is float else as_float('dp_i', dp_i)
-    raise ModelError('give exactly one of dp (between the ports) and dp_i (chambers)')
+        port, drop = True, dp if type(dp) is float else as_float('dp', dp)
+    elif dp is None and dp_i is not None:
+        port, drop = False, dp_i if type(dp_i) is float else as_float('dp_i', dp_i)
+    else:
+        raise ModelError('give exactly one of dp (between the ports) and dp_i (chambers)')
+    value = value if type(value) is float else as_float(name, value)
+    return value, port, drop, p_ex if type(p_ex) is float else as_float('p_ex', p_ex)
 
 
 class _Magnitudes:
@@ -209,7 +218,7 @@ class MotorModel:
         Returns
         -------
         MotorModel
-            The model.
+            The SM-0,75/25 on that set.
 
         """
         return cls.from_spec(load_motor(), coefficients, None, displacement_law)
@@ -261,10 +270,9 @@ class MotorModel:
         ----------
         flow : float or ndarray
             Flow into the motor Q, [m^3/s]
-        dp : float or ndarray, optional
-            Pressure drop between the ports; eqs. (34)-(35) give dp_i, [Pa]
-        dp_i : float or ndarray, optional
-            Pressure drop in the working chambers, instead of `dp`, [Pa]
+        dp, dp_i : float or ndarray, optional
+            Pressure drop between the ports (eqs. (34)-(35) give dp_i) or in the
+            working chambers: exactly one of them, [Pa]
         p_ex : float or ndarray
             Pressure driving the external leakage, eq. (24), [Pa]
         errors : {'raise', 'mask'}
@@ -312,10 +320,8 @@ class MotorModel:
         ----------
         speed : float or ndarray
             Shaft speed n, [rad/s]
-        dp : float or ndarray, optional
-            Pressure drop between the ports, [Pa]
-        dp_i : float or ndarray, optional
-            Pressure drop in the working chambers, instead of `dp`, [Pa]
+        dp, dp_i : float or ndarray, optional
+            Pressure drop between the ports or in the working chambers: exactly one, [Pa]
         p_ex : float or ndarray
             Pressure driving the external leakage, eq. (24), [Pa]
         errors : {'raise', 'mask'}
@@ -366,7 +372,7 @@ class MotorModel:
         errors : {'raise', 'mask'}
             Raise on the first invalid element, or return it as NaN, [-]
         channels : mapping of str to float or ndarray, optional
-            Measured channels the coefficient set's effects need, [-]
+            The effects' measured channels, as :meth:`absorbency` reads them, [-]
 
         Returns
         -------
@@ -393,10 +399,8 @@ class MotorModel:
         ----------
         flow : float
             Flow into the motor Q, [m^3/s]
-        dp : float, optional
-            Pressure drop between the ports, [Pa]
-        dp_i : float, optional
-            Pressure drop in the working chambers, instead of `dp`, [Pa]
+        dp, dp_i : float, optional
+            Pressure drop between the ports or in the working chambers: exactly one, [Pa]
         p_ex : float
             Pressure driving the external leakage, eq. (24), [Pa]
         channels : mapping of str to float, optional
@@ -405,7 +409,7 @@ class MotorModel:
         Returns
         -------
         Point
-            The operating point.
+            The speed n at the flow Q, with its losses and status.
 
         Raises
         ------
@@ -414,14 +418,10 @@ class MotorModel:
             number, or an effect's channel is missing.
 
         """
-        if dp_i is None and type(dp) is float:  # the usual call: skip the checks
-            port, value = True, dp
+        if dp_i is None and type(dp) is float and type(flow) is float and type(p_ex) is float:
+            port, value = True, dp  # the usual call: skip the checks
         else:
-            port, value = _point_dp(dp, dp_i)
-        if type(flow) is not float:
-            flow = as_float('flow', flow)
-        if type(p_ex) is not float:
-            p_ex = as_float('p_ex', p_ex)
+            flow, port, value, p_ex = _point_args('flow', flow, dp, dp_i, p_ex)
         if self._valves:  # the motor's map at the flow the valves leave it
             return self._valves.speed(self._speed_at, flow, port, value, p_ex, channels)
         return self._speed_at(flow, port, value, p_ex, channels)
@@ -453,10 +453,8 @@ class MotorModel:
         ----------
         speed : float
             Shaft speed n, [rad/s]
-        dp : float, optional
-            Pressure drop between the ports, [Pa]
-        dp_i : float, optional
-            Pressure drop in the working chambers, instead of `dp`, [Pa]
+        dp, dp_i : float, optional
+            Pressure drop between the ports or in the working chambers: exactly one, [Pa]
         p_ex : float
             Pressure driving the external leakage, eq. (24), [Pa]
         flow_guess : float, optional
@@ -468,7 +466,7 @@ class MotorModel:
         Returns
         -------
         Point
-            The operating point.
+            Q at n: the flow, the losses and the status flags.
 
         Raises
         ------
@@ -476,14 +474,10 @@ class MotorModel:
             If not exactly one of `dp` and `dp_i` is given, or an argument is not a number.
 
         """
-        if dp_i is None and type(dp) is float:  # the usual call: skip the checks
-            port, value = True, dp
+        if dp_i is None and type(dp) is float and type(speed) is float and type(p_ex) is float:
+            port, value = True, dp  # the usual call: skip the checks
         else:
-            port, value = _point_dp(dp, dp_i)
-        if type(speed) is not float:
-            speed = as_float('speed', speed)
-        if type(p_ex) is not float:
-            p_ex = as_float('p_ex', p_ex)
+            speed, port, value, p_ex = _point_args('speed', speed, dp, dp_i, p_ex)
         if flow_guess is not None and type(flow_guess) is not float:
             flow_guess = as_float('flow_guess', flow_guess)
         if self._valves:  # the motor's flow plus the valves'
@@ -519,7 +513,7 @@ class MotorModel:
         p_ex : float
             Pressure driving the external leakage, eq. (24), [Pa]
         channels : mapping of str to float, optional
-            Measured channels the coefficient set's effects need, [-]
+            The effects' measured channels, as :meth:`absorbency_point` reads them, [-]
 
         Returns
         -------
@@ -527,20 +521,12 @@ class MotorModel:
             The operating point (its flow is the absorbency of eq. 36).
 
         """
-        if type(speed) is not float:
-            speed = as_float('speed', speed)
-        if type(dp_i) is not float:
-            dp_i = as_float('dp_i', dp_i)
-        if type(p_ex) is not float:
-            p_ex = as_float('p_ex', p_ex)
+        if not (type(speed) is float and type(dp_i) is float and type(p_ex) is float):
+            speed, _, dp_i, p_ex = _point_args('speed', speed, None, dp_i, p_ex)
         if self._valves:
             return self._valves.absorbency(self._absorbency_at, speed, False, dp_i, p_ex, None,
                                            channels)
-        if not (speed >= 0.0 and dp_i >= 0.0):
-            return self._quadrants.absorbency(speed, dp_i, False, p_ex, None, channels)
-        if self._conditioned is not None:
-            return self._conditioned.absorbency_point(speed, dp_i, False, p_ex, None, channels)
-        return self._point.absorbency(speed, dp_i, False, p_ex, None)
+        return self._absorbency_at(speed, False, dp_i, p_ex, None, channels)
 
     def chamber_drop(self, dp: ArrayLike, flow: ArrayLike) -> FloatArray:
         """
