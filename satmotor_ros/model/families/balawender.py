@@ -88,21 +88,12 @@ def constants(geometry: MotorGeometry, coefficient_set: CoefficientSet,
     """
     Derive the constants of the family's equations for one motor and liquid.
 
-    Parameters
-    ----------
-    geometry : MotorGeometry
-        The motor (its displacement), [-]
-    coefficient_set : CoefficientSet
-        The oil coefficients, [-]
-    valid_range : ValidRange
-        Range the coefficients were validated over, [-]
-    liquid : Liquid
-        The working liquid, [-]
+    The arguments are those of :meth:`~satmotor_ros.model.families._base.Family.compose`.
 
     Returns
     -------
     BalawenderConstants
-        The constants.
+        The constants; a liquid below ``low_viscosity_below`` gets the variant's.
 
     """
     c = cast(BalawenderCoefficients, coefficient_set.coefficients)
@@ -193,13 +184,13 @@ class Balawender(Family):
     title = 'the earlier literature model, eqs. (15)-(28), with its low-viscosity variant'
     equations = 'eqs. (15)-(28)'
     coefficients_type = BalawenderCoefficients
+    quantities = {'oil_viscosity': ('viscosity', 'm^2/s'), 'oil_density': ('density', 'kg/m^3'),
+                  'oil_bulk_modulus': ('pressure', 'Pa'),
+                  'low_viscosity_below': ('viscosity', 'm^2/s')}
     components = {'flat_clearance': 'clearances Q_l + Q_t, eqs. (20)-(23)',
                   'compressibility': 'pressure x speed dQ_vl, eqs. (17)-(19)',
                   'external': 'external Q_ex, eqs. (16), (24)',
                   'total': 'total Q_vl, eqs. (15)-(16)'}
-    quantities = {'oil_viscosity': ('viscosity', 'm^2/s'), 'oil_density': ('density', 'kg/m^3'),
-                  'oil_bulk_modulus': ('pressure', 'Pa'),
-                  'low_viscosity_below': ('viscosity', 'm^2/s')}
 
     def compose(self, geometry: MotorGeometry, coefficient_set: CoefficientSet,
                 valid_range: ValidRange, liquid: Liquid, law: str) -> SplitEquations:

@@ -84,16 +84,7 @@ def constants(geometry: MotorGeometry, coefficient_set: CoefficientSet,
     """
     Derive the constants of eq. (29) for one motor and liquid.
 
-    Parameters
-    ----------
-    geometry : MotorGeometry
-        The motor (its displacement), [-]
-    coefficient_set : CoefficientSet
-        The coefficients, [-]
-    valid_range : ValidRange
-        Range the coefficients were validated over, [-]
-    liquid : Liquid
-        The working liquid, [-]
+    The arguments are those of :meth:`~satmotor_ros.model.families._base.Family.compose`.
 
     Returns
     -------

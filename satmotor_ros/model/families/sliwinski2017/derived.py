@@ -7,14 +7,18 @@ from dataclasses import dataclass
 import math
 
 from satmotor_ros.model.coefficients import CoefficientSet, Liquid, MotorGeometry, ValidRange
+from satmotor_ros.model.families._base import Bounds, bounds
 from satmotor_ros.model.families.sliwinski2017 import losses as eq
 from satmotor_ros.model.families.sliwinski2017.speed import effective_speed_coefficients
 
 
 @dataclass(frozen=True)
-class DerivedCoefficients:
+class DerivedCoefficients(Bounds):
     """
     Per-model constants of eqs. (1)-(40), each read off the equation module's own helper.
+
+    The range constants every family gives (qt, dp_limit, the validated range)
+    are :class:`~satmotor_ros.model.families._base.Bounds`'.
 
     The equations then reduce to a few multiplications and powers, which both
     the array maps and the single-point path evaluate. ``c_lumped`` is the C of
@@ -22,7 +26,6 @@ class DerivedCoefficients:
     compressibility share), not the fitted coefficient itself.
     """
 
-    qt: float  # theoretical displacement q_t [m^3/rad]
     c_fc_beta: float  # C_fc*beta_l of eq. (11) for this liquid [1/(MPa*rev)]
     c_dch: float  # C_dch of eq. (12) [1/(MPa*rev)]
     c_b: float  # C_b of eq. (13) [1/(MPa*rev)]
@@ -47,12 +50,6 @@ class DerivedCoefficients:
     es_b: float
     c1_39: float  # C_1 of eq. (39) [cm^3/rev (rev/min)^0.5]
     c2_39: float  # C_2 of eq. (39) [-]
-    dp_limit: float  # chamber drop where eq. (1) would start to fall with pressure [Pa]
-    dp_max: float  # validated range: largest chamber drop [Pa]
-    speed_max: float  # validated range: largest speed [rad/s]
-    dp_min: float  # validated range: smallest chamber drop [Pa]
-    speed_min: float  # validated range: smallest speed [rad/s]
-    liquid_extrapolated: bool  # the liquid's viscosity is outside the fitted span
 
 
 def derive(geometry: MotorGeometry, coefficient_set: CoefficientSet, valid_range: ValidRange,
@@ -60,16 +57,7 @@ def derive(geometry: MotorGeometry, coefficient_set: CoefficientSet, valid_range
     """
     Derive the constants of every equation for one motor and liquid.
 
-    Parameters
-    ----------
-    geometry : MotorGeometry
-        Motor geometry, [-]
-    coefficient_set : CoefficientSet
-        Fitted coefficients and the liquid they were fitted on, [-]
-    valid_range : ValidRange
-        Range the coefficients were validated over, [-]
-    liquid : Liquid
-        The working liquid, [-]
+    The arguments are those of :meth:`~satmotor_ros.model.families._base.Family.compose`.
 
     Returns
     -------
@@ -78,8 +66,6 @@ def derive(geometry: MotorGeometry, coefficient_set: CoefficientSet, valid_range
 
     """
     coef = coefficient_set.coefficients
-    nu = liquid.kinematic_viscosity
-    low, high = coefficient_set.fitted_viscosity
     c_fc_ref = eq.compressibility_coefficient(coefficient_set.liquid.bulk_modulus, geometry, coef)
     c_fc_beta = eq.compressibility_coefficient(liquid.bulk_modulus, geometry, coef)
     rest = coef.c - c_fc_ref
@@ -93,7 +79,8 @@ def derive(geometry: MotorGeometry, coefficient_set: CoefficientSet, valid_range
     # Q_Lfg ~ (h^3 dp)^e rises with dp only while h - 3 s dp > 0 with h = h0 - s dp: dp < h0/4s
     dp_limit = h0 / (4.0 * compliance) if compliance > 0.0 else math.inf
     return DerivedCoefficients(
-        qt=geometry.displacement, c_fc_beta=c_fc_beta, c_dch=c_dch, c_b=c_b, c_lumped=c_lumped,
+        **vars(bounds(geometry, coefficient_set, valid_range, liquid, dp_limit)),
+        c_fc_beta=c_fc_beta, c_dch=c_dch, c_b=c_b, c_lumped=c_lumped,
         h0=h0, compliance=compliance, lfg_k=lfg_k, lfg_e=lfg_e,
         com_k=eq.commutation_coefficient(liquid, geometry, coef), com_e=coef.gamma,
         k_fc=eq.pressure_speed_coefficient(c_fc_beta, geometry),
@@ -102,7 +89,4 @@ def derive(geometry: MotorGeometry, coefficient_set: CoefficientSet, valid_range
         k_p=eq.pressure_speed_coefficient(c_lumped, geometry),
         k_i=eq.inertia_coefficient(coef.c_id, geometry), k_ex=coef.external_leakage,
         ch_a=ch_a, ch_b=ch_b, es_a0=es[0], es_a1=es[1], es_scale=es[2],
-        es_b=es[3], c1_39=coef.c1_39, c2_39=coef.c2_39, dp_limit=dp_limit,
-        dp_max=valid_range.dp_max, speed_max=valid_range.speed_max,
-        dp_min=valid_range.dp_min, speed_min=valid_range.speed_min,
-        liquid_extrapolated=not low * (1.0 - 1e-9) <= nu <= high * (1.0 + 1e-9))
+        es_b=es[3], c1_39=coef.c1_39, c2_39=coef.c2_39)
