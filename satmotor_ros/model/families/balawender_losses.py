@@ -172,10 +172,8 @@ def leakage_ratio_turbulent(dp_i: Real, mu_oil: float, mu_liquid: float) -> Real
     ----------
     dp_i : float or ndarray
         Pressure drop in the working chambers, > 0, [Pa]
-    mu_oil : float
-        Dynamic viscosity of the oil mu_o, [Pa*s]
-    mu_liquid : float
-        Dynamic viscosity of the low-viscosity liquid mu_E, [Pa*s]
+    mu_oil, mu_liquid : float
+        Dynamic viscosities of the oil mu_o and of the low-viscosity liquid mu_E, [Pa*s]
 
     Returns
     -------
@@ -208,10 +206,8 @@ def leakage_ratio_laminar(mu_oil: float, mu_liquid: float) -> float:
 
     Parameters
     ----------
-    mu_oil : float
-        Dynamic viscosity of the oil mu_o, [Pa*s]
-    mu_liquid : float
-        Dynamic viscosity of the low-viscosity liquid mu_E, [Pa*s]
+    mu_oil, mu_liquid : float
+        Dynamic viscosities of the oil mu_o and of the low-viscosity liquid mu_E, [Pa*s]
 
     Returns
     -------
@@ -233,10 +229,8 @@ def leakage_ratio(dp_i: Real, mu_oil: float, mu_liquid: float) -> Real:
     ----------
     dp_i : float or ndarray
         Pressure drop in the working chambers, >= 0, [Pa]
-    mu_oil : float
-        Dynamic viscosity of the oil mu_o, [Pa*s]
-    mu_liquid : float
-        Dynamic viscosity of the low-viscosity liquid mu_E, [Pa*s]
+    mu_oil, mu_liquid : float
+        Dynamic viscosities of the oil mu_o and of the low-viscosity liquid mu_E, [Pa*s]
 
     Returns
     -------
@@ -318,7 +312,7 @@ def channel_pressure_drop_oil(omega: Real, rho: float, q: float, c_ich: float) -
     Returns
     -------
     float or ndarray
-        Delta p_ich, [Pa]
+        Delta p_ich,O with oil, [Pa]
 
     Notes
     -----

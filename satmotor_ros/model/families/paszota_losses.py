@@ -40,7 +40,7 @@ def motor_leakage(dp_i: Real, speed: Real, k_g: float, flow_t: float, p_n: float
     dp_i : float or ndarray
         Pressure drop in the working chambers, [Pa]
     speed : float or ndarray
-        Shaft speed n, [rad/s]
+        Shaft speed n of the motor, [rad/s]
     k_g : float
         Loss coefficient k_g: Q_l / Q_Pt at p_n, n_t and nu_n, [-]
     flow_t : float
@@ -99,7 +99,7 @@ def pump_leakage(dp_i: Real, speed: Real, k_1: float, q: float, p_n: float, a_pv
     Returns
     -------
     float or ndarray
-        Q_l, [m^3/s]
+        Q_l of the pump, [m^3/s]
 
     Examples
     --------
