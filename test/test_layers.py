@@ -38,5 +38,6 @@ def test_equation_function_cites_its_equation_and_units(name, fn):
     params = list(inspect.signature(fn).parameters)
     section = doc.split('Parameters\n----------\n', 1)[1].split('\n\n', 1)[0]
     for param in params:
-        line = re.search(rf'^{param}\b.*\n\s+.*\[.*\]\s*$', section, re.MULTILINE)
+        line = re.search(rf'^(\w+, )*{param}\b.*\n\s+.*\[.*\]\s*$', section,
+                         re.MULTILINE)  # numpydoc: `a, b : float` documents both
         assert line, f'{name}: parameter {param!r} lacks a [unit]'
