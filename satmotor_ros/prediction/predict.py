@@ -21,6 +21,7 @@ import numpy.typing as npt
 
 from satmotor_ros.model import (COMPONENTS, describe_status, INVALID, MotorModel, Point,
                                 PointStatus)
+from satmotor_ros.model.effects import Effect, kind_of
 from satmotor_ros.model.revolutions import revolutions
 from satmotor_ros.model.units import channel_gauge, LPM, MPA
 from satmotor_ros.prediction.rule import (describe_input, FIELDS, input_level, INPUTS,
@@ -146,9 +147,9 @@ class Progress:
         return (stamp_ns - origin) * 1e-9, self.revolutions
 
 
-def _leakage_channel(model: MotorModel) -> str | None:
-    """Return the channel an external-leakage effect reads p_ex from, or None."""
-    return next((e.regressor for e in model.effects if e.kind == 'external_leakage'), None)
+def _leakage_effect(model: MotorModel) -> Effect | None:
+    """Return the effect whose channel drives the external leakage of eq. (24), or None."""
+    return next((e for e in model.effects if kind_of(e).drives_leakage), None)
 
 
 def _gauge(p: Any) -> Any:
@@ -380,10 +381,11 @@ def predict(model: MotorModel, snap: Snapshot | SnapshotBatch, timeout: float,
     if channels is not None:
         channels = dict(zip(channels, _masked(usable, list(channels.values()), 0.0)))
     speed, dp_i, status, losses = _model_call(model, flow, dp, p_ex, channels)
-    leak = _leakage_channel(model) if channels is not None else None
+    leak = _leakage_effect(model) if channels is not None else None
     if leak is not None and channels is not None:  # the pressure that drove eq. (24)
-        p_ex = (channels[leak] if leak != 'p_out'
-                else pick(flow < 0.0, channels['p_in'], channels['p_out']))
+        kind = kind_of(leak)  # the channel it reads while the flow runs backwards, or forward
+        p_ex = pick(flow < 0.0, channels[kind.channel_at(leak, True)],
+                    channels[kind.channel_at(leak, False)])
     status = pick(usable, status, 0)
     level = _worst([level, pick(status & _INVALID, _ERROR, pick(status & _NOTED, _WARN, _OK))])
     residual = pick(states[_I_SPEED] == _FRESH, model.true_speed(values[_I_SPEED]) - speed,

@@ -344,6 +344,7 @@ class EffectKind:
     required: tuple[str, ...] = ('coefficient',)  # of which these must be there
     regressors: tuple[str, ...] = ()  # channels it may read, the default first
     reads_channel: bool = False  # the model needs its regressor's value
+    drives_leakage: bool = False  # its channel is the pressure p_ex of eq. (24)'s leakage
     drifts: bool = False  # it changes the motor itself (a rebuilt model)
     sensor: str = ''  # the channel of an instrument error ('flow', 'speed')
     reverse: bool = False  # its loss() applies only while the shaft turns backwards (n < 0)

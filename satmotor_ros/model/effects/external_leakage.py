@@ -52,6 +52,7 @@ class ExternalLeakage(EffectKind):
     rank = 40
     regressors = ('p_case', 'p_out')
     reads_channel = True
+    drives_leakage = True
     unit = 'm^3/(s*Pa)'
     source = 'eq. (24), lumped'
     evaluation = ('Q_ex = k_ex * p (eq. 24) with p the gauge pressure named by regressor; '
