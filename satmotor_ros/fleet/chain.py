@@ -90,7 +90,7 @@ def monitor_step(rec: Recording, rule: MotorRule, baseline: dict[str, Any], run:
     Parameters
     ----------
     rec : Recording
-        The recording, [-]
+        The recording to monitor, [-]
     rule : MotorRule
         Its motor's fleet.yaml entry, [-]
     baseline : dict

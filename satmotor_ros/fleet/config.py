@@ -113,7 +113,7 @@ def load_fleet(path: str | Path) -> FleetConfig:
     Parameters
     ----------
     path : str or pathlib.Path
-        The file, [-]
+        The fleet.yaml, [-]
 
     Returns
     -------

@@ -61,7 +61,7 @@ def content_of(path: str | Path) -> str:
     Parameters
     ----------
     path : str or pathlib.Path
-        A file or a bag directory, [-]
+        The recording: a file or a bag directory, [-]
 
     Returns
     -------

@@ -66,7 +66,7 @@ def channel_gauge(absolute: Real) -> Real:
     Parameters
     ----------
     absolute : float or ndarray
-        Absolute pressure, [Pa]
+        Absolute pressure, as a sensor reads it, [Pa]
 
     Returns
     -------

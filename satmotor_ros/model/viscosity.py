@@ -122,7 +122,7 @@ def vogel_viscosity(temperature: ArrayLike, t_ref: float, nu_ref: float, slope: 
     Parameters
     ----------
     temperature : float or ndarray
-        Liquid temperature, [degC]
+        Water temperature, [degC]
     t_ref : float
         Temperature at which the viscosity is `nu_ref`, [degC]
     nu_ref : float

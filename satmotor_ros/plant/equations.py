@@ -28,10 +28,8 @@ def return_flow(p_out: float, p_tank: float, back_pressure: float, conductance: 
 
     Parameters
     ----------
-    p_out : float
-        Outlet-line pressure, absolute, [Pa]
-    p_tank : float
-        Tank pressure, absolute, [Pa]
+    p_out, p_tank : float
+        Outlet-line and tank pressures, absolute, [Pa]
     back_pressure : float
         Back pressure p_b above tank, [Pa]
     conductance : float
@@ -108,10 +106,8 @@ def case_pressure(p_out: float, p_tank: float, offset: float, outlet_share: floa
 
     Parameters
     ----------
-    p_out : float
-        Outlet-line pressure, absolute, [Pa]
-    p_tank : float
-        Tank pressure, absolute, [Pa]
+    p_out, p_tank : float
+        Outlet-line and tank pressures, absolute, [Pa]
     offset : float
         Case pressure above tank at p_out = p_t, [Pa]
     outlet_share : float

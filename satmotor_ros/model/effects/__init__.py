@@ -299,7 +299,7 @@ def effect_to_mapping(effect: Effect) -> dict[str, Any]:
     Parameters
     ----------
     effect : Effect
-        The effect, [-]
+        The effect to write, [-]
 
     Returns
     -------

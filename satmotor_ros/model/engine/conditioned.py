@@ -344,7 +344,7 @@ class ConditionedModel:
         port : bool
             Whether `dp` is between the ports, [-]
         p_ex : float
-            Pressure driving the external leakage when no effect names one, [Pa]
+            Pressure driving the external leakage (no effect naming one), [Pa]
         flow_guess : float or None
             Starting estimate of Q for the coupled solve, [m^3/s]
         channels : mapping of str to float or None
@@ -435,7 +435,7 @@ def points_to_array(points: list[Point], shape: tuple[int, ...], geometry: Motor
     inputs : tuple of ndarray
         The inputs broadcast to `shape`, quoted in that error, [SI]
     errors : {'raise', 'mask'}
-        Raise on the first invalid element, or keep it as NaN, [-]
+        Raise on the first invalid element (quoting `inputs`), or keep it as NaN, [-]
 
     Returns
     -------
@@ -480,14 +480,14 @@ def map_points(point: Callable[..., Point], first: tuple[str, object],
     channels : mapping of str to array_like, or None
         Measured channels by name, [-]
     geometry : MotorGeometry
-        The motor, [-]
+        The motor the points belong to (their speed loss reads q_t), [-]
     errors : {'raise', 'mask'}
         Raise on the first invalid element, or keep it as NaN, [-]
 
     Returns
     -------
     OperatingPoints
-        The points.
+        The points, each from `point`.
 
     """
     if errors not in ('raise', 'mask'):

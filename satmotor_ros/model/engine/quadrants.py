@@ -150,14 +150,14 @@ class Quadrants:
         port : bool
             Whether `dp` is between the ports, [-]
         p_ex : float
-            Pressure driving the external leakage, [Pa]
+            Pressure driving the external leakage, eq. (24), [Pa]
         channels : mapping or None
             Measured channels the effects read, [-]
 
         Returns
         -------
         Point
-            The operating point, signed.
+            Q and the losses at n, signed.
 
         """
         if not (abs(flow) < _INF and abs(dp) < _INF):  # flagged NOT_FINITE at the magnitudes

@@ -368,7 +368,7 @@ def check_floor(speed: FloatArray, law: DisplacementLaw, dp_i: FloatArray, statu
     status : ndarray of uint8
         Flags, updated in place, [-]
     errors : {'raise', 'mask'}
-        What to do with a bad element, [-]
+        What to do with a point below the floor, [-]
     at : tuple
         The chunk's place in the batch, [-]
 
