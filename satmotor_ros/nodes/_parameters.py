@@ -131,6 +131,14 @@ def declare(node: Node, specs: Iterable[ParamSpec]) -> dict[str, str]:
     return problems
 
 
+def declare_logged(node: Node, specs: Iterable[ParamSpec]) -> dict[str, str]:
+    """Declare every parameter as :func:`declare` does, and log each problem as an error."""
+    problems = declare(node, specs)
+    for problem in problems.values():
+        node.get_logger().error(f'parameter {problem}')
+    return problems
+
+
 def check(specs: Mapping[str, ParamSpec], params: Iterable[RosParameter]) -> SetParametersResult:
     """
     Check a set request against the table (for an on-set callback).
@@ -153,6 +161,44 @@ def check(specs: Mapping[str, ParamSpec], params: Iterable[RosParameter]) -> Set
         reason = spec.reason(param.value) if spec is not None else None
         if reason is not None:
             return SetParametersResult(successful=False, reason=reason)
+    return SetParametersResult(successful=True)
+
+
+def check_proposed(specs: Mapping[str, ParamSpec], request: list[RosParameter],
+                   current: Mapping[str, Any],
+                   build: Callable[[dict[str, Any], set[str]], object],
+                   errors: tuple[type[Exception], ...]) -> SetParametersResult:
+    """
+    Check a set request value by value (:func:`check`), then as the whole set it would make.
+
+    Parameters
+    ----------
+    specs : mapping
+        The table, name -> ParamSpec, [-]
+    request : list of rclpy.parameter.Parameter
+        The parameters the request sets, [-]
+    current : mapping
+        The node's values now, by name, [-]
+    build : callable
+        ``build(proposed, changed)``: raises one of `errors` where the values
+        proposed (the names `changed` among them) would not make a working node, [-]
+    errors : tuple of type
+        What `build` raises on a bad set, [-]
+
+    Returns
+    -------
+    SetParametersResult
+        Unsuccessful, with the reason, where a value or the whole set is refused.
+
+    """
+    result = check(specs, request)
+    if not result.successful:
+        return result
+    changed = {p.name: p.value for p in request if p.name in specs}
+    try:
+        build({**current, **changed}, set(changed))
+    except errors as err:
+        return SetParametersResult(successful=False, reason=str(err))
     return SetParametersResult(successful=True)
 
 

@@ -111,9 +111,7 @@ class MotorModelNode(Node):
     def __init__(self, node_name: str = 'motor_model', **kwargs: Any) -> None:
         """Declare parameters, build the model, create publishers and subscriptions."""
         super().__init__(node_name, **kwargs)
-        self._problems = params.declare(self, PARAMETERS)
-        for problem in self._problems.values():
-            self.get_logger().error(f'parameter {problem}')
+        self._problems = params.declare_logged(self, PARAMETERS)
         values = params.values(self, PARAMETERS)
         self._model: MotorModel | None = None
         self._model_error = ''
@@ -173,18 +171,12 @@ class MotorModelNode(Node):
             self.get_logger().error(f'no model: {err}')
 
     def _check_parameters(self, request: list[RosParameter]) -> SetParametersResult:
-        result = params.check(_SPECS, request)
-        if not result.successful:
-            return result
-        proposed = params.values(self, PARAMETERS)
-        proposed.update({p.name: p.value for p in request if p.name in _SPECS})
-        try:
+        def build(proposed: dict[str, Any], changed: set[str]) -> None:
             rule_from_parameters(proposed)
-            if any(p.name in params.MOTOR_KEYS for p in request):
+            if changed & set(params.MOTOR_KEYS):
                 params.motor_options(proposed).build_model()
-        except (ModelError, ValueError) as err:
-            return SetParametersResult(successful=False, reason=str(err))
-        return SetParametersResult(successful=True)
+        return params.check_proposed(_SPECS, request, params.values(self, PARAMETERS), build,
+                                     (ModelError, ValueError))
 
     def _apply_parameters(self, changed: list[RosParameter]) -> None:
         names = {p.name for p in changed}

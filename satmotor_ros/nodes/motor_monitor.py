@@ -164,9 +164,7 @@ class MotorMonitorNode(Node):
     def __init__(self, node_name: str = 'motor_monitor', **kwargs: Any) -> None:
         """Declare parameters, build or resume the estimator, open the topics."""
         super().__init__(node_name, **kwargs)
-        self._problems = params.declare(self, PARAMETERS)
-        for problem in self._problems.values():
-            self.get_logger().error(f'parameter {problem}')
+        self._problems = params.declare_logged(self, PARAMETERS)
         values = self._values = params.values(self, PARAMETERS)
         self.monitor: HealthMonitor | None = None
         self._error = ''  # why there is no estimator, or why it failed
@@ -229,18 +227,12 @@ class MotorMonitorNode(Node):
         self.monitor = HealthMonitor(baseline, settings)
 
     def _check_parameters(self, request: list[RosParameter]) -> SetParametersResult:
-        result = params.check(_SPECS, request)
-        if not result.successful:
-            return result
-        proposed = dict(self._values)
-        proposed.update({p.name: p.value for p in request if p.name in _SPECS})
-        try:
+        def build(proposed: dict[str, Any], changed: set[str]) -> None:
             settings_from(proposed)
-            if any(p.name in params.MOTOR_KEYS for p in request):
+            if changed & set(params.MOTOR_KEYS):
                 baseline_from(proposed)
-        except (ModelError, DataError, OSError, ValueError) as err:
-            return SetParametersResult(successful=False, reason=str(err))
-        return SetParametersResult(successful=True)
+        return params.check_proposed(_SPECS, request, self._values, build,
+                                     (ModelError, DataError, OSError, ValueError))
 
     def _apply_parameters(self, changed: list[RosParameter]) -> None:
         names = {p.name for p in changed}

@@ -79,8 +79,7 @@ class SpeedControllerNode(Node):
         """Declare parameters, build the law, open topics, start the control timer."""
         super().__init__(node_name, **kwargs)
         self._specs = {spec.name: spec for spec in PARAMETERS}
-        for problem in params.declare(self, PARAMETERS).values():
-            self.get_logger().error(f'parameter {problem}')
+        params.declare_logged(self, PARAMETERS)
         self.values = params.values(self, PARAMETERS)
         self.law = self._build(self.values)  # invalid start-up parameters raise here
         self._liquid_source = params.liquid_source(self)
