@@ -154,3 +154,34 @@ def describe_status(code: int) -> str:
     """
     names = [flag.name for flag in PointStatus if flag and code & flag]
     return '|'.join(n for n in names if n) or 'OK'
+
+
+def from_table(table: FloatArray, status: npt.NDArray[np.uint8], shape: tuple[int, ...],
+               geometry: MotorGeometry) -> OperatingPoints:
+    """
+    Return points as read-only :class:`OperatingPoints` of `shape`, each field its own copy.
+
+    Parameters
+    ----------
+    table : ndarray
+        One row a point: flow, speed, dp, dp_i and the :data:`COMPONENTS`, [SI]
+    status : ndarray of uint8
+        The points' flags, [-]
+    shape : tuple of int
+        The shape of the result (``()`` for one point), [-]
+    geometry : MotorGeometry
+        The motor the points belong to, [-]
+
+    Returns
+    -------
+    OperatingPoints
+        The points.
+
+    """
+    rows = table.reshape(-1, 12)
+    columns = [rows[:, j].reshape(shape).copy() for j in range(12)]
+    flags = status.reshape(shape).copy()
+    for column in (*columns, flags):
+        column.setflags(write=False)
+    return OperatingPoints(columns[0], columns[1], columns[2], columns[3],
+                           LossBreakdown(**dict(zip(COMPONENTS, columns[4:]))), flags, geometry)

@@ -27,12 +27,12 @@ from satmotor_ros.model.effects import Conditions, Effect, kind_of
 from satmotor_ros.model.effects._base import Loss
 from satmotor_ros.model.engine.core import ModelCore
 from satmotor_ros.model.engine.point import invalid_point
-from satmotor_ros.model.engine.screening import (channel_limited, CHECK, fitted_bounds, FLOW_ATOL,
-                                                 outside_fitted)
+from satmotor_ros.model.engine.screening import (channel_limited, CHECK, check_errors,
+                                                 fitted_bounds, FLOW_ATOL, outside_fitted,
+                                                 raise_invalid)
 from satmotor_ros.model.engine.solve import solve_increasing_scalar, Tolerance, with_secant_slope
 from satmotor_ros.model.errors import ConfigError, InvalidInputError, ModelError
-from satmotor_ros.model.results import (COMPONENTS, describe_status, INVALID, LossBreakdown,
-                                        OperatingPoints, Point, PointStatus)
+from satmotor_ros.model.results import from_table, INVALID, OperatingPoints, Point, PointStatus
 
 Channels = Mapping[str, float]
 _CACHE = 4096  # variants kept before the cache is cleared
@@ -448,19 +448,11 @@ def points_to_array(points: list[Point], shape: tuple[int, ...], geometry: Motor
         With ``errors='raise'``, naming the first invalid element and its flags.
 
     """
-    table = np.array([p[:12] for p in points], dtype=float).reshape(*shape, 12)
-    status = np.array([p.status for p in points], dtype=np.uint8).reshape(shape)
-    if errors == 'raise' and (status & _INVALID_FLAGS).any():
-        i = int(np.flatnonzero(status & _INVALID_FLAGS)[0])
-        values = ', '.join(f'{n} = {float(x.reshape(-1)[i])!r}' for n, x in zip(names, inputs))
-        msg = f'element {i} ({values}) is invalid: {describe_status(int(status.reshape(-1)[i]))}'
-        raise InvalidInputError(msg)
-    columns = [np.array(table[..., j]) for j in range(12)]  # a copy of `shape`, 0-d kept
-    for column in (*columns, status):
-        column.setflags(write=False)
-    losses = LossBreakdown(**dict(zip(COMPONENTS, columns[4:])))
-    return OperatingPoints(columns[0], columns[1], columns[2], columns[3], losses, status,
-                           geometry)
+    table = np.array([p[:12] for p in points], dtype=float).reshape(-1, 12)
+    status = np.array([p.status for p in points], dtype=np.uint8)
+    if errors == 'raise':
+        raise_invalid(status, names, inputs)
+    return from_table(table, status, shape, geometry)
 
 
 def map_points(point: Callable[..., Point], first: tuple[str, object],
@@ -490,9 +482,7 @@ def map_points(point: Callable[..., Point], first: tuple[str, object],
         The points, each from `point`.
 
     """
-    if errors not in ('raise', 'mask'):
-        msg = f"errors = {errors!r}: use 'raise' or 'mask'"
-        raise ModelError(msg)
+    check_errors(errors)
     names = (first[0], second[0], 'p_ex', *(channels or {}))
     values = (first[1], second[1], p_ex, *(channels or {}).values())
     try:

@@ -29,11 +29,12 @@ import numpy as np
 from satmotor_ros.model._typing import FloatArray, Real
 from satmotor_ros.model.coefficients import MotorGeometry
 from satmotor_ros.model.engine.point import invalid_point
-from satmotor_ros.model.engine.screening import CHECK, FLOW_ATOL, numbers, raise_first, SPEED_SOLVE
+from satmotor_ros.model.engine.screening import (CHECK, check_errors, FLOW_ATOL, numbers,
+                                                 raise_first, raise_invalid, SPEED_SOLVE)
 from satmotor_ros.model.engine.solve import solve_increasing_scalar, Tolerance, with_secant_slope
-from satmotor_ros.model.errors import InvalidInputError, ModelError
-from satmotor_ros.model.results import (COMPONENTS, describe_status, INVALID, LossBreakdown,
-                                        OperatingPoints, Point, PointStatus)
+from satmotor_ros.model.errors import InvalidInputError
+from satmotor_ros.model.results import (COMPONENTS, from_table, INVALID, OperatingPoints, Point,
+                                        PointStatus)
 
 Channels = Mapping[str, float] | None
 _INVALID = int(INVALID)
@@ -338,9 +339,7 @@ def signed_map(point: Callable[[float, float, float], Point],
         With ``errors='raise'``, naming the first invalid element and its flags.
 
     """
-    if errors not in ('raise', 'mask'):
-        msg = f"errors = {errors!r}: use 'raise' or 'mask'"
-        raise ModelError(msg)
+    check_errors(errors)
     a, b = numbers(first[0], first[1]), numbers(second[0], second[1])
     if not ((a < 0.0).any() or (b < 0.0).any()):  # forward motor mode: the map as it is
         return magnitudes(first[1], second[1], p_ex, errors)
@@ -368,18 +367,9 @@ def signed_map(point: Callable[[float, float, float], Point],
     for i in np.flatnonzero(pump):
         p = point(float(a[i]), float(b[i]), float(c[i]))
         table[i], status[i] = p[:12], p.status
-    invalid = (status & _INVALID) != 0
-    if errors == 'raise' and invalid.any():
-        k = int(np.flatnonzero(invalid)[0])
-        msg = (f'element {k} ({first[0]} = {float(a[k])!r}, {second[0]} = {float(b[k])!r}) '
-               f'is invalid: {describe_status(int(status[k]))}')
-        raise InvalidInputError(msg)
-    status = status.reshape(shape)
-    columns = [table[:, j].reshape(shape).copy() for j in range(12)]
-    for column in (*columns, status):
-        column.setflags(write=False)
-    return OperatingPoints(columns[0], columns[1], columns[2], columns[3],
-                           LossBreakdown(**dict(zip(COMPONENTS, columns[4:]))), status, geometry)
+    if errors == 'raise':
+        raise_invalid(status, (first[0], second[0]), (a, b))
+    return from_table(table, status, shape, geometry)
 
 
 def chamber_drop(drop: Callable[[FloatArray], FloatArray], dp: FloatArray,

@@ -21,7 +21,7 @@ from satmotor_ros.model.engine.solve import Tolerance
 from satmotor_ros.model.errors import InvalidInputError, ModelError
 from satmotor_ros.model.families.sliwinski2017.derived import DerivedCoefficients
 from satmotor_ros.model.families.sliwinski2017.laws import DisplacementLaw
-from satmotor_ros.model.results import INVALID, PointStatus
+from satmotor_ros.model.results import describe_status, INVALID, PointStatus
 from satmotor_ros.model.units import MPA
 
 Errors = Literal['raise', 'mask']
@@ -126,6 +126,37 @@ def raise_first(name: str, unit: str, value: FloatArray, bad: npt.NDArray[np.boo
     tail = f' ({count} element{"s" if count > 1 else ""} of this kind)' if len(shape) else ''
     msg = f'{where} = {float(value.flat[first])!r} {unit}: {why}{tail}'
     raise InvalidInputError(msg)
+
+
+def check_errors(errors: str) -> None:
+    """Refuse an `errors` mode other than ``'raise'`` and ``'mask'`` (ModelError)."""
+    if errors not in ('raise', 'mask'):
+        msg = f"errors = {errors!r}: use 'raise' or 'mask'"
+        raise ModelError(msg)
+
+
+def raise_invalid(status: npt.NDArray[np.uint8], names: tuple[str, ...],
+                  inputs: tuple[FloatArray, ...]) -> None:
+    """
+    Raise :class:`InvalidInputError` for the first invalid element of a map's result, if any.
+
+    Parameters
+    ----------
+    status : ndarray of uint8
+        The result's flags, one per element, [-]
+    names : tuple of str
+        The inputs' names, [-]
+    inputs : tuple of ndarray
+        Their values, as many as `status` has elements, quoted in the message, [SI]
+
+    """
+    invalid = np.flatnonzero(status.reshape(-1) & int(INVALID))
+    if invalid.size:
+        i = int(invalid[0])
+        values = ', '.join(f'{n} = {float(x.reshape(-1)[i])!r}' for n, x in zip(names, inputs))
+        msg = (f'element {i} ({values}) is invalid: '
+               f'{describe_status(int(status.reshape(-1)[i]))}')
+        raise InvalidInputError(msg)
 
 
 CEILINGS = {'m^3/s': 10.0, 'rad/s': 1.0e5, 'Pa': 1.0e10}
@@ -295,9 +326,7 @@ def prepare(named: dict[str, tuple[object, str]],
         NOT_FINITE / NEGATIVE flags per element.
 
     """
-    if errors not in ('raise', 'mask'):
-        msg = f"errors = {errors!r}: use 'raise' or 'mask'"
-        raise ModelError(msg)
+    check_errors(errors)
     values = [numbers(name, v) for name, (v, _) in named.items()]
     flags = [_screen(name, unit, value, errors)
              for (name, (_, unit)), value in zip(named.items(), values)]
