@@ -12,7 +12,7 @@ from typing import Any
 
 from satmotor_ros.cli._common import CliError, fail
 from satmotor_ros.cli._liquid import Liquid, settle_liquid
-from satmotor_ros.cli._output import check_target, written_by
+from satmotor_ros.cli._output import add_out_dir, check_target, written_by
 from satmotor_ros.identify import BenchTable, DataError, IdentificationError, read_csv
 from satmotor_ros.identify.columns import load_mapping, read_log
 from satmotor_ros.identify.table import BAD_CELLS, IMPOSSIBLE, negative_losses
@@ -35,11 +35,7 @@ def add_data_arguments(parser: argparse.ArgumentParser,
 
     """
     parser.add_argument('data', metavar='DATA', help='bench CSV or rosbag2 directory')
-    parser.add_argument('--out', required=True, metavar='DIR',
-                        help='output directory, written whole or not at all; an existing one '
-                             'is replaced only if this command wrote it')
-    parser.add_argument('--force', action='store_true',
-                        help='replace an existing --out that this command did not write')
+    add_out_dir(parser)
     transient = (', transient: a time series, every sample with the transient terms'
                  if 'transient' in modes else '')
     parser.add_argument('--mode', choices=modes, default='auto',

@@ -14,6 +14,7 @@ file the subcommand's own check recognises), an empty directory, or with
 
 from __future__ import annotations
 
+import argparse
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 import json
@@ -32,6 +33,29 @@ MARKER = '.satmotor-output.json'
 
 COMMITTED: list[Path] = []
 """Each output renamed into place by this process, in order (what an interrupt leaves)."""
+
+
+def add_out_dir(parser: argparse.ArgumentParser, writer: str = 'this command',
+                default: str | None = None) -> None:
+    """
+    Add ``--out DIR``, the directory :func:`output_dir` writes, and ``--force``.
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser
+        The subcommand's parser, [-]
+    writer : str
+        Who wrote an --out that may be replaced without --force, for the help, [-]
+    default : str, optional
+        The directory when --out is not given; --out is required without one, [-]
+
+    """
+    where = f' (default {default})' if default is not None else ''
+    parser.add_argument('--out', required=default is None, default=default, metavar='DIR',
+                        help=f'output directory{where}, written whole or not at all; an '
+                             f'existing one is replaced only if {writer} wrote it')
+    parser.add_argument('--force', action='store_true',
+                        help=f'replace an existing --out that {writer} did not write')
 
 
 _HELD = {signal.SIGINT, signal.SIGTERM}

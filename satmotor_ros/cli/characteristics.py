@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from satmotor_ros.cli._common import add_motor_options, CliError, fail
-from satmotor_ros.cli._output import output_dir
+from satmotor_ros.cli._output import add_out_dir, output_dir
 from satmotor_ros.limits import CURVE_MAX_POINTS
 from satmotor_ros.model import ModelError, MotorModel
 from satmotor_ros.model.families import DEFAULT_FAMILY
@@ -48,11 +48,7 @@ DESCRIPTION = ("Characteristics of the paper's Figs. 8-16 kind over the chamber 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Add the options of ``satmotor characteristics``."""
-    parser.add_argument('--out', required=True, metavar='DIR',
-                        help='output directory, written whole; an existing one is replaced '
-                             'only if this command wrote it')
-    parser.add_argument('--force', action='store_true',
-                        help='replace an existing --out that this command did not write')
+    add_out_dir(parser)
     parser.add_argument('--points', type=int, default=60,
                         help='points per curve (default 60; at most 100000, '
                              'SATMOTOR_CURVE_MAX_POINTS)')

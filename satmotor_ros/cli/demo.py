@@ -19,7 +19,7 @@ import time
 from typing import Any
 
 from satmotor_ros.cli._common import CliError, fail
-from satmotor_ros.cli._output import output_dir
+from satmotor_ros.cli._output import add_out_dir, output_dir
 from satmotor_ros.model.units import LPM, MPA, RPM
 from satmotor_ros.plant.config import parameter_specs, params_from_flat
 from satmotor_ros.plant.scenario import default_cycle, identification_cycle
@@ -65,11 +65,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              'repeatable)')
     parser.add_argument('--no-loop', action='store_true',
                         help='skip the closing-the-loop run and its calibration')
-    parser.add_argument('--out', default='out/demo', metavar='DIR',
-                        help='output directory (default out/demo), written whole; an existing '
-                             'one is replaced only if the demo wrote it')
-    parser.add_argument('--force', action='store_true',
-                        help='replace an existing --out that the demo did not write')
+    add_out_dir(parser, 'the demo', 'out/demo')
     parser.add_argument('--quiet', action='store_true', help='no progress bar')
 
 

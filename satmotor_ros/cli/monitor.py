@@ -9,7 +9,7 @@ from pathlib import Path
 from satmotor_ros.cli._bench import load_data, run_bench_command
 from satmotor_ros.cli._common import add_motor_options, CliError
 from satmotor_ros.cli._liquid import settle_liquid
-from satmotor_ros.cli._output import check_target, output_dir, written_by
+from satmotor_ros.cli._output import add_out_dir, check_target, output_dir, written_by
 from satmotor_ros.identify.coverage import calibrated_envelope
 from satmotor_ros.identify.errors import DataError
 from satmotor_ros.identify.health import Baseline, HealthMonitor, HealthSettings
@@ -35,10 +35,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Add the options of ``satmotor monitor``."""
     parser.add_argument('data', nargs='+', metavar='DATA',
                         help='bench CSVs, rosbag2 directories or logs, in time order')
-    parser.add_argument('--out', required=True, metavar='DIR',
-                        help='output directory, written whole or not at all')
-    parser.add_argument('--force', action='store_true',
-                        help='replace an existing --out that this command did not write')
+    add_out_dir(parser)
     parser.add_argument('--columns', default='', metavar='MAPPING',
                         help='read logs through a column mapping (doc/columns.md)')
     group = parser.add_argument_group('health')
