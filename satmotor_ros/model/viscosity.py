@@ -123,10 +123,8 @@ def vogel_viscosity(temperature: ArrayLike, t_ref: float, nu_ref: float, slope: 
     ----------
     temperature : float or ndarray
         Water temperature, [degC]
-    t_ref : float
-        Temperature at which the viscosity is `nu_ref`, [degC]
-    nu_ref : float
-        Kinematic viscosity at `t_ref`, [m^2/s]
+    t_ref, nu_ref : float
+        The reference point, as for :func:`walther_viscosity`, [degC], [m^2/s]
     slope : float
         Vogel B; 0 gives a constant viscosity, [K]
     t_inf : float
