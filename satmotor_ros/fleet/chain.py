@@ -23,7 +23,7 @@ from typing import Any
 
 from satmotor_ros.fleet.config import MotorRule
 from satmotor_ros.fleet.discover import Motor, Recording
-from satmotor_ros.fleet.resume import content_of, options_key, stat_of
+from satmotor_ros.fleet.resume import content_of, options_key, read_marker, stat_of
 from satmotor_ros.fleet.tasks import (columns_of, input_of, load_screened, MONITOR_DIR,
                                       motor_options, no_baseline, Refused, RunOptions, STATE,
                                       STEP)
@@ -44,11 +44,7 @@ def step_options(rule: MotorRule, run: RunOptions, baseline_key: str) -> str:
 
 def read_step(directory: Path) -> dict[str, Any] | None:
     """Return a step's marker, or None (none, or unreadable)."""
-    try:
-        marker = json.loads((directory / STEP).read_text(encoding='utf-8'))
-    except (OSError, ValueError):
-        return None
-    return marker if isinstance(marker, dict) else None
+    return read_marker(directory / STEP)
 
 
 def valid_steps(motor: Motor, run: RunOptions, baseline_key: str) -> list[dict[str, Any]]:

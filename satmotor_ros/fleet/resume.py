@@ -87,13 +87,18 @@ def options_key(options: dict[str, Any]) -> str:
     return hashlib.blake2b(text.encode(), digest_size=20).hexdigest()
 
 
-def read_done(directory: Path) -> dict[str, Any] | None:
-    """Return the done-marker of an output directory, or None (none, or unreadable)."""
+def read_marker(path: Path) -> dict[str, Any] | None:
+    """Return the JSON mapping a marker file holds, or None (no file, or not a readable one)."""
     try:
-        marker = json.loads((directory / DONE).read_text(encoding='utf-8'))
+        marker = json.loads(path.read_text(encoding='utf-8'))
     except (OSError, ValueError):
         return None
     return marker if isinstance(marker, dict) else None
+
+
+def read_done(directory: Path) -> dict[str, Any] | None:
+    """Return the done-marker of an output directory, or None (none, or unreadable)."""
+    return read_marker(directory / DONE)
 
 
 def is_done(directory: Path, path: str | Path, options: str) -> dict[str, Any] | None:
@@ -148,5 +153,5 @@ def write_done(directory: Path, marker: dict[str, Any], skip: tuple[str, ...] = 
     os.replace(temporary, directory / DONE)
 
 
-__all__ = ['DONE', 'content_of', 'is_done', 'options_key', 'read_done', 'stat_of',
+__all__ = ['DONE', 'content_of', 'is_done', 'options_key', 'read_done', 'read_marker', 'stat_of',
            'write_done']

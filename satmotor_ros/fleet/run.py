@@ -18,6 +18,7 @@ from satmotor_ros.fleet.errors import FleetError
 from satmotor_ros.fleet.explain import explain_alarms
 from satmotor_ros.fleet.health import ESTIMATOR
 from satmotor_ros.fleet.report import write_report
+from satmotor_ros.fleet.resume import read_marker
 from satmotor_ros.fleet.summary import iso_now, LIMIT, motor_view, rank
 from satmotor_ros.fleet.tasks import BASELINE, RunOptions
 
@@ -137,11 +138,7 @@ def _config(base: Path, fleet: str) -> FleetConfig:
 
 
 def _read_baseline(directory: Path) -> dict[str, Any] | None:
-    try:
-        found = json.loads((directory / BASELINE).read_text(encoding='utf-8'))
-    except (OSError, ValueError):
-        return None
-    return found if isinstance(found, dict) else None
+    return read_marker(directory / BASELINE)
 
 
 __all__ = ['Outcome', 'run_fleet']
