@@ -40,13 +40,14 @@ except KeyboardInterrupt:
 """
 
 
-@pytest.mark.parametrize(('mode', 'said', 'lost'), [
-    ('bare', 'the Ctrl-C was lost', True), ('guarded', 'interrupted', False)])
-def test_a_signal_inside_a_finaliser_is_raised_at_the_next_check(mode, said, lost):
-    proc = subprocess.run([sys.executable, '-c', FINALISER.format(root=str(ROOT)), mode],
+def test_a_signal_inside_a_finaliser_is_raised_at_the_next_check():
+    # unguarded, CPython usually runs the handler inside the finaliser and the Ctrl-C is lost
+    # ("Exception ignored in"), but not always (a loaded machine once ran it after): only the
+    # guarded case is this package's behaviour, and it must always be interrupted
+    proc = subprocess.run([sys.executable, '-c', FINALISER.format(root=str(ROOT)), 'guarded'],
                           capture_output=True, text=True, timeout=60)
-    assert proc.stdout.strip() == said
-    assert ('Exception ignored in' in proc.stderr) == lost, proc.stderr
+    assert proc.stdout.strip() == 'interrupted'
+    assert 'Exception ignored in' not in proc.stderr, proc.stderr
 
 
 def test_sigterm_is_delivered_to_the_handler_that_was_there():
