@@ -221,7 +221,8 @@ def test_an_ageing_recording_can_have_a_tanks_temperature_that_moves_its_losses(
     cold = _series(plan, aging(wear=0.0), samples=2000)
     warm = _series(plan, aging(wear=0.0, temperature_span=10.0), samples=2000)
     temperature = warm.channels['temperature']
-    jittered = _series(Plan(), aging(wear=0.0), samples=2000).channels['temperature']
+    jittered = _series(Plan(), aging(wear=0.0, temperature_span=10.0),
+                       samples=2000).channels['temperature']
 
     def jumps(t):  # steps beyond 1.5 K: the sensor's noise (0.3 K) all but never makes one
         return np.mean(np.abs(np.diff(t)) > 1.5)
@@ -231,3 +232,14 @@ def test_an_ageing_recording_can_have_a_tanks_temperature_that_moves_its_losses(
     assert np.mean(extra[hot]) > np.mean(extra[~hot]) + 0.01 * LPM
     assert np.array_equal(_series(Plan(), [Injection()], samples=200).flow,
                           _series(Plan(temperature_jitter=0.3), [Injection()], samples=200).flow)
+
+
+def test_a_recordings_temperature_moves_only_when_its_losses_follow_it():
+    """No viscosity_temperature: the oil is held at one temperature (only the sensor's noise)."""
+    held = _series(Plan(), [Injection()], samples=2000).channels['temperature']
+    assert np.std(held) < 0.5 and abs(np.mean(held) - 43.0) < 0.1
+    swing = _series(Plan(), aging(wear=0.0, temperature_span=10.0),
+                    samples=2000).channels['temperature']
+    assert np.ptp(swing) > 8.0
+    # a bench table's points keep their drawn temperatures (a channel calibration must ignore)
+    assert np.ptp(generate(Plan(n_points=50), Injection(), seed=1).channels['temperature']) > 5.0

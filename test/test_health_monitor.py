@@ -295,3 +295,60 @@ def test_relearning_after_a_change_keeps_the_learned_noise_so_intervals_cover() 
         hits += [p.leakage_factor.low <= 1.3 <= p.leakage_factor.high for p in points]
     assert len(hits) >= 60
     assert np.mean(hits) >= 0.92
+
+
+def test_the_default_synthetic_recording_writes_no_temperature_its_losses_ignore() -> None:
+    """
+    ``satmotor synthetic``'s recording with no effect, read with its temperature: no alarm.
+
+    Its losses do not follow a temperature, so it must not write one that moves: a swing of
+    10 K the losses ignored moved this baseline by +-10 % and raised change alarms every hour
+    or two; the monitor with and without the temperature column must agree.
+    """
+    from satmotor_ros.identify.synthetic import generate_series, Injection, Plan
+    table = generate_series(Plan(family='paszota', displacement=DISPLACEMENT), Injection(),
+                            seed=2, samples=6 * 3600, rate=1.0, hold_s=20.0)
+    samples = HealthSamples.from_table(table)
+    assert samples.temperature is not None
+    factors, alarms = [], []
+    for data in (samples, dataclasses.replace(samples, temperature=None)):
+        monitor = HealthMonitor(Baseline.for_family('paszota', DISPLACEMENT), QUIET)
+        alarms.append(_run(data, monitor, 3600))
+        factors.append(np.array([p.bin_factor for p in monitor.pop_points()]))
+    assert alarms == [[], []]
+    assert np.max(np.abs(factors[0] - factors[1])) < 0.01
+
+
+@pytest.mark.parametrize('case_measured', [True, False])
+def test_a_leak_to_the_case_is_found_and_named_from_the_case_or_outlet_pressure(
+        case_measured: bool) -> None:
+    """
+    A seal passing k p to the case from 1 h on (+25 % of the losses at this motor's loads).
+
+    With the case pressure measured the leak follows it; without, the case drains to the
+    outlet and its pressure drives the leak: either way one change alarm within 5 min,
+    named a leak (external leakage) on the pressure that drives it (the outlet's must move:
+    a leak on a constant pressure is a flow offset, and is named so).
+    """
+    samples = recording(1.6, seed=5, rate_hz=2.0)
+    # the outlet's pressure moves (the drop kept): a leak on a constant one is an offset
+    lift = 1.0e6 * (1.0 + np.sin(2 * np.pi * samples.time / 71.0))
+    samples = dataclasses.replace(samples, p_in=samples.p_in + lift, p_out=samples.p_out + lift)
+    p_case = 0.3 * samples.p_out + 0.2e6 * (1.0 + np.sin(2 * np.pi * samples.time / 97.0))
+    drive = p_case if case_measured else samples.p_out
+    baseline = Baseline.for_family('paszota', DISPLACEMENT)
+    model = baseline.model
+    loss = float(np.mean(model.absorbency(samples.speed, dp=samples.p_in - samples.p_out,
+                                          errors='mask').flow
+                         - model.geometry.displacement * samples.speed))
+    k = 0.25 * loss / float(np.mean(drive))
+    flow = samples.flow + np.where(samples.time >= 3600.0, k * drive, 0.0)
+    data = dataclasses.replace(samples, flow=flow, p_case=p_case if case_measured else None)
+    monitor = HealthMonitor(baseline, dataclasses.replace(QUIET, explain=True))
+    _run(data, monitor)
+    (alarm,) = monitor.snapshot().alarms
+    assert alarm.kind == 'change' and 3600.0 <= alarm.time_s <= 3600.0 + 300.0
+    assert alarm.after > alarm.before
+    driver = 'p_case' if case_measured else 'p_out'
+    assert alarm.what.startswith('leak (external leakage)'), alarm.what
+    assert f'external_leakage({driver})' in alarm.what, alarm.what

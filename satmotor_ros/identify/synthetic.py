@@ -123,7 +123,8 @@ class Plan:
     dp_mpa: tuple[float, float] = (2.0, 25.0)  # port drop [MPa]
     p_out_mpa: tuple[float, float] = (0.3, 3.0)  # [MPa]
     p_case_mpa: tuple[float, float] = (0.05, 0.6)  # [MPa]
-    temperature_c: tuple[float, float] = (38.0, 48.0)  # when viscosity is not injected [degC]
+    temperature_c: tuple[float, float] = (38.0, 48.0)  # when viscosity is not injected: the
+    # steady points' range, a recording's oil held at its middle [degC]
     temperature_jitter: float = 0.3  # share of the span drawn anew per set-point; 0: only the
     # slow warm-up and cool-down cycles, as a tank of oil [-]
     duration_s: float = 3600.0  # test duration [s]
@@ -243,7 +244,18 @@ def _operating_points(plan: Plan, rng: np.random.Generator,
 
 
 def _temperature(plan: Plan, injections: tuple[Injection, ...], rng: np.random.Generator,
-                 time: FloatArray) -> FloatArray:
+                 time: FloatArray, recording: bool) -> FloatArray:
+    """
+    Draw the oil's temperature, [degC].
+
+    With ``viscosity_temperature`` injected it spans the injection's magnitude and the
+    losses follow it. Without, a bench table's points are set at temperatures drawn over the
+    plan's range that the losses ignore (a channel that does not matter, which calibration
+    must not take for an effect); a recording's oil is held at the middle of that range
+    (the losses at the model's viscosity, which does not move): a temperature that moved
+    while the losses did not would be a motor no oil makes, and a monitor that reads the
+    temperature, as it must, would alarm on it.
+    """
     span = [i.magnitude for i in injections if i.effect == 'viscosity_temperature']
     if span:
         mid = 0.5 * sum(plan.temperature_c)
@@ -256,13 +268,17 @@ def _temperature(plan: Plan, injections: tuple[Injection, ...], rng: np.random.G
     jitter = plan.temperature_jitter
     temperature: FloatArray = lo + (hi - lo) * ((1.0 - jitter) * cycles
                                                 + jitter * rng.uniform(0, 1, time.size))
+    if recording and not span:  # drawn all the same: the other channels' draws do not move
+        return np.full_like(temperature, 0.5 * (lo + hi))
     return temperature
 
 
 def _channels(plan: Plan, injections: tuple[Injection, ...], rng: np.random.Generator,
-              time: FloatArray, draw: int, index: np.ndarray) -> dict[str, FloatArray]:
+              time: FloatArray, draw: int, index: np.ndarray,
+              recording: bool = True) -> dict[str, FloatArray]:
     """Draw p_case, p_out and the extra channels `draw` times, spread by `index`."""
-    channels = {'time': time, 'temperature': _temperature(plan, injections, rng, time),
+    channels = {'time': time,
+                'temperature': _temperature(plan, injections, rng, time, recording),
                 'p_case': rng.uniform(*plan.p_case_mpa, draw)[index] * MPA,
                 'p_out': rng.uniform(*plan.p_out_mpa, draw)[index] * MPA}
     names = list(plan.extra_channels)
@@ -407,8 +423,8 @@ def aging(family: str = '', wear: float = 1.0, fault: Injection | None = None,
         ``'oil'`` or ``'water'``, [-]
     temperature_span : float
         The losses follow the temperature over this span, by the liquid's own viscosity
-        law (``viscosity_temperature``), as a real motor's do; 0: the temperature column
-        is drawn but the losses do not depend on it, [K]
+        law (``viscosity_temperature``), as a real motor's do; 0: the oil is held at the
+        middle of the plan's temperatures (the recording's temperature does not move), [K]
 
     Returns
     -------
@@ -453,7 +469,7 @@ def generate(plan: Plan, injection: Injection | Sequence[Injection],
     speed, dp = _operating_points(plan, rng, n)
     time = np.sort(rng.uniform(0.0, plan.duration_s, n))
     injections = _injections(injection)
-    channels = _channels(plan, injections, rng, time, n, np.arange(n))
+    channels = _channels(plan, injections, rng, time, n, np.arange(n), recording=False)
     channels['revolutions'] = revolutions(speed, np.diff(time, prepend=0.0))
     spans, flow = _motor_flow(plan, injections, speed, dp, channels)
     return _measure(plan, spans, rng, flow, speed, dp, channels, 1.0)

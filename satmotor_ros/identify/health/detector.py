@@ -34,10 +34,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 import math
 
-CLIP = 5.0
+CLIP = 4.0
 """Largest |innovation| the CUSUM takes: beyond it a bin is a spike, not evidence, [-]."""
 
-DELTA_MAX = CLIP
+DELTA_MAX = 2.0
 """Largest shift per bin the CUSUM is tuned to, [-]: with innovations clipped at CLIP a
 step tuned to delta gains at most delta CLIP - delta^2 / 2, which is negative beyond 2 CLIP,
 so on a quiet flowmeter (a 20 % change many sigma per bin) the detector would never alarm.
