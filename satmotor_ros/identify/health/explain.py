@@ -8,15 +8,26 @@ every sample (:func:`~satmotor_ros.identify.parts.loss_parts`), the candidate li
 for those data (:func:`~satmotor_ros.identify.candidates.build_library`) and the
 cross-validated forward selection with time-ordered blocked folds
 (:class:`~satmotor_ros.identify.selection.CrossValidatedSelector`). An effect the samples
-since the change ask for and those before do not is what changed. When neither side asks
-for an effect, the components' fitted factors are compared: one that moved beyond both
-sides' 95 % intervals names a change of that loss (a wear of the clearances scales the
-leakage). Otherwise the change is ``unexplained``.
+since the change ask for and those before do not is what changed.
+
+That selection guards calibration against effects the data do not need, so on a change of
+some per cent of the losses it often asks for nothing. The change is known to be there,
+though (the alarm), so the explanations are then weighed against each other
+(:func:`_contrast`): the samples of both sides in one least-squares fit, the model's
+components scaled by factors both sides share, plus one explanation acting since the change
+only: either a component's factor moving (a wear of that loss) or a named kind of the
+candidate library (its first-order change of the prediction, by the kind's own modifier: a
+leak to the case, a sensor's gain or offset). The explanation with the least residual is
+named when it beats the next by a likelihood ratio of 20 (residual sums of squares
+2 ln 20 residual variances apart, the variance inflated by the residuals' correlation, from
+batch means); when it does not, both are named, as fitting alike; when none beats no
+change by the 99 % chi-square point, the change is ``unexplained``.
 """
 
 from __future__ import annotations
 
 from dataclasses import replace
+import math
 
 import numpy as np
 
@@ -24,10 +35,13 @@ from satmotor_ros.identify.candidates import build_library
 from satmotor_ros.identify.errors import IdentificationError
 from satmotor_ros.identify.fit import MIN_POINTS
 from satmotor_ros.identify.health.baseline import Baseline
+from satmotor_ros.identify.health.noise import fit_variance
 from satmotor_ros.identify.health.records import HealthSamples
-from satmotor_ros.identify.parts import loss_parts
+from satmotor_ros.identify.parts import loss_parts, LossParts, NO_EFFECT, predict_flow
 from satmotor_ros.identify.selection import CrossValidatedSelector, Forward, Score
 from satmotor_ros.identify.table import BenchTable
+from satmotor_ros.model._typing import FloatArray
+from satmotor_ros.model.effects import Candidate
 
 GAINS = ('flow_sensor_gain', 'speed_sensor_gain')
 """Two kinds that tie where the flow follows the speed: named together when they do."""
@@ -44,11 +58,30 @@ WORDS = {'external_leakage': 'leak (external leakage)', 'clearance_wear': 'wear 
          'threshold': 'valve (a flow above a pressure threshold)'}
 """Effect kind -> how the monitor names it (the kind's id follows in brackets)."""
 
+CONTRASTED = ('external_leakage', 'flow_sensor_gain', 'flow_sensor_offset', 'speed_sensor_gain')
+"""Kinds :func:`_contrast` weighs beside the components' own factors (a wear is a component's
+factor moving; a kind with a shape to fit, a threshold, is left to the selection)."""
 
-def _table(samples: HealthSamples, baseline: Baseline) -> BenchTable:
+DECISIVE = 2.0 * math.log(20.0)
+"""Residual variances by which the best explanation must beat the next, [-]."""
+
+BATCH = 40
+"""Consecutive residuals per batch of :func:`_inflation` (10 s at the monitor's 4 Hz)."""
+
+SIGNIFICANT = 6.635
+"""Residual variances by which it must beat no change: chi-square, 1 dof, 99 %, [-]."""
+
+
+def _keep(samples: HealthSamples, most: int = MOST_SAMPLES) -> np.ndarray:
+    """Return the rows a side is cut to: at most `most` with a flow, spread evenly."""
     keep = np.flatnonzero(np.isfinite(samples.flow))
-    if keep.size > MOST_SAMPLES:
-        keep = keep[np.linspace(0, keep.size - 1, MOST_SAMPLES).astype(int)]
+    if keep.size > most:
+        keep = keep[np.linspace(0, keep.size - 1, most).astype(int)]
+    return keep
+
+
+def _table(samples: HealthSamples, baseline: Baseline, most: int = MOST_SAMPLES) -> BenchTable:
+    keep = _keep(samples, most)
     channels = {'time': samples.time[keep]}
     if samples.temperature is not None:
         channels['temperature'] = samples.temperature[keep]
@@ -99,7 +132,7 @@ def explain_change(before: HealthSamples, after: HealthSamples, baseline: Baseli
 
     """
     try:
-        fwd_before, names = _select(before, baseline)
+        fwd_before, _ = _select(before, baseline)
         fwd_after, _ = _select(after, baseline)
     except IdentificationError:
         return 'unexplained'
@@ -114,7 +147,7 @@ def explain_change(before: HealthSamples, after: HealthSamples, baseline: Baseli
             # a flow gain and a speed gain fit alike where the flow follows the speed
             word = 'flow or speed sensor gain (they fit alike here)'
         return f'{word} [{score.label}]'
-    return _factors(fwd_before, fwd_after, names)
+    return _contrast(before, after, baseline)
 
 
 def _kind(score: Score) -> str:
@@ -123,26 +156,117 @@ def _kind(score: Score) -> str:
     return effect.split(':')[0]
 
 
-def _factors(before: Forward, after: Forward, names: tuple[str, ...]) -> str:
-    """Name the component whose factor moved beyond both intervals, or 'unexplained'."""
+def _contrast(before: HealthSamples, after: HealthSamples, baseline: Baseline) -> str:
+    """Weigh the explanations of the change on both sides at once; name the best."""
+    both = HealthSamples(*(np.concatenate([getattr(before, name), getattr(after, name)])
+                           for name in ('time', 'speed', 'flow', 'p_in', 'p_out')),
+                         _joined(before.p_case, after.p_case),
+                         _joined(before.temperature, after.temperature))
+    table = _table(both, baseline, 2 * MOST_SAMPLES)
+    x = baseline.displacement * both.speed
+    dt = np.diff(both.time, prepend=np.nan)
+    with np.errstate(invalid='ignore', divide='ignore'):
+        rate = np.abs(np.diff(x, prepend=np.nan) / dt)
+    rate = np.where(np.isfinite(rate) & (dt > 0), rate, 0.0)[_keep(both, 2 * MOST_SAMPLES)]
+    model = baseline.model
+    bare = type(model)(model.geometry, replace(model.coefficient_set, effects=()),
+                       model.valid_range, model.liquid, model.displacement_law, model.name)
     try:
-        a, b = before.final.fit.report(), after.final.fit.report()
+        parts, usable = loss_parts(bare, table)
     except IdentificationError:
         return 'unexplained'
-    best, best_ratio = '', 1.0
-    for i, name in enumerate(names):
-        lo_a, hi_a = a.ci95[i]
-        lo_b, hi_b = b.ci95[i]
-        apart = lo_b > hi_a or hi_b < lo_a
-        ratio = float(b.values[i] / a.values[i]) if a.values[i] else np.inf
-        if apart and abs(np.log(ratio)) > abs(np.log(best_ratio)):
-            best, best_ratio = name, ratio
-    if not best:
+    since = (table.channels['time'] >= after.time[0])[usable] if len(after) else usable[usable]
+    if min(int(since.sum()), int((~since).sum())) < 4 * MIN_POINTS:
         return 'unexplained'
-    word = 'wear' if best_ratio > 1.0 else 'recovery'
+    rate = rate[usable]
+    points = table.select(usable)
+    channels = {**points.channels, 'p_in': points.p_in, 'p_out': points.p_out}
+    candidates, _ = build_library(parts, channels, baseline.law, model.family.name)
+    shared = np.column_stack([c.flow(NO_EFFECT) for c in parts.components])
+    y = parts.flow - parts.displacement
+    # each sample weighed by its noise, as the monitor does (:mod:`.noise`), fitted before
+    flow = parts.displacement + shared.sum(axis=1)
+    a, b, c = fit_variance(rate[~since], (y - shared.sum(axis=1))[~since], flow[~since])
+    root = 1.0 / np.sqrt(a + b * rate ** 2 + c * flow ** 2)
+    shared, y = shared * root[:, None], y * root
+    columns = {f'wear: the {c.name.removesuffix("_scale")} part of the losses': shared[:, j]
+               for j, c in enumerate(parts.components)}
+    columns.update({f'{WORDS[_kind_of(c)]} [{c.label}]': _first_order(parts, c) * root
+                    for c in candidates if _kind_of(c) in CONTRASTED and not c.shape})
+    rss0, _, _ = _lsq(shared, y)
+    fits = {name: _lsq(np.column_stack([shared, np.where(since, x, 0.0)]), y)
+            for name, x in columns.items()
+            if np.all(np.isfinite(x)) and np.any(x[since] != 0.0)}
+    if not fits:
+        return 'unexplained'
+    ranked = sorted(fits, key=lambda name: fits[name][0])
+    best_rss, coef, residual = fits[ranked[0]]
+    variance = best_rss / max(residual.size - shared.shape[1] - 1, 1) * _inflation(residual)
+    if not (rss0 - best_rss) / variance >= SIGNIFICANT:
+        return 'unexplained'
+    named = _named(ranked[0], coef, list(columns))
+    if len(ranked) > 1 and (fits[ranked[1]][0] - best_rss) / variance < DECISIVE:
+        words = {name.partition(' [')[0] for name in ranked[:2]}
+        if words == {WORDS[g] for g in GAINS}:
+            label = ranked[0].partition(' [')[2].removesuffix(']')
+            return f'flow or speed sensor gain (they fit alike here) [{label}]'
+        return f'{named} or {_named(ranked[1], fits[ranked[1]][1], list(columns))} ' \
+               '(they fit alike here)'
+    return named
+
+
+def _inflation(residual: FloatArray) -> float:
+    """
+    Return the residuals' long-run variance over their variance, by batch means, [-].
+
+    Correlated noise (a flowmeter's slow wander, a log's timing jitter) makes a sum of
+    squares worth fewer independent samples: the variance of the means of
+    :data:`BATCH` consecutive residuals, times BATCH, over the residuals' variance (at
+    least 1).
+    """
+    batches = residual.size // BATCH
+    if batches < 10 or not np.var(residual) > 0:
+        return 1.0
+    means = residual[:batches * BATCH].reshape(batches, BATCH).mean(axis=1)
+    return max(1.0, float(BATCH * np.var(means) / np.var(residual)))
+
+
+def _joined(a: FloatArray | None, b: FloatArray | None) -> FloatArray | None:
+    return None if a is None or b is None else np.concatenate([a, b])
+
+
+def _kind_of(candidate: Candidate) -> str:
+    return candidate.effect.split(':')[0]
+
+
+def _first_order(parts: LossParts, candidate: Candidate) -> FloatArray:
+    """Return d(prediction)/d(coefficient) at 0 by the kind's own modifier, [m^3/s per unit]."""
+    ones = np.ones(len(parts.components))
+    step = candidate.typical * 1e-3  # a thousandth of a l/min at the largest
+    moved = predict_flow(parts, ones, candidate.modify(step))
+    return np.asarray((moved - predict_flow(parts, ones)) / step, dtype=float)
+
+
+def _lsq(design: FloatArray, y: FloatArray) -> tuple[float, FloatArray, FloatArray]:
+    """Return the residual sum of squares, the coefficients and the residuals of y ~ design."""
+    scale = np.max(np.abs(design), axis=0)
+    scale[scale == 0] = 1.0
+    coef, *_ = np.linalg.lstsq(design / scale, y, rcond=None)
+    coef = coef / scale
+    residual = y - design @ coef
+    return float(residual @ residual), coef, residual
+
+
+def _named(name: str, coef: FloatArray, names: list[str]) -> str:
+    """Give a component's wear the factor it moved by (since over before); others as they are."""
+    if not name.startswith('wear: '):
+        return name
+    before = coef[names.index(name)]
+    ratio = (before + coef[-1]) / before if before else math.inf
+    word = name if ratio >= 1.0 else name.replace('wear', 'recovery', 1)
     # the factor of one part of the losses, not of all of them (the alarm's before and
     # after give that): a small part may grow several times for a change of some per cent
-    return f'{word}: the {best.removesuffix("_scale")} part of the losses x{best_ratio:.2f}'
+    return f'{word} x{ratio:.2f}'
 
 
 __all__ = ['explain_change', 'MOST_SAMPLES', 'WORDS']

@@ -213,22 +213,26 @@ class HealthMonitor:
         op = np.where(used, dt, 0.0)
         self._keep_recent(block, used)
         residual = losses.measured - losses.baseline
+        # the reading's noise part grows with the flow the baseline gives, not the flow read:
+        # weights that fell with the reading's own noise would bias the factor low
+        flow = np.where(used, np.abs(losses.displacement + losses.baseline), 0.0)
         if math.isnan(self.var_a):  # stage 1: these samples teach the noise model only
             need = self.settings.learn_hours * 3600.0 / 3.0 * (1.0 - EPS) - self.op_s
             early = np.cumsum(op) < need
             early[:int(np.argmin(early)) + 1] = True  # up to the sample that completes it
             teach = used & early
             self.op_s += float(op[teach].sum())
-            self._gather_noise(rate[teach], residual[teach], block, teach)
+            self._gather_noise(rate[teach], residual[teach], flow[teach], block, teach)
             if math.isfinite(self.t_ref):  # the rest of the block at the temperature learned
                 losses = self.baseline.losses(block, s.min_speed, self.t_ref)
+                flow = np.where(used, np.abs(losses.displacement + losses.baseline), 0.0)
             used = used & ~early
             op = np.where(used, op, 0.0)
             if math.isnan(self.var_a) or not used.any():
                 return alarms
         base = losses.baseline
         w = 1.0 / (self.var_a + self.var_b * rate ** 2
-                   + self.var_c * np.asarray(block.flow, dtype=float) ** 2)
+                   + self.var_c * flow ** 2)
         lb, lm = np.where(used, base, 0.0), np.where(used, losses.measured, 0.0)
         contributions = np.vstack([used.astype(float), w * lb * lb, w * lb * lm, op,
                                    np.where(used, losses.displacement, 0.0), lb,
@@ -291,12 +295,13 @@ class HealthMonitor:
         while self.recent and self.recent[0].time[-1] < horizon:
             self.recent.popleft()
 
-    def _gather_noise(self, rate: FloatArray, residual: FloatArray, block: HealthSamples,
+    def _gather_noise(self, rate: FloatArray, residual: FloatArray, flow: FloatArray,
+                      block: HealthSamples,
                       used: np.ndarray) -> None:
         """Stage 1: keep residuals until a third of the learning time, then fit the noise."""
         self.noise_rate.append(rate)
         self.noise_residual.append(residual)
-        self.noise_flow.append(np.asarray(block.flow, dtype=float)[used])
+        self.noise_flow.append(flow)
         if block.temperature is not None:
             self.noise_temperature.append(np.asarray(block.temperature)[used])
         if self.op_s < self.settings.learn_hours * 3600.0 / 3.0 * (1.0 - EPS):
