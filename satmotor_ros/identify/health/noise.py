@@ -91,7 +91,10 @@ def fit_variance(rate: FloatArray, residual: FloatArray,
     design = np.column_stack([np.ones_like(y), x_rate, x_flow])
     scale = np.max(np.abs(design), axis=0)
     scale[scale == 0] = 1.0
-    weight = np.sqrt(count) / max(float(np.max(y)), RESOLUTION ** 2)
+    # relative errors: the quiet cells (low flow, at rest) fix the floor a as much as the
+    # loud ones fix b and c; absolute errors let the loud cells set it and left the quiet
+    # samples' variance 2.5 times too small (an alarm on one quiet bin)
+    weight = np.sqrt(count) / np.maximum(y, RESOLUTION ** 2)
     coef, _ = nnls(design / scale * weight[:, None], y * weight)
     a, b, c = coef / scale
     floor = float(np.min(y))
