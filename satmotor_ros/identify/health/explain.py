@@ -158,9 +158,11 @@ def _kind(score: Score) -> str:
 
 def _contrast(before: HealthSamples, after: HealthSamples, baseline: Baseline) -> str:
     """Weigh the explanations of the change on both sides at once; name the best."""
-    both = HealthSamples(*(np.concatenate([getattr(before, name), getattr(after, name)])
-                           for name in ('time', 'speed', 'flow', 'p_in', 'p_out')),
-                         _joined(before.p_case, after.p_case),
+    def join(name: str) -> FloatArray:
+        return np.concatenate([getattr(before, name), getattr(after, name)])
+
+    both = HealthSamples(join('time'), join('speed'), join('flow'), join('p_in'),
+                         join('p_out'), _joined(before.p_case, after.p_case),
                          _joined(before.temperature, after.temperature))
     table = _table(both, baseline, 2 * MOST_SAMPLES)
     x = baseline.displacement * both.speed

@@ -1,7 +1,6 @@
 # SPDX-License-Identifier: Apache-2.0
 """
-The per-sample noise of the loss residual: a floor, a part that grows with the flow's rate and
-a part that grows with the reading.
+The per-sample noise of the loss residual: a floor, and parts that grow with rate and flow.
 
 Two readings taken a little apart in time disagree in proportion to how fast the flow
 changes (on the MBARI logs 0.05 l/min at rest, several l/min while the flow ramps), and a
@@ -21,9 +20,8 @@ depend on them being right (:mod:`.detector` scales by the data's own spread).
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import nnls
-
 from satmotor_ros.model._typing import FloatArray
+from scipy.optimize import nnls
 
 RESOLUTION = 1.0e-9
 """Least noise a flow reading is taken to have, 6e-5 l/min (far below any flowmeter's
