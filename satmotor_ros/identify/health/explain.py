@@ -187,9 +187,8 @@ def _contrast(before: HealthSamples, after: HealthSamples, baseline: Baseline) -
     shared = np.column_stack([c.flow(NO_EFFECT) for c in parts.components])
     y = parts.flow - parts.displacement
     # each sample weighed by its noise, as the monitor does (:mod:`.noise`), fitted before
-    flow = parts.displacement + shared.sum(axis=1)
-    a, b, c = fit_variance(rate[~since], (y - shared.sum(axis=1))[~since], flow[~since])
-    root = 1.0 / np.sqrt(a + b * rate ** 2 + c * flow ** 2)
+    a, b = fit_variance(rate[~since], (y - shared.sum(axis=1))[~since])
+    root = 1.0 / np.sqrt(a + b * rate ** 2)
     shared, y = shared * root[:, None], y * root
     columns = {f'wear: the {c.name.removesuffix("_scale")} part of the losses': shared[:, j]
                for j, c in enumerate(parts.components)}

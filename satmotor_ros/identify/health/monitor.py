@@ -79,8 +79,8 @@ spread evenly, so more would only cost memory and state-file size), [1/s]."""
 LEVEL_POINTS = 6
 """Trend points (an hour at the default 10 min) before its line is the detector's level."""
 
-STATE_VERSION = 2
-"""Version of the saved state's layout (2: the noise part that grows with the reading)."""
+STATE_VERSION = 1
+"""Version of the saved state's layout."""
 
 
 class HealthMonitor:
@@ -125,11 +125,9 @@ class HealthMonitor:
         # stage 1: the sample noise model and the temperature the baseline holds at
         self.noise_rate: list[FloatArray] = []
         self.noise_residual: list[FloatArray] = []
-        self.noise_flow: list[FloatArray] = []
         self.noise_temperature: list[FloatArray] = []
         self.var_a = math.nan
         self.var_b = math.nan
-        self.var_c = math.nan
         self.t_ref = math.nan  # [degC]
         # bins
         self.bin_index = -1
@@ -213,26 +211,21 @@ class HealthMonitor:
         op = np.where(used, dt, 0.0)
         self._keep_recent(block, used)
         residual = losses.measured - losses.baseline
-        # the reading's noise part grows with the flow the baseline gives, not the flow read:
-        # weights that fell with the reading's own noise would bias the factor low
-        flow = np.where(used, np.abs(losses.displacement + losses.baseline), 0.0)
         if math.isnan(self.var_a):  # stage 1: these samples teach the noise model only
             need = self.settings.learn_hours * 3600.0 / 3.0 * (1.0 - EPS) - self.op_s
             early = np.cumsum(op) < need
             early[:int(np.argmin(early)) + 1] = True  # up to the sample that completes it
             teach = used & early
             self.op_s += float(op[teach].sum())
-            self._gather_noise(rate[teach], residual[teach], flow[teach], block, teach)
+            self._gather_noise(rate[teach], residual[teach], block, teach)
             if math.isfinite(self.t_ref):  # the rest of the block at the temperature learned
                 losses = self.baseline.losses(block, s.min_speed, self.t_ref)
-                flow = np.where(used, np.abs(losses.displacement + losses.baseline), 0.0)
             used = used & ~early
             op = np.where(used, op, 0.0)
             if math.isnan(self.var_a) or not used.any():
                 return alarms
         base = losses.baseline
-        w = 1.0 / (self.var_a + self.var_b * rate ** 2
-                   + self.var_c * flow ** 2)
+        w = 1.0 / (self.var_a + self.var_b * rate ** 2)
         lb, lm = np.where(used, base, 0.0), np.where(used, losses.measured, 0.0)
         contributions = np.vstack([used.astype(float), w * lb * lb, w * lb * lm, op,
                                    np.where(used, losses.displacement, 0.0), lb,
@@ -295,29 +288,26 @@ class HealthMonitor:
         while self.recent and self.recent[0].time[-1] < horizon:
             self.recent.popleft()
 
-    def _gather_noise(self, rate: FloatArray, residual: FloatArray, flow: FloatArray,
-                      block: HealthSamples,
+    def _gather_noise(self, rate: FloatArray, residual: FloatArray, block: HealthSamples,
                       used: np.ndarray) -> None:
         """Stage 1: keep residuals until a third of the learning time, then fit the noise."""
         self.noise_rate.append(rate)
         self.noise_residual.append(residual)
-        self.noise_flow.append(flow)
         if block.temperature is not None:
             self.noise_temperature.append(np.asarray(block.temperature)[used])
         if self.op_s < self.settings.learn_hours * 3600.0 / 3.0 * (1.0 - EPS):
             return
-        rate_all, residual_all, flow_all = (np.concatenate(x) for x in (
-            self.noise_rate, self.noise_residual, self.noise_flow))
+        rate_all, residual_all = np.concatenate(self.noise_rate), np.concatenate(
+            self.noise_residual)
         if rate_all.size > NOISE_SAMPLES:
             pick = np.linspace(0, rate_all.size - 1, NOISE_SAMPLES).astype(int)
-            rate_all, residual_all, flow_all = rate_all[pick], residual_all[pick], flow_all[pick]
-        self.var_a, self.var_b, self.var_c = fit_variance(rate_all, residual_all, flow_all)
+            rate_all, residual_all = rate_all[pick], residual_all[pick]
+        self.var_a, self.var_b = fit_variance(rate_all, residual_all)
         finite = (np.concatenate(self.noise_temperature) if self.noise_temperature
                   else np.zeros(0))
         finite = finite[np.isfinite(finite)]
         self.t_ref = float(np.median(finite)) if finite.size else math.nan
         self.noise_rate, self.noise_residual, self.noise_temperature = [], [], []
-        self.noise_flow = []
 
     # ------------------------------------------------------------------ bins
     def _close_bin(self, sums: FloatArray, index: int) -> list[Alarm]:
@@ -616,7 +606,6 @@ class HealthMonitor:
             reference_dp=self.reference_dp,
             statistic=0.0 if self.learning else self.cusum.statistic, threshold=self.cusum.h,
             noise={'sample_var_rest': self.var_a, 'sample_var_per_rate2': self.var_b,
-                   'sample_var_per_flow2': self.var_c,
                    'bin_inflation': c2, 'bin_autocorrelation': phi,
                    'trend_autocorrelation': phi_t, 'reference_temperature': self.t_ref},
             n_samples=self.n_samples, n_skipped=sum(self.skipped.values()),
@@ -727,7 +716,6 @@ class HealthMonitor:
         state['trend_point'] = np.asarray(state['trend_point'], dtype=float)
         state['noise_rate'] = [np.asarray(x, dtype=float) for x in state['noise_rate']]
         state['noise_residual'] = [np.asarray(x, dtype=float) for x in state['noise_residual']]
-        state['noise_flow'] = [np.asarray(x, dtype=float) for x in state['noise_flow']]
         state['noise_temperature'] = [np.asarray(x, dtype=float)
                                       for x in state['noise_temperature']]
         for key, value in state.items():
