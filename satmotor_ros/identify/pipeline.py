@@ -156,6 +156,9 @@ class Calibration:
             if effect.fitted_range:
                 row['fitted_range'] = {q: [written(lo), written(hi)]
                                        for q, lo, hi in effect.fitted_range}
+            note = one_sided(candidate, effect)
+            if note:
+                row['direction_note'] = note
             if effect.kind == 'threshold':
                 row['threshold'] = {'regressor': 'dp', 'value': written(effect.reference),
                                     'unit': 'Pa',
@@ -333,6 +336,31 @@ class Calibration:
                 'n_samples': self.samples.n_samples, 'bin_size': self.samples.bin_size,
                 'variance_inflation': written(self.inflation),
                 'dynamics': dynamics_summary(self.final, self.samples)}
+
+
+def one_sided(candidate: Candidate, effect: Effect) -> str:
+    """
+    Say when an effect fitted on both sides of dp acts on one only, since the data hold one.
+
+    Parameters
+    ----------
+    candidate : Candidate
+        The candidate fitted, [-]
+    effect : Effect
+        The effect found, [-]
+
+    Returns
+    -------
+    str
+        One sentence, or '' when the directions agree.
+
+    """
+    if candidate.direction != 'both' or effect.direction == 'both':
+        return ''
+    other = 'positive' if effect.direction == 'negative' else 'negative'
+    return (f'{effect.key}: fitted on both signs of dp, it acts on the {effect.direction} side '
+            f'only, because the data hold no {other} drop beyond its crack: whether it also '
+            f'opens the {other} way, these data cannot say')
 
 
 def _coefficient_interval(report: FitReport, position: int,
@@ -743,4 +771,4 @@ def _source_rows(table: BenchTable, points: BenchTable) -> np.ndarray | None:
 
 
 __all__ = ['AT_BOUND', 'Calibration', 'IdentificationError', 'MODES', 'Mode', 'Options', 'Rows',
-           'calibrate', 'read_rows', 'steady_points']
+           'calibrate', 'one_sided', 'read_rows', 'steady_points']

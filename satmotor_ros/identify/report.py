@@ -14,7 +14,7 @@ import numpy as np
 
 from satmotor_ros.identify.output import effect_block, fitted_coefficients
 from satmotor_ros.identify.parts import LossParts
-from satmotor_ros.identify.pipeline import AT_BOUND, Calibration
+from satmotor_ros.identify.pipeline import AT_BOUND, Calibration, one_sided
 from satmotor_ros.identify.plot_tools import (draw_beyond, MARK_STYLES, portable,
                                               residual_colors, robust_limits, unique_legend)
 from satmotor_ros.identify.residual_map import coverage_section, plot_residual_map
@@ -351,6 +351,8 @@ def _steps(cal: Calibration) -> list[str]:
     lines = []
     for i, step in enumerate(cal.forward.steps, 1):
         lines.append(f'{i}. {step.verdict}.')
+    lines += [f'- {note}.' for note in (one_sided(score.added, effect) for score, effect in
+                                        zip(cal.found, cal.effects())) if note]
     rows = [_errors_row('packaged model (in sample)', cal.error_packaged),
             _errors_row('fitted, no effect', cal.error_before)]
     names = []

@@ -64,7 +64,8 @@ from satmotor_ros.identify.errors import IdentificationError
 from satmotor_ros.identify.fit import HUBER, LossFit
 from satmotor_ros.identify.noise import noise_model, outliers, robust_scale
 from satmotor_ros.identify.parts import LossParts
-from satmotor_ros.identify.regional import acting, local_gain, LocalGain
+from satmotor_ros.identify.regional import (acting, local_gain, LocalGain, RECUR_ALPHA,
+                                            recurrence)
 from satmotor_ros.identify.regions import clustered, regions, Space
 from satmotor_ros.identify.transient import variance_inflation
 from satmotor_ros.model._typing import FloatArray
@@ -161,7 +162,7 @@ class Selection:
     sigma: FloatArray  # noise model of the step at every point [m^3/s]
     left_out: np.ndarray  # bool: outliers even under the step's best model, not fitted
     refused: tuple[Score, ...] = ()  # ahead of the candidates chosen from, but on a bound
-    confined: bool = False  # chosen by its gain where it acts (:mod:`.regional`): the last
+    confined: bool = False  # chosen by its gain where it acts (:mod:`.regional`)
 
 
 @dataclass(frozen=True)
@@ -332,6 +333,13 @@ class CrossValidatedSelector:
 
         """
         full = LossFit(effects, sigma, HUBER).fit(parts, index, start)
+        if baseline is not None and effects[-1].shape and start is not None \
+                and len(start) > baseline.fit.u_.size:
+            # a form's shape from the outlier screen's fit (one scale, Tukey's weights, which
+            # reject the few rows where a valve opens) may sit in another basin than this
+            # step's weights have: the form's own starts are tried too, the better fit kept
+            own = LossFit(effects, sigma, HUBER).fit(parts, index, baseline.fit.u_)
+            full = own if own.objective_ < full.objective_ else full
         error = parts.flow - full.predict(parts)  # out of sample where not fitted
         for test in folds(index.size, self.n_folds, self.time_ordered, self.seed, self.block):
             u = full.without(_guarded(test, self.guard, index.size))
@@ -465,7 +473,8 @@ class CrossValidatedSelector:
         return self._space
 
     def step(self, parts: LossParts, found: tuple[Candidate, ...],
-             pool: Sequence[Candidate], start: FloatArray | None) -> Selection:
+             pool: Sequence[Candidate], start: FloatArray | None,
+             recur: bool = False) -> Selection:
         """
         Test every candidate of `pool` on top of the effects `found`, and choose.
 
@@ -479,6 +488,9 @@ class CrossValidatedSelector:
             Candidates still to test, [-]
         start : ndarray, optional
             The fit of the model with `found`, to start from, [-]
+        recur : bool
+            Whether an effect chosen over every row must also recur across the blocks of
+            the time series (:func:`~.regional.recurrence`): after a valve, [-]
 
         Returns
         -------
@@ -540,6 +552,14 @@ class CrossValidatedSelector:
         others.sort(key=lambda s: priority(s.effect) != priority(best.effect))
         runner = others[0] if others else None
         gain = 1.0 - best.cv_rmse / baseline.cv_rmse
+        if recur:
+            again = recurrence(baseline.cv_error, best.cv_error, sigma, index, self.block)
+            if again.chance >= RECUR_ALPHA / m:
+                return _with_verdict(done, (
+                    f'no further effect: the best candidate, {best.label}, cuts the '
+                    f'cross-validated error by {100 * gain:.1f} % with p = {best.p_value:.2g}, '
+                    f'but after a valve an effect must also recur across the recording: '
+                    f'{again.says()} (need < {RECUR_ALPHA:g}/{m})' + _at_bound(refused)))
         verdict = (f'{best.label}: cuts the cross-validated error by {100 * gain:.1f} %, '
                    f'p = {best.p_value:.2g} < {self.alpha:g}/{m}, plain RMSE '
                    f'{_plain(baseline, best)}')
@@ -577,17 +597,21 @@ class CrossValidatedSelector:
         self._space = Space(parts.sign * parts.dp, parts.rotation * parts.speed,
                             None if time is None else np.asarray(time, dtype=float))
         start = None
+        valve = False
         while True:
             pool = [c for c in candidates if not any(same_effect(c, f) for f in found)]
-            step = self.step(parts, found, pool, start)
+            step = self.step(parts, found, pool, start, valve and self.correlated)
             steps.append(step)
             if step.chosen is None:
                 break
             found = (*found, step.chosen.added)
             start = step.chosen.fit.u_
-            # an effect chosen where it acts ends the search: a form fitted on a few events
-            # moves with the next step's weights (the noise re-estimated without its misses)
-            if len(found) >= self.max_effects or step.confined:
+            # after a valve (an effect confined to a region, or a threshold), the search goes
+            # on, but a form fitted on a few openings moves with the next step's weights (the
+            # noise re-estimated without its misses), and any candidate may bend to that: a
+            # further effect must recur across the recording's blocks (.regional)
+            valve = valve or step.confined or step.chosen.effect.startswith('threshold:')
+            if len(found) >= self.max_effects:
                 break
         # the model as accepted (the last step only re-weighs it to test what is left)
         accepted = [s.chosen for s in steps if s.chosen is not None]
@@ -614,10 +638,10 @@ def _plain(baseline: Score, score: Score) -> str:
     return f'{baseline.rmse / LPM:.4g} -> {score.rmse / LPM:.4g} l/min'
 
 
-ENDS_SEARCH = ('it ends the search: no further effect is tested after it (a form fitted on a '
-               "few openings moves with the next step's noise weights), so an effect beside it "
-               'may be missing')
-"""What the report says after an effect chosen where it acts, since nothing follows it."""
+ENDS_SEARCH = ('the search goes on, and a further effect must also recur across the '
+               "recording's blocks (a form fitted on a few openings moves with the next "
+               "step's noise weights, and a candidate may bend to that)")
+"""What the report says after an effect chosen where it acts."""
 
 
 def _local_verdict(score: Score, baseline: Score, alpha: float, m: int,

@@ -136,8 +136,10 @@ class Candidate:
 
     def as_effect(self, coefficient: float, *shape: float) -> Effect:
         """Return the effect this candidate stands for at a fitted coefficient (and shape)."""
-        if self.make is not None:
-            return replace(self.make(coefficient, *shape), direction=self.direction)
+        if self.make is not None:  # a form on both sides may say which side its data hold
+            made = self.make(coefficient, *shape)
+            return made if self.direction == 'both' else replace(made,
+                                                                 direction=self.direction)
         return Effect(self.effect, coefficient, self.regressor, direction=self.direction)
 
 

@@ -137,9 +137,10 @@ class Threshold(EffectKind):
         if both:
             sides += [('positive', ~negative), ('negative', negative)]
         out, skipped = [], []
+        tops = _side_tops(dp, negative, data.samples)
         for direction, at in sides:
             # data of one sign are one side: the threshold may also sit near its top
-            candidate = self._candidate(dp, at, direction, both, data.samples)
+            candidate = self._candidate(dp, at, direction, both, data.samples, tops)
             if candidate is None:
                 skipped.append(f'{self.name}:dp ({direction}): too few points to place a '
                                'threshold')
@@ -148,7 +149,8 @@ class Threshold(EffectKind):
         return out, skipped
 
     def _candidate(self, dp: FloatArray, at: np.ndarray, direction: str,
-                   two: bool = True, samples: Sampled | None = None) -> Candidate | None:
+                   two: bool = True, samples: Sampled | None = None,
+                   tops: tuple[float, float] = (np.inf, np.inf)) -> Candidate | None:
         """
         Return the candidate acting at `at` only, the threshold among those points.
 
@@ -157,7 +159,10 @@ class Threshold(EffectKind):
         within the range and at the side's quantiles. When the points are bins of a time
         series' `samples`, the valve's flow is computed at every sample and averaged over
         each bin, as the model evaluates it: the flow of a bin whose drop crosses the crack
-        is not the flow at the bin's mean drop.
+        is not the flow at the bin's mean drop. A valve on both sides whose crack lies
+        beyond every drop of one side (`tops`: the largest drop of each, positive then
+        negative) acts on the other side only, and is written as that side's: the data
+        cannot say whether it opens both ways.
         """
         ordered = np.sort(dp[at])
         share, least = MIN_ABOVE[direction if two else 'negative']
@@ -182,7 +187,7 @@ class Threshold(EffectKind):
 
         def make(k: float, x_c: float, e: float) -> Effect:
             return Effect(f'{self.name}:dp', k / (top - x_c) ** e, 'dp', x_c,
-                          options=(('exponent', e),), direction=direction)
+                          options=(('exponent', e),), direction=supported(direction, x_c, tops))
 
         quantiles = tuple(float(np.clip((np.quantile(ordered, q) - low) / (high - low), 0.0,
                                         1.0)) for q in STARTS[direction if two else 'negative'])
@@ -200,6 +205,41 @@ class Threshold(EffectKind):
         drop = data.dp if data.dp is not None else data.dp_i  # the valve reads the port drop
         peak = float(np.max(np.maximum(np.abs(drop) - x_c, 0.0) ** e))
         return Effect(name, magnitude / max(peak, 1e-300), 'dp', x_c, options=(('exponent', e),))
+
+
+def supported(direction: str, crack: float, tops: tuple[float, float]) -> str:
+    """
+    Return the side a valve acts on in the data: one side when the other holds no drop past it.
+
+    Parameters
+    ----------
+    direction : str
+        The candidate's direction (DIRECTIONS), [-]
+    crack : float
+        The fitted cracking drop, [Pa]
+    tops : tuple of float
+        The largest drop on the positive and on the negative side of dp, [Pa]
+
+    Returns
+    -------
+    str
+        `direction`, or for ``'both'`` the one side with drops past the crack when the other
+        has none.
+
+    """
+    positive, negative = (top > crack for top in tops)
+    if direction != 'both' or positive == negative:
+        return direction
+    return 'positive' if positive else 'negative'
+
+
+def _side_tops(dp: FloatArray, negative: np.ndarray,
+               samples: Sampled | None) -> tuple[float, float]:
+    """Return the largest drop of each side, positive then negative (0 for none), [Pa]."""
+    if samples is not None:  # the valve reads the drop at every sample
+        signed = samples.dp[np.isfinite(samples.dp)]
+        return (float(np.max(signed, initial=0.0)), float(np.max(-signed, initial=0.0)))
+    return (float(np.max(dp[~negative], initial=0.0)), float(np.max(dp[negative], initial=0.0)))
 
 
 def _at_samples(samples: Sampled, direction: str) -> FloatArray:
