@@ -213,17 +213,19 @@ def test_calibrate_each_mbari_log_with_the_f11_displacement(mbari_calibrations, 
     if result['effects']:
         assert after['rmse_lpm'] < before['rmse_lpm']
     assert result['error_after_with_outliers']['rmse_lpm'] >= 0.99 * after['rmse_lpm']
-    # the relief valve at the top of the negative drop (about 2 850 psi), found on both logs:
-    # one-sided on the log that runs both ways; on the bias log, whose drops are nearly all
-    # negative, a valve on both sides is that one side
+    # the relief valve at the top of the negative drop (about 2 850 psi), found on both logs,
+    # on the negative side: on the bias log, whose drops beyond the crack are all negative, the
+    # valve fitted on both sides is written as that side's, and the output says so
     valve = [e for e in result['effects'] if e['effect'].startswith('threshold:')]
-    assert valve and valve[0]['direction'] in (('negative',) if name == MBARI[0] else
-                                               ('negative', 'both'))
+    assert valve and valve[0]['direction'] == 'negative'
+    assert ('direction_note' in valve[0]) == (name != MBARI[0])
     assert 19.0 * MPA < valve[0]['threshold']['value'] < 20.5 * MPA
     assert after['rmse_lpm'] < 0.9 * before['rmse_lpm']
     report = (out / 'report.md').read_text()
     assert '## Model family' in report and 'columns mapped by' in report
-    if name == MBARI[0]:  # found where it acts: the search ends there, and the report says so
+    if name == MBARI[0]:  # found where it acts; the search goes on, a further effect must recur
+        # across the recording's blocks: the 11 % flow gain it would name next does not (and
+        # predicts the other log worse)
         assert ENDS_SEARCH in report and len(result['effects']) == 1
     assert load_motor(out / 'coefficients.yaml').family == result['family']
 

@@ -56,7 +56,7 @@ candidate that bends to slow noise whitens its own residuals).
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from satmotor_ros.identify.candidates import Candidate
@@ -334,11 +334,16 @@ class CrossValidatedSelector:
         """
         full = LossFit(effects, sigma, HUBER).fit(parts, index, start)
         if baseline is not None and effects[-1].shape and start is not None \
-                and len(start) > baseline.fit.u_.size:
+                and len(start) > baseline.fit.u_.size and (
+                    effects[-1].effect.startswith('threshold:')
+                    or full.pinned(effects_only=True)):
             # a form's shape from the outlier screen's fit (one scale, Tukey's weights, which
             # reject the few rows where a valve opens) may sit in another basin than this
-            # step's weights have: the form's own starts are tried too, the better fit kept
-            own = LossFit(effects, sigma, HUBER).fit(parts, index, baseline.fit.u_)
+            # step's weights have (a valve slid to an offset: exponent 0.05, crack at the
+            # bottom), and a fit that ends on a bound is no estimate: for a valve, and for a
+            # form on a bound, the form's own starts are tried too, the better fit kept
+            own = LossFit((*effects[:-1], _near_top(effects[-1])), sigma, HUBER).fit(
+                parts, index, baseline.fit.u_)
             full = own if own.objective_ < full.objective_ else full
         error = parts.flow - full.predict(parts)  # out of sample where not fitted
         for test in folds(index.size, self.n_folds, self.time_ordered, self.seed, self.block):
@@ -519,7 +524,10 @@ class CrossValidatedSelector:
             return _with_verdict(done, 'no candidate could be tested' if not ranking else
                                  'none: every candidate ends on a bound of its range'
                                  + _at_bound(refused))
-        top = estimated[0]
+        # the best candidate that passes every test: one that the weighted figure prefers
+        # while the plain error rises (a gain that bends to a valve's misses) does not hide
+        # one behind it that passes (the valve)
+        top = next((s for s in estimated if self._passes(s, baseline, m)), estimated[0])
         gain = 1.0 - top.cv_rmse / baseline.cv_rmse if baseline.cv_rmse > 0 else 0.0
         if not self._passes(top, baseline, m):
             confined = self._confined(estimated, baseline, sigma, index, m)
@@ -621,6 +629,20 @@ class CrossValidatedSelector:
         flagged = outliers(residual, sigma)
         return Forward(tuple(steps), final, sigma, self._isolated(parts, residual, sigma),
                        tuple(regions(flagged, residual / sigma, self.space(parts))))
+
+
+def _near_top(candidate: Candidate) -> Candidate:
+    """
+    Return a valve candidate started at its last start only (its crack nearest the top).
+
+    A valve cracks near the top of its side's drops (the threshold's starts end there), and
+    a valve's fit evaluates it at every sample of a time series, the dearest fit of a step:
+    the second fit from the form's own starts tries that one. Other forms keep every start.
+    """
+    if not candidate.effect.startswith('threshold:'):
+        return candidate
+    return replace(candidate, shape=tuple(replace(s_, starts=s_.starts[-1:])
+                                          for s_ in candidate.shape))
 
 
 def _guarded(test: np.ndarray, guard: int, n: int) -> np.ndarray:
