@@ -23,9 +23,9 @@ from satmotor_ros.identify import regional
 from satmotor_ros.identify.fit import HUBER
 from satmotor_ros.identify.regional import (acting, CONFINED, local_gain, LocalGain,
                                             recurrence)
-from satmotor_ros.model.effects.threshold import supported
 from satmotor_ros.identify.semireal import (build_case, demand_relief, estimate_noise,
                                             load_trajectory, write_mbari_log)
+from satmotor_ros.model.effects.threshold import supported
 from satmotor_ros.model.units import LPM
 from vendored_data import data_path
 

@@ -524,10 +524,13 @@ class CrossValidatedSelector:
             return _with_verdict(done, 'no candidate could be tested' if not ranking else
                                  'none: every candidate ends on a bound of its range'
                                  + _at_bound(refused))
-        # the best candidate that passes every test: one that the weighted figure prefers
-        # while the plain error rises (a gain that bends to a valve's misses) does not hide
-        # one behind it that passes (the valve)
-        top = next((s for s in estimated if self._passes(s, baseline, m)), estimated[0])
+        # a valve that passes every test is not hidden behind a candidate that fails them (a
+        # gain that the weighted figure prefers while the plain error rises: it bends to the
+        # valve's misses); any other candidate must be the best
+        top = estimated[0]
+        if not self._passes(top, baseline, m):
+            top = next((s for s in estimated if s.effect.startswith('threshold:')
+                        and self._passes(s, baseline, m)), top)
         gain = 1.0 - top.cv_rmse / baseline.cv_rmse if baseline.cv_rmse > 0 else 0.0
         if not self._passes(top, baseline, m):
             confined = self._confined(estimated, baseline, sigma, index, m)
