@@ -20,8 +20,8 @@ from satmotor_ros.identify import calibrate, Options
 from satmotor_ros.identify.columns import load_mapping, read_log
 from satmotor_ros.identify.synthetic import (generate_transient, Injection, Plan,
                                              REALISTIC_DYNAMICS)
-from satmotor_ros.options import MotorOptions
 from satmotor_ros.model.units import parse_quantity
+from satmotor_ros.options import MotorOptions
 from vendored_data import data_path
 
 SWAPPED = {'positive': 'negative', 'negative': 'positive', 'both': 'both'}
@@ -62,9 +62,10 @@ def test_a_mirrored_transient_recording_gives_the_mirrored_calibration():
 @pytest.mark.slow
 @pytest.mark.xfail(strict=True, reason='T1 reads port A in both directions (issue 20)')
 def test_the_mirrored_mbari_log_gives_the_mirrored_calibration():
-    table = read_log(data_path('real', 'mbari_pto', '2021.07.26T10.51.44.exp'), load_mapping('mbari_pto'))
-    spec = MotorOptions(liquid='oil',
-                        displacement=parse_quantity('0.30 in^3/rev', 'displacement', 'cm^3/rev')).spec()
+    log = data_path('real', 'mbari_pto', '2021.07.26T10.51.44.exp')
+    table = read_log(log, load_mapping('mbari_pto'))
+    displacement = parse_quantity('0.30 in^3/rev', 'displacement', 'cm^3/rev')
+    spec = MotorOptions(liquid='oil', displacement=displacement).spec()
     one, other = (calibrate(t, 'oil', spec) for t in (table, mirrored(table)))
     first, second = _figures(one), _figures(other)
     _same(first, second, 0.02)
