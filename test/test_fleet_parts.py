@@ -13,7 +13,7 @@ from satmotor_ros.fleet.discover import (BAG_START, discover, MTIME, PATH_DATE, 
                                          TIME_COLUMN)
 from satmotor_ros.fleet.errors import FleetError
 from satmotor_ros.fleet.resume import is_done, options_key, stat_of, write_done
-from satmotor_ros.fleet.summary import DAY, motor_view, rank
+from satmotor_ros.fleet.summary import DAY, MONITOR_EPOCH, motor_view, rank
 
 HEADER = 'time [s],speed [rpm],flow [l/min],p_in [MPa],p_out [MPa]\n'
 EPOCH = datetime(2026, 3, 1, tzinfo=timezone.utc).timestamp()
@@ -240,10 +240,12 @@ def test_one_monitor_runs_through_the_motors_recordings_in_time_order(tmp_path):
 
 
 def test_a_monitored_motors_view_is_the_monitors_figures_and_named_alarms():
+    """On an epoch clock (calendar time) the monitor's own trend is the motor's."""
     steps = [{'recording': f'r{i}.csv', 'status': 'done', 'result': {
         'leakage_factor': {'value': v, 'ci95': [v - 0.01, v + 0.01]}, 'learning': False,
-        'trend_per_hour': 0.01, 'hours_to_limit': 48.0, 'span_s': [i * 100.0, i * 100.0 + 90],
-        'alarms': [{'time_s': 150.0, 'kind': 'change', 'what': 'wear: leakage x1.3'}]
+        'trend_per_hour': 0.01, 'hours_to_limit': 48.0,
+        'span_s': [EPOCH + i * 100.0, EPOCH + i * 100.0 + 90],
+        'alarms': [{'time_s': EPOCH + 150.0, 'kind': 'change', 'what': 'wear: leakage x1.3'}]
         if i else []}} for i, v in enumerate((1.0, 1.3))]
     markers = _markers([1.0, 1.0])
     view = motor_view('m', 'water', markers, None, steps=steps)
@@ -251,6 +253,7 @@ def test_a_monitored_motors_view_is_the_monitors_figures_and_named_alarms():
     assert view['trend_per_day'] == pytest.approx(0.24) and view['days_to_limit'] == 2.0
     assert [(a['kind'], a['recording']) for a in view['alarms']] == [('change', 'r1.csv')]
     assert view['alarms'][0]['what'].startswith('wear: leakage x1.3')
+    assert view['trend_clock'] == MONITOR_EPOCH
 
 
 def test_without_a_baseline_the_damaged_keep_their_reason_and_the_sound_say_why(tmp_path):

@@ -12,6 +12,7 @@ from typing import Any
 import numpy as np
 
 from satmotor_ros.cli._output import png_metadata
+from satmotor_ros.fleet.health import RATIO
 
 PLOTS = 'plots'
 """The plots' directory under DIR: one PNG per motor and ``fleet.png``."""
@@ -92,6 +93,8 @@ def markdown(motors: list[dict[str, Any]], header: dict[str, Any]) -> str:
         lines += ['', f"## {m['motor']}", '',
                   f"Liquid {m['liquid'] or 'as each recording records it'}; baseline: "
                   f"{m['baseline']}; recording times from: {', '.join(m['time_sources'])}.", '',
+                  f"Estimator: {_estimator(m)}; trend per day on {m.get('trend_clock', '')}.",
+                  '',
                   f"![{m['motor']}](plots/{m['motor']}.png)", '']
         lines.append('Alarms:' if m['alarms'] else 'No alarm.')
         lines += [f"- {a['date']} **{a['kind']}**: {a['what']}" for a in m['alarms']]
@@ -99,11 +102,21 @@ def markdown(motors: list[dict[str, Any]], header: dict[str, Any]) -> str:
             lines += ['', 'Refused recordings (whole, not salvaged):']
             lines += [f"- `{r['path']}`: {r['reason']}" for r in m['refused']]
         if m['leakage_factor']:
-            lines += ['', '| date | recording | leakage factor | 95 % interval |',
-                      '| --- | --- | --- | --- |']
-            lines += [f"| {p['date']} | `{p['recording']}` | {p['value']:.4f} | "
-                      f"[{p['ci95'][0]:.4f}, {p['ci95'][1]:.4f}] |" for p in m['leakage_factor']]
+            lines += ['', '| date | time from | recording | leakage factor | 95 % interval |',
+                      '| --- | --- | --- | --- | --- |']
+            lines += [f"| {p['date']} | {p.get('time_source', '')} | `{p['recording']}` | "
+                      f"{p['value']:.4f} | [{p['ci95'][0]:.4f}, {p['ci95'][1]:.4f}] |"
+                      for p in m['leakage_factor']]
     return '\n'.join(lines) + '\n'
+
+
+def _estimator(motor: dict[str, Any]) -> str:
+    """Say which estimator gave a motor's figures."""
+    if motor.get('estimator') == 'monitor':
+        return ("the health monitor (`satmotor monitor`'s), run through the recordings in "
+                'time order')
+    return (f'{RATIO}: per recording, the ratio of measured to baseline losses, its interval '
+            "widened by the residuals' autocorrelation")
 
 
 def _pyplot() -> Any:

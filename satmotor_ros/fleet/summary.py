@@ -11,6 +11,14 @@ alarm (a step is not wear); the days to the limit are where that line meets it, 
 from the last recording. A change is a step between consecutive recordings larger than
 both their intervals and the motor's own day-to-day scatter allow
 (:data:`CHANGE_SIGMAS`), with the wear trend taken out.
+
+Trends are per calendar day. A recording's time is calendar time whichever way it was found
+(a bag's start, an epoch ``time`` column, a date in its path); but the monitor's own clock is
+calendar time only when the samples carry epoch times: recordings whose clock starts again
+(a ``time`` column from 0) are laid end to end on it, a few seconds apart, so its trend is
+per hour *recorded*. For such a motor the trend per day and the days to the limit are the
+line through the monitor's figure after each recording against the recordings' times
+(as above), and ``trend_clock`` says which clock each motor's trend is on.
 """
 
 from __future__ import annotations
@@ -34,6 +42,13 @@ MIN_STEP = 0.05
 
 MIN_TREND_POINTS = 3
 """Fewest recordings a trend is fitted on, [-]."""
+
+EPOCH_S = 9.0e8
+"""A monitor clock beyond this is epoch seconds (as the fleet's discovery reads a time column)."""
+
+RECORDING_TIMES = 'calendar: the recordings\' times'
+MONITOR_EPOCH = "calendar: the monitor's epoch clock"
+"""What a motor's trend per day is reckoned on (``trend_clock``)."""
 
 
 def motor_view(motor: str, liquid: str, markers: list[dict[str, Any]],
@@ -61,7 +76,9 @@ def motor_view(motor: str, liquid: str, markers: list[dict[str, Any]],
     -------
     dict
         The DESIGN.md "Fleet output" entry, plus ``baseline``, ``limit``, ``time_sources``,
-        ``last`` (the latest leakage factor) and ``estimator`` ('monitor' or 'ratio').
+        ``last`` (the latest leakage factor), ``estimator`` ('monitor' or 'ratio') and
+        ``trend_clock`` (:data:`RECORDING_TIMES` or :data:`MONITOR_EPOCH`); each point of
+        ``leakage_factor`` says its recording's ``time_source``.
 
     """
     points = [m for m in markers if m.get('status') == 'done' and m.get('result')]
@@ -69,7 +86,8 @@ def motor_view(motor: str, liquid: str, markers: list[dict[str, Any]],
     if any(s['result']['leakage_factor'].get('value') is not None for s in watched):
         return _monitored(motor, liquid, markers, watched, baseline, limit)
     series = [{'date': m['date'], 'value': m['result']['leakage_factor'],
-               'ci95': m['result']['ci95'], 'recording': m['recording']} for m in points]
+               'ci95': m['result']['ci95'], 'recording': m['recording'],
+               'time_source': m.get('time_source', '')} for m in points]
     times = np.array([m['time'] for m in points], dtype=float)
     values = np.array([s['value'] for s in series], dtype=float)
     half = np.array([(s['ci95'][1] - s['ci95'][0]) / 2.0 for s in series], dtype=float)
@@ -81,13 +99,14 @@ def motor_view(motor: str, liquid: str, markers: list[dict[str, Any]],
                                f'{limit:g}', 'recording': crossed['recording']})
     alarms.sort(key=lambda a: a['date'])
     trend, days = _trend(times[start:], values[start:], limit)
-    return _view(motor, liquid, markers, series, trend, days, alarms, baseline, limit, 'ratio')
+    return _view(motor, liquid, markers, series, trend, days, alarms, baseline, limit, 'ratio',
+                 RECORDING_TIMES)
 
 
 def _view(motor: str, liquid: str, markers: list[dict[str, Any]],
           series: list[dict[str, Any]], trend: float | None, days: float | None,
           alarms: list[dict[str, Any]], baseline: dict[str, Any] | None, limit: float,
-          estimator: str) -> dict[str, Any]:
+          estimator: str, clock: str) -> dict[str, Any]:
     refused = [{'path': m['recording'], 'reason': m.get('reason', ''),
                 'status': m.get('status')} for m in markers if m.get('status') != 'done']
     sources = sorted({m.get('time_source', '') for m in markers})
@@ -95,7 +114,7 @@ def _view(motor: str, liquid: str, markers: list[dict[str, Any]],
             'leakage_factor': series, 'trend_per_day': trend, 'days_to_limit': days,
             'alarms': alarms, 'limit': limit, 'last': series[-1]['value'] if series else None,
             'baseline': _baseline_line(baseline), 'time_sources': sources,
-            'estimator': estimator}
+            'estimator': estimator, 'trend_clock': clock}
 
 
 def _monitored(motor: str, liquid: str, markers: list[dict[str, Any]],
@@ -103,7 +122,9 @@ def _monitored(motor: str, liquid: str, markers: list[dict[str, Any]],
                limit: float) -> dict[str, Any]:
     """Build the view from the motor's one monitor: its figure after each recording."""
     dates = {m['recording']: m['date'] for m in markers}
+    times = {m['recording']: m for m in markers}
     series = [{'date': dates.get(s['recording'], ''), 'recording': s['recording'],
+               'time_source': times.get(s['recording'], {}).get('time_source', ''),
                **s['result']['leakage_factor']} for s in watched
               if s['result']['leakage_factor'].get('value') is not None]
     last = watched[-1]['result']
@@ -116,10 +137,27 @@ def _monitored(motor: str, liquid: str, markers: list[dict[str, Any]],
         alarms.append({'date': dates.get(recording, ''), 'kind': alarm.get('kind', 'change'),
                        'what': f"{alarm.get('what', 'unexplained')} (in {recording})",
                        'recording': recording, 'source': 'monitor'})
-    per_hour, hours = last.get('trend_per_hour'), last.get('hours_to_limit')
-    return _view(motor, liquid, markers, series,
-                 None if per_hour is None else 24.0 * per_hour,
-                 None if hours is None else hours / 24.0, alarms, baseline, limit, 'monitor')
+    if all((s['result'].get('span_s') or [0.0])[0] > EPOCH_S for s in watched):
+        per_hour, hours = last.get('trend_per_hour'), last.get('hours_to_limit')
+        return _view(motor, liquid, markers, series,
+                     None if per_hour is None else 24.0 * per_hour,
+                     None if hours is None else hours / 24.0, alarms, baseline, limit,
+                     'monitor', MONITOR_EPOCH)
+    trend, days = _calendar_trend(series, times, alarms, limit)
+    return _view(motor, liquid, markers, series, trend, days, alarms, baseline, limit,
+                 'monitor', RECORDING_TIMES)
+
+
+def _calendar_trend(series: list[dict[str, Any]], markers: dict[str, dict[str, Any]],
+                    alarms: list[dict[str, Any]], limit: float) -> tuple[float | None,
+                                                                         float | None]:
+    """Fit the monitor's figures against the recordings' times, since the last change."""
+    timed = [(float(markers[p['recording']]['time']), float(p['value'])) for p in series
+             if markers.get(p['recording'], {}).get('time') is not None]
+    changed = {a['recording'] for a in alarms if a.get('kind') != 'limit'}
+    start = max((i for i, p in enumerate(series) if p['recording'] in changed), default=0)
+    timed = timed[start:]
+    return _trend(np.array([t for t, _ in timed]), np.array([v for _, v in timed]), limit)
 
 
 def _baseline_line(baseline: dict[str, Any] | None) -> str:
@@ -229,5 +267,6 @@ def iso_now() -> str:
     return datetime.now(timezone.utc).isoformat(timespec='seconds')
 
 
-__all__ = ['CHANGE_SIGMAS', 'DAY', 'LIMIT', 'MIN_STEP', 'MIN_TREND_POINTS', 'iso_now',
+__all__ = ['CHANGE_SIGMAS', 'DAY', 'EPOCH_S', 'LIMIT', 'MIN_STEP', 'MIN_TREND_POINTS',
+           'MONITOR_EPOCH', 'RECORDING_TIMES', 'iso_now',
            'motor_view', 'rank']
