@@ -62,3 +62,38 @@ def test_a_monitor_on_a_restarting_clock_is_trended_on_the_recordings_calendar_t
     assert view['trend_per_day'] == pytest.approx(0.05)
     assert view['days_to_limit'] == pytest.approx((2.0 - 1.4) / 0.05)
     assert {p['time_source'] for p in view['leakage_factor']} == {PATH_DATE}
+
+
+def _csv(path, first_time=0.0):
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text('time [s],speed [rpm],flow [l/min],p_in [MPa],p_out [MPa]\n'
+                    f'{first_time},1000,20,10,1\n{first_time + 1},1000,20,10,1\n')
+    return path
+
+
+@pytest.mark.parametrize('address', ['nonsense', 'tcp://[::1', 'tcp://host:port'])
+def test_a_malformed_scheduler_is_one_line_and_exit_1_before_any_work(tmp_path, capsys,
+                                                                       address):
+    from satmotor_ros.cli.main import main
+    _csv(tmp_path / 'root' / 'm1' / 'a.csv')
+    assert main(['fleet', str(tmp_path / 'root'), '--out', str(tmp_path / 'o'),
+                 '--scheduler', address, '--no-progress']) == 1
+    err = capsys.readouterr().err
+    assert err.count('\n') == 1 and f'--scheduler {address!r}' in err
+    assert 'Traceback' not in err and not (tmp_path / 'o').exists()
+
+
+def test_an_out_another_command_wrote_is_refused_and_left_as_it_was(tmp_path, capsys):
+    import json
+    from satmotor_ros.cli.main import main
+    _csv(tmp_path / 'root' / 'm1' / 'a.csv')
+    theirs = tmp_path / 'cal'
+    theirs.mkdir()
+    marker = theirs / '.satmotor-output.json'
+    marker.write_text(json.dumps({'command': 'calibrate'}) + '\n')
+    (theirs / 'coefficients.yaml').write_text('kept: 1\n')
+    assert main(['fleet', str(tmp_path / 'root'), '--out', str(theirs)]) == 1
+    assert capsys.readouterr().err.count('\n') == 1
+    assert sorted(p.name for p in theirs.iterdir()) == ['.satmotor-output.json',
+                                                        'coefficients.yaml']
+    assert json.loads(marker.read_text()) == {'command': 'calibrate'}

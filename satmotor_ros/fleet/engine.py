@@ -240,9 +240,9 @@ def connect(workers: int = 0, scheduler: str = '') -> Iterator[tuple[Any, Cluste
                                        memory_limit=memory_per_worker(n),
                                        dashboard_address=':0', silence_logs=40)
                 client = Client(cluster)
-        except (OSError, TimeoutError) as err:
+        except (OSError, TimeoutError, ValueError) as err:  # ValueError: a malformed address
             where = f'--scheduler {scheduler!r}' if scheduler else 'the local cluster'
-            raise FleetError(f'{where}: cannot connect ({err})') from None
+            raise FleetError(f'{where}: cannot connect ({_first_line(err)})') from None
         try:
             yield client, _describe(client, scheduler, cluster is not None)
         finally:
@@ -280,6 +280,36 @@ def run_on(client: Any, work: Plan, run: RunOptions,
     for rec, future in steps.items():
         work.steps[rec.relative] = _outcome(rec, future)
     return [_outcome(rec, f) for rec, f in futures.items()]
+
+
+def check_address(scheduler: str) -> None:
+    """
+    Refuse a --scheduler address Dask cannot parse, before any work is planned.
+
+    Parameters
+    ----------
+    scheduler : str
+        The address, e.g. ``tcp://host:8786``; '' passes, [-]
+
+    Raises
+    ------
+    FleetError
+        One line naming the address and what is wrong with it.
+
+    """
+    if not scheduler:
+        return
+    from distributed.comm.addressing import get_address_host_port
+    try:
+        get_address_host_port(scheduler)
+    except (ValueError, TypeError) as err:
+        raise FleetError(f'--scheduler {scheduler!r}: not an address such as '
+                         f'tcp://host:8786 ({_first_line(err)})') from None
+
+
+def _first_line(err: BaseException) -> str:
+    text = str(err).strip()
+    return text.splitlines()[0] if text else type(err).__name__
 
 
 def _wait_for_a_worker(client: Any, scheduler: str) -> None:
@@ -341,5 +371,5 @@ def _outcome(rec: Recording, future: Any) -> dict[str, Any]:
                 'reason': reason, 'result': None}
 
 
-__all__ = ['Cluster', 'MEMORY_CAP', 'MEMORY_FRACTION', 'Plan', 'WORKER_WAIT', 'connect',
-           'execute', 'machine_workers', 'memory_per_worker', 'plan', 'run_on']
+__all__ = ['Cluster', 'MEMORY_CAP', 'MEMORY_FRACTION', 'Plan', 'WORKER_WAIT', 'check_address',
+           'connect', 'execute', 'machine_workers', 'memory_per_worker', 'plan', 'run_on']

@@ -13,7 +13,7 @@ from typing import Any
 from satmotor_ros.cli._output import check_target, MARKER, written_by
 from satmotor_ros.fleet.config import FLEET_FILE, FleetConfig, load_fleet
 from satmotor_ros.fleet.discover import discover
-from satmotor_ros.fleet.engine import execute, plan
+from satmotor_ros.fleet.engine import check_address, execute, plan
 from satmotor_ros.fleet.errors import FleetError
 from satmotor_ros.fleet.explain import explain_alarms
 from satmotor_ros.fleet.health import ESTIMATOR
@@ -90,6 +90,7 @@ def run_fleet(root: str, out: str, fleet: str = '', workers: int = 0, scheduler:
         check_target('--out', target, [str(base)], force, written_by('fleet'), 'fleet')
     except CliError as err:
         raise FleetError(str(err)) from None
+    check_address(scheduler)
     config = _config(base, fleet)
     motors = discover(base, config)
     if not motors:
