@@ -39,29 +39,38 @@ def test_the_ratios_interval_holds_its_95_percent_on_correlated_points():
     assert health.as_dict()['estimator'].startswith('ratio-v2')
 
 
-def test_a_monitor_on_a_restarting_clock_is_trended_on_the_recordings_calendar_times():
+def test_a_monitor_on_a_restarting_clock_is_trended_on_the_recordings_calendar_times(tmp_path):
     """Ten-minute series, one every 2 days, each clock from 0: the monitor's clock spans 1 h.
 
-    Its own trend (0.1 per recorded hour) would be 2.4 a day; the calendar's is 0.05.
+    Its own trend (0.1 per recorded hour) would be 2.4 a day; the calendar's is 0.05. The
+    first recording leaves the monitor learning, its figure without an interval: not a point
+    (it stopped the report's plot).
     """
+    from satmotor_ros.fleet.report import write_report
     steps, markers = [], []
-    for i in range(5):
+    for i in range(-1, 5):
         value = 1.0 + 0.1 * i
-        start = i * 610.0  # laid end to end, 10 s apart, on the monitor's clock
-        steps.append({'recording': f'm/run_2026-03-{1 + 2 * i:02d}.csv', 'status': 'done',
-                      'result': {'leakage_factor': {'value': value,
-                                                    'ci95': [value - 0.01, value + 0.01]},
+        start = (i + 1) * 610.0  # laid end to end, 10 s apart, on the monitor's clock
+        bounds = [value - 0.01, value + 0.01] if i >= 0 else [None, None]
+        steps.append({'recording': f'm/run_2026-03-{3 + 2 * i:02d}.csv', 'status': 'done',
+                      'result': {'leakage_factor': {'value': value, 'ci95': bounds},
                                  'trend_per_hour': 0.1 * 3600 / 610, 'hours_to_limit': 0.5,
                                  'span_s': [start, start + 600.0], 'alarms': []}})
         markers.append({'status': 'done', 'recording': steps[-1]['recording'],
-                        'date': f'2026-03-{1 + 2 * i:02d}T00:00:00+00:00',
-                        'time': EPOCH + 2 * i * DAY, 'time_source': PATH_DATE,
+                        'date': f'2026-03-{3 + 2 * i:02d}T00:00:00+00:00',
+                        'time': EPOCH + (2 + 2 * i) * DAY, 'time_source': PATH_DATE,
                         'result': {'leakage_factor': value, 'ci95': [value, value]}})
     view = motor_view('m', 'water', markers, None, steps=steps)
     assert view['estimator'] == 'monitor' and view['trend_clock'] == RECORDING_TIMES
     assert view['trend_per_day'] == pytest.approx(0.05)
     assert view['days_to_limit'] == pytest.approx((2.0 - 1.4) / 0.05)
     assert {p['time_source'] for p in view['leakage_factor']} == {PATH_DATE}
+    assert len(view['leakage_factor']) == 5
+    write_report(tmp_path, [view], {'root': 'r', 'recordings': 6, 'refused': 0, 'ran': 6,
+                                    'reused': 0, 'written': 'now', 'estimator': 'e',
+                                    'limit': 2.0})
+    assert '| 2026-03-03T00:00:00+00:00 | date in the path |' in \
+        (tmp_path / 'fleet.md').read_text()
 
 
 def _csv(path, first_time=0.0):

@@ -18,7 +18,8 @@ calendar time only when the samples carry epoch times: recordings whose clock st
 (a ``time`` column from 0) are laid end to end on it, a few seconds apart, so its trend is
 per hour *recorded*. For such a motor the trend per day and the days to the limit are the
 line through the monitor's figure after each recording against the recordings' times
-(as above), and ``trend_clock`` says which clock each motor's trend is on.
+(as above, since the last step in those figures), and ``trend_clock`` says which clock each
+motor's trend is on. A figure without an interval (the monitor still learning) is no point.
 """
 
 from __future__ import annotations
@@ -83,7 +84,7 @@ def motor_view(motor: str, liquid: str, markers: list[dict[str, Any]],
     """
     points = [m for m in markers if m.get('status') == 'done' and m.get('result')]
     watched = [s for s in steps or () if s.get('status') == 'done' and s.get('result')]
-    if any(s['result']['leakage_factor'].get('value') is not None for s in watched):
+    if any(_interval(s) for s in watched):
         return _monitored(motor, liquid, markers, watched, baseline, limit)
     series = [{'date': m['date'], 'value': m['result']['leakage_factor'],
                'ci95': m['result']['ci95'], 'recording': m['recording'],
@@ -125,8 +126,7 @@ def _monitored(motor: str, liquid: str, markers: list[dict[str, Any]],
     times = {m['recording']: m for m in markers}
     series = [{'date': dates.get(s['recording'], ''), 'recording': s['recording'],
                'time_source': times.get(s['recording'], {}).get('time_source', ''),
-               **s['result']['leakage_factor']} for s in watched
-              if s['result']['leakage_factor'].get('value') is not None]
+               **s['result']['leakage_factor']} for s in watched if _interval(s)]
     last = watched[-1]['result']
     alarms = []
     for alarm in last.get('alarms', []):  # the snapshot's: each with its final name
@@ -143,21 +143,33 @@ def _monitored(motor: str, liquid: str, markers: list[dict[str, Any]],
                      None if per_hour is None else 24.0 * per_hour,
                      None if hours is None else hours / 24.0, alarms, baseline, limit,
                      'monitor', MONITOR_EPOCH)
-    trend, days = _calendar_trend(series, times, alarms, limit)
+    trend, days = _calendar_trend(series, times, limit)
     return _view(motor, liquid, markers, series, trend, days, alarms, baseline, limit,
                  'monitor', RECORDING_TIMES)
 
 
+def _interval(step: dict[str, Any]) -> bool:
+    """Whether a step's figure has a value and an interval (none while the monitor learns)."""
+    figure = step['result']['leakage_factor']
+    bounds = figure.get('ci95') or (None, None)
+    return figure.get('value') is not None and all(b is not None for b in bounds)
+
+
 def _calendar_trend(series: list[dict[str, Any]], markers: dict[str, dict[str, Any]],
-                    alarms: list[dict[str, Any]], limit: float) -> tuple[float | None,
-                                                                         float | None]:
-    """Fit the monitor's figures against the recordings' times, since the last change."""
-    timed = [(float(markers[p['recording']]['time']), float(p['value'])) for p in series
-             if markers.get(p['recording'], {}).get('time') is not None]
-    changed = {a['recording'] for a in alarms if a.get('kind') != 'limit'}
-    start = max((i for i, p in enumerate(series) if p['recording'] in changed), default=0)
-    timed = timed[start:]
-    return _trend(np.array([t for t, _ in timed]), np.array([v for _, v in timed]), limit)
+                    limit: float) -> tuple[float | None, float | None]:
+    """
+    Fit the monitor's figures against the recordings' times, since the last step.
+
+    The steps are found as for the ratios (:func:`_changes`) in the figures' own series: the
+    monitor's alarms cannot tell a step from a drift its windows saw pass (both say which
+    part of the losses grew), and a drift is the trend.
+    """
+    timed = [p for p in series if markers.get(p['recording'], {}).get('time') is not None]
+    times = np.array([float(markers[p['recording']]['time']) for p in timed])
+    values = np.array([float(p['value']) for p in timed])
+    half = np.array([(p['ci95'][1] - p['ci95'][0]) / 2.0 for p in timed])
+    _, start = _changes(timed, times, values, half)
+    return _trend(times[start:], values[start:], limit)
 
 
 def _baseline_line(baseline: dict[str, Any] | None) -> str:
