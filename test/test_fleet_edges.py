@@ -106,3 +106,87 @@ def test_an_out_another_command_wrote_is_refused_and_left_as_it_was(tmp_path, ca
     assert sorted(p.name for p in theirs.iterdir()) == ['.satmotor-output.json',
                                                         'coefficients.yaml']
     assert json.loads(marker.read_text()) == {'command': 'calibrate'}
+
+
+@pytest.fixture(scope='module')
+def edge_fleet(tmp_path_factory):
+    """A fleet of edge cases, run through the tasks a worker runs (no cluster): the views."""
+    from satmotor_ros.fleet.config import FleetConfig
+    from satmotor_ros.fleet.discover import discover
+    from satmotor_ros.fleet.synthetic import write_recording
+    from satmotor_ros.fleet.tasks import calibrate_baseline, process_recording, RunOptions
+    base = tmp_path_factory.mktemp('edges')
+    root = base / 'root'
+    write_recording(root / 'solo' / 'only_2026-03-01.csv', 1.0, 1, 24)
+    (root / 'badfirst').mkdir(parents=True)
+    (root / 'badfirst' / 'run_2026-03-01.csv').write_bytes(b'\xff\xfe\x00garbage\n' * 20)
+    for i in range(3):
+        write_recording(root / 'badfirst' / f'run_2026-03-{2 + i:02d}.csv', 1.0, 10 + i, 24)
+    for i, name in enumerate('abc'):  # one time for all three, from their names
+        write_recording(root / 'twins' / f'{name}_2026-03-01.csv', 1.0, 20 + i, 24)
+    for i in range(4):  # every 3 days by the name, 0.03 a day: 0.09 a recording
+        write_recording(root / 'sparse' / f'run_2026-03-{1 + 3 * i:02d}_0800.csv',
+                        1.0 + 0.09 * i, 30 + i, 24)
+    run = RunOptions(str(base / 'out'), liquid='water')
+    views = {}
+    for motor in discover(root, FleetConfig()):
+        baseline = calibrate_baseline(motor, run)
+        markers = [process_recording(r, motor.rule, baseline, run) for r in motor.recordings]
+        views[motor.motor] = (motor_view(motor.motor, 'water', markers, baseline), baseline,
+                              motor)
+    return views
+
+
+@pytest.mark.slow
+def test_a_motor_with_one_recording_is_its_own_baseline_with_no_trend(edge_fleet):
+    view, baseline, _ = edge_fleet['solo']
+    assert baseline['recording'] == 'solo/only_2026-03-01.csv'
+    assert [p['value'] for p in view['leakage_factor']] == [pytest.approx(1.0, abs=0.02)]
+    assert view['trend_per_day'] is None and view['days_to_limit'] is None
+    assert not view['alarms'] and not view['refused']
+
+
+@pytest.mark.slow
+def test_a_refused_first_recording_leaves_the_baseline_to_the_next_usable_one(edge_fleet):
+    view, baseline, _ = edge_fleet['badfirst']
+    assert baseline['recording'] == 'badfirst/run_2026-03-02.csv'
+    assert [r['path'] for r in view['refused']] == ['badfirst/run_2026-03-01.csv']
+    assert 'UTF-8' in view['refused'][0]['reason']
+    assert len(view['leakage_factor']) == 3
+
+
+@pytest.mark.slow
+def test_recordings_at_one_time_are_kept_apart_in_name_order_with_no_trend(edge_fleet):
+    view, _, motor = edge_fleet['twins']
+    assert [r.name for r in motor.recordings] == ['a_2026-03-01.csv', 'b_2026-03-01.csv',
+                                                  'c_2026-03-01.csv']
+    assert len({r.time for r in motor.recordings}) == 1
+    assert len(view['leakage_factor']) == 3 and not view['alarms']
+    assert view['trend_per_day'] is None and view['days_to_limit'] is None
+
+
+@pytest.mark.slow
+def test_times_from_file_names_give_the_trend_per_calendar_day(edge_fleet):
+    view, _, motor = edge_fleet['sparse']
+    assert {r.time_source for r in motor.recordings} == {PATH_DATE}
+    assert motor.recordings[1].date == '2026-03-04T08:00:00+00:00'
+    assert view['trend_clock'] == RECORDING_TIMES
+    assert view['trend_per_day'] == pytest.approx(0.03, rel=0.1)  # not 0.09 a recording
+    last = view['leakage_factor'][-1]['value']
+    assert view['days_to_limit'] == pytest.approx((2.0 - last) / 0.03, rel=0.15)
+
+
+@pytest.mark.slow  # the client's connect timeout, 20 s
+def test_an_unreachable_scheduler_is_one_line_and_exit_1(tmp_path, capsys):
+    import socket
+    from satmotor_ros.cli.main import main
+    _csv(tmp_path / 'root' / 'm1' / 'a.csv')
+    with socket.socket() as free:  # a port nothing listens on once closed
+        free.bind(('127.0.0.1', 0))
+        port = free.getsockname()[1]
+    address = f'tcp://127.0.0.1:{port}'
+    assert main(['fleet', str(tmp_path / 'root'), '--out', str(tmp_path / 'o'),
+                 '--scheduler', address, '--no-progress']) == 1
+    err = capsys.readouterr().err
+    assert err.count('\n') == 1 and f'--scheduler {address!r}: cannot connect' in err
+    assert 'Traceback' not in err

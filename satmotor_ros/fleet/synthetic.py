@@ -54,7 +54,25 @@ def _scaled(table: BenchTable, factor: float) -> BenchTable:
     return replace(table, flow=ideal + factor * (table.flow - ideal))
 
 
-def _csv(path: Path, factor: float, seed: int, points: int, epoch: float | None) -> None:
+def write_recording(path: Path, factor: float, seed: int, points: int,
+                    epoch: float | None = None) -> None:
+    """
+    Write one steady-point recording whose volumetric losses are `factor` times healthy.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The CSV to write (its directory made), [-]
+    factor : float
+        Leakage factor k, [-]
+    seed : int
+        The generator's seed, [-]
+    points : int
+        Steady points, [-]
+    epoch : float, optional
+        Epoch of the first row, written into the ``time`` column; None leaves it from 0, [s]
+
+    """
     table = _scaled(generate(Plan(liquid='water', n_points=points), Injection(), seed), factor)
     columns = to_columns(table)
     if epoch is not None:
@@ -110,7 +128,7 @@ def make_fleet(root: str | Path, days: int = 8, points: int = 40, bags: bool = F
         for motor, (path, factor, epoch) in recordings.items():
             n += 1
             if motor in motors:
-                _csv(path, factor, n, points, epoch)
+                write_recording(path, factor, n, points, epoch)
         if bags:
             n += 1
             table = generate_series(Plan(liquid='water', n_points=points, duration_s=600.0),
@@ -202,7 +220,7 @@ def main(argv: list[str] | None = None) -> int:
 
 
 __all__ = ['COMMAND', 'FLEET_YAML', 'LEAK_DAY', 'LEAK_FACTOR', 'MAX_DAYS', 'MOTORS', 'START',
-           'WEAR_PER_DAY', 'main', 'make_fleet']
+           'WEAR_PER_DAY', 'main', 'make_fleet', 'write_recording']
 
 if __name__ == '__main__':
     sys.exit(main())
