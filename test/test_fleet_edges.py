@@ -40,7 +40,8 @@ def test_the_ratios_interval_holds_its_95_percent_on_correlated_points():
 
 
 def test_a_monitor_on_a_restarting_clock_is_trended_on_the_recordings_calendar_times(tmp_path):
-    """Ten-minute series, one every 2 days, each clock from 0: the monitor's clock spans 1 h.
+    """
+    Ten-minute series, one every 2 days, each clock from 0: the monitor's clock spans 1 h.
 
     Its own trend (0.1 per recorded hour) would be 2.4 a day; the calendar's is 0.05. The
     first recording leaves the monitor learning, its figure without an interval: not a point
@@ -82,7 +83,7 @@ def _csv(path, first_time=0.0):
 
 @pytest.mark.parametrize('address', ['nonsense', 'tcp://[::1', 'tcp://host:port'])
 def test_a_malformed_scheduler_is_one_line_and_exit_1_before_any_work(tmp_path, capsys,
-                                                                       address):
+                                                                      address):
     from satmotor_ros.cli.main import main
     _csv(tmp_path / 'root' / 'm1' / 'a.csv')
     assert main(['fleet', str(tmp_path / 'root'), '--out', str(tmp_path / 'o'),
@@ -110,7 +111,7 @@ def test_an_out_another_command_wrote_is_refused_and_left_as_it_was(tmp_path, ca
 
 @pytest.fixture(scope='module')
 def edge_fleet(tmp_path_factory):
-    """A fleet of edge cases, run through the tasks a worker runs (no cluster): the views."""
+    """Run a fleet of edge cases through the tasks a worker runs (no cluster): the views."""
     from satmotor_ros.fleet.config import FleetConfig
     from satmotor_ros.fleet.discover import discover
     from satmotor_ros.fleet.synthetic import write_recording

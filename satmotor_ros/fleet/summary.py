@@ -47,7 +47,7 @@ MIN_TREND_POINTS = 3
 EPOCH_S = 9.0e8
 """A monitor clock beyond this is epoch seconds (as the fleet's discovery reads a time column)."""
 
-RECORDING_TIMES = 'calendar: the recordings\' times'
+RECORDING_TIMES = "calendar: the recordings' times"
 MONITOR_EPOCH = "calendar: the monitor's epoch clock"
 """What a motor's trend per day is reckoned on (``trend_clock``)."""
 
