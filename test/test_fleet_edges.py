@@ -191,3 +191,13 @@ def test_an_unreachable_scheduler_is_one_line_and_exit_1(tmp_path, capsys):
     err = capsys.readouterr().err
     assert err.count('\n') == 1 and f'--scheduler {address!r}: cannot connect' in err
     assert 'Traceback' not in err
+
+
+def test_a_tls_scheduler_without_a_tls_configuration_is_one_line_and_exit_1(tmp_path, capsys):
+    from satmotor_ros.cli.main import main
+    _csv(tmp_path / 'root' / 'm1' / 'a.csv')
+    assert main(['fleet', str(tmp_path / 'root'), '--out', str(tmp_path / 'o'),
+                 '--scheduler', 'tls://127.0.0.1:9', '--no-progress']) == 1
+    err = capsys.readouterr().err
+    assert err.count('\n') == 1 and "--scheduler 'tls://127.0.0.1:9': cannot connect" in err
+    assert 'TLS' in err

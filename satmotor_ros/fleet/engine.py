@@ -240,7 +240,8 @@ def connect(workers: int = 0, scheduler: str = '') -> Iterator[tuple[Any, Cluste
                                        memory_limit=memory_per_worker(n),
                                        dashboard_address=':0', silence_logs=40)
                 client = Client(cluster)
-        except (OSError, TimeoutError, ValueError) as err:  # ValueError: a malformed address
+        except (OSError, TimeoutError, ValueError, TypeError) as err:  # TypeError: tls://
+            # without a TLS configuration; ValueError: an address distributed cannot use
             where = f'--scheduler {scheduler!r}' if scheduler else 'the local cluster'
             raise FleetError(f'{where}: cannot connect ({_first_line(err)})') from None
         try:
