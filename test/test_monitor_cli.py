@@ -81,6 +81,37 @@ def test_state_file_carries_the_history_to_the_next_run(tmp_path: Path) -> None:
     assert doc['detector']['learning'] is False
 
 
+def test_an_epoch_recording_sent_again_to_a_state_is_not_counted_twice(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A daily job that sends day 2 twice: its samples are counted once, the clock not moved."""
+    samples = _step(2.0, at=5000.0)
+    epoch = 1.6e9
+    first = _csv(tmp_path / 'a.csv', samples.take(samples.time < 3600.0), -epoch)
+    second = _csv(tmp_path / 'b.csv', samples.take(samples.time >= 3600.0), -epoch)
+    state = tmp_path / 'state.json'
+    for data, out in ((first, 'o1'), (second, 'o2'), (second, 'o3')):
+        assert main(['monitor', str(data), '--out', str(tmp_path / out), '--state', str(state),
+                     *MOTOR]) == 0
+    once, twice = (json.loads((tmp_path / o / 'monitor.json').read_text())
+                   for o in ('o2', 'o3'))
+    assert twice['n_samples'] == once['n_samples'] == len(samples)
+    assert twice['operating_hours'] == pytest.approx(once['operating_hours'])
+    assert twice['recordings'] == []  # nothing new: not placed after the history
+    assert 'already counted' in capsys.readouterr().out
+
+
+def test_a_state_in_a_missing_directory_is_refused_before_anything_is_written(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """--state nodir/st.json: one line naming --state, no --out written."""
+    data = _csv(tmp_path / 'run.csv', recording(0.05, seed=1))
+    state = tmp_path / 'nodir' / 'state.json'
+    assert main(['monitor', str(data), '--out', str(tmp_path / 'out'), '--state', str(state),
+                 *MOTOR]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and '--state' in err[0]
+    assert not (tmp_path / 'out').exists()
+
+
 @pytest.mark.parametrize(('flag', 'value'), [('--false-alarm-hours', '-1'),
                                              ('--limit-volumetric-efficiency', '1.5'),
                                              ('--change-fraction', 'nan')])

@@ -125,6 +125,8 @@ def _monitor(data: list[str], out: str, options: MotorOptions, columns: str, for
     settings = _settings(values, explain)
     inputs = [name for name in (*data, options.motor_file, columns) if name]
     check_target('--out', Path(out), inputs, force, written_by('monitor'), 'monitor')
+    if state and not Path(state).parent.is_dir():  # found out only after --out was written
+        raise CliError(f'--state {state!r}: {Path(state).parent} is not a directory')
     settled = settle_liquid(options, data[0], 'monitor')
     options = settled.options
     model = options.build_model()

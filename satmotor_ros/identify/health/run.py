@@ -7,7 +7,9 @@ after the one before (epoch times, a log that continues); a recording whose cloc
 again (each bench CSV at 0 s, each bag at its first message) is placed after the one before,
 :data:`GAP_S` later, so no operation is counted across the gap and no sample goes back in
 time. Epoch clocks (beyond :data:`EPOCH_S`) are reported from their first sample, with
-``t0_epoch``.
+``t0_epoch``; an epoch-stamped recording that reaches back into what the monitor has seen
+(the same file sent again to a resumed state) gives only its samples after that, or none: an
+epoch clock is the time, and moving it on would count the same operation twice.
 """
 
 from __future__ import annotations
@@ -116,7 +118,17 @@ def monitor_recordings(tables: Sequence[BenchTable], baseline: Baseline,
         if not finite.size:
             continue
         shift = 0.0
-        if math.isfinite(last) and finite[0] <= last:
+        if math.isfinite(last) and finite[0] <= last and finite[0] > EPOCH_S:
+            newer = time > last
+            notes.append(f'{table.source}: {int(np.count_nonzero(~newer))} of {len(samples)} '
+                         'samples are at or before the last one monitored (its epoch clock): '
+                         'left out, already counted')
+            if not newer.any():
+                continue
+            samples = samples.take(newer)
+            time = samples.time
+            finite = time[np.isfinite(time)]
+        elif math.isfinite(last) and finite[0] <= last:
             shift = last + GAP_S - float(finite[0])
             notes.append(f'{table.source}: its clock starts again; placed {GAP_S:.0f} s after '
                          'the recording before it')
