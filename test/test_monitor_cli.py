@@ -52,6 +52,16 @@ def test_monitor_writes_the_contract_outputs(tmp_path: Path,
     assert 'change at' in capsys.readouterr().out
 
 
+def test_times_are_from_the_first_sample_and_t0_maps_them_back(tmp_path: Path) -> None:
+    """A log whose clock starts at 5000 s: time_s from 0 (DESIGN.md), t0_s says 5000."""
+    data = _csv(tmp_path / 'run.csv', _step(), -5000.0)
+    assert main(['monitor', str(data), '--out', str(tmp_path / 'out'), *MOTOR]) == 0
+    doc = json.loads((tmp_path / 'out' / 'monitor.json').read_text())
+    assert doc['t0_s'] == 5000.0 and 't0_epoch' not in doc
+    (alarm,) = doc['alarms']
+    assert 3000.0 <= alarm['time_s'] <= 3300.0  # the step at 8000 s on the log's clock
+
+
 def test_recordings_whose_clock_restarts_are_placed_in_order(tmp_path: Path) -> None:
     """Two CSVs each from 0 s: the second after the first, the change found in it."""
     samples = _step(2.0, at=5000.0)

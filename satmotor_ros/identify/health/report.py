@@ -45,7 +45,9 @@ def summary(run: MonitorRun) -> dict[str, Any]:
     dict
         ``alarms``, ``leakage_factor`` (time series with intervals), ``trend_per_hour``,
         ``hours_to_limit`` (null when the trend does not reach the limit), ``n_samples``,
-        ``n_skipped`` first, then the figures now, the detector and the recordings.
+        ``n_skipped`` first, then the figures now, the detector and the recordings; times
+        are seconds from the first sample, ``t0_s`` that sample on the data's own time column
+        (``t0_epoch`` too for an epoch clock).
 
     """
     snap = run.snapshot
@@ -85,7 +87,7 @@ def summary(run: MonitorRun) -> dict[str, Any]:
         'recordings': [{'data': portable(r.source), 'samples': r.samples,
                         'start_s': _num(r.start_s, 9), 'end_s': _num(r.end_s, 9),
                         'shifted_s': _num(r.shifted_s, 9)} for r in run.recordings],
-        'notes': list(run.notes), 'flags': _flags(run)}
+        'notes': list(run.notes), 'flags': _flags(run), 't0_s': _num(run.t0_s, 12)}
     if run.t0_epoch is not None:
         out['t0_epoch'] = run.t0_epoch
     return out

@@ -58,6 +58,8 @@ class MonitorRun:
     settings: HealthSettings
     baseline: str  # where the baseline came from
     t0_epoch: float | None = None  # epoch seconds of the first sample, where the data give them
+    t0_s: float = math.nan  # the first sample on its own time column: time_s + t0_s is the
+    # data's time (plus a recording's shifted_s where its clock started again) [s]
     notes: tuple[str, ...] = field(default=())
 
 
@@ -151,7 +153,7 @@ def monitor_recordings(tables: Sequence[BenchTable], baseline: Baseline,
         last = float(finite[-1] + shift)
     epoch = monitor.t0 if math.isfinite(monitor.t0) and monitor.t0 > EPOCH_S else None
     return MonitorRun(monitor.snapshot(), tuple(points), tuple(recordings), monitor.settings,
-                      baseline.source, epoch, tuple(notes))
+                      baseline.source, epoch, monitor.t0, tuple(notes))
 
 
 __all__ = ['BLOCK', 'EPOCH_S', 'GAP_S', 'monitor_recordings', 'MonitorRun', 'Recording']
