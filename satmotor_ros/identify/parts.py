@@ -173,6 +173,9 @@ def loss_parts(model: MotorModel, table: BenchTable) -> tuple[LossParts, np.ndar
         Which rows of `table` were usable (finite, a flow the model can give:
         not a shaft turning with the pressure and no flow that way, the
         channels not taking the whole port drop, dp_i within the model's limit).
+        A shaft at rest may read a flow of either sign: its leak is small against
+        the noise, and keeping only the readings of one sign would bias the rest
+        points by the noise's half-mean (a phantom flow offset).
 
     Raises
     ------
@@ -186,7 +189,7 @@ def loss_parts(model: MotorModel, table: BenchTable) -> tuple[LossParts, np.ndar
         flow, speed, dp = s * table.flow, s * table.speed, s * table.dp  # the loss runs forward
         dp_i = s * model.chamber_drop(table.dp, table.flow)
         usable = (np.isfinite(flow) & np.isfinite(speed) & np.isfinite(dp)
-                  & ((flow > 0.0) | (speed < 0.0)) & (dp_i >= 0.0) & (dp_i < model.dp_limit))
+                  & ((flow > 0.0) | (speed <= 0.0)) & (dp_i >= 0.0) & (dp_i < model.dp_limit))
     if not usable.any():
         msg = (f'{table.source}: no usable point (need a flow, with the pressure drop unless '
                'the shaft turns against it, and a chamber pressure drop between 0 and '

@@ -62,7 +62,7 @@ import numpy as np
 from satmotor_ros.identify.candidates import Candidate
 from satmotor_ros.identify.errors import IdentificationError
 from satmotor_ros.identify.fit import HUBER, LossFit
-from satmotor_ros.identify.noise import noise_model, outliers, robust_scale
+from satmotor_ros.identify.noise import noise_model, outliers, rates_of, robust_scale
 from satmotor_ros.identify.parts import LossParts
 from satmotor_ros.identify.regional import (acting, local_gain, LocalGain, RECUR_ALPHA,
                                             recurrence)
@@ -453,7 +453,7 @@ class CrossValidatedSelector:
         residual = parts.flow - best.predict(parts)
         # a time series' rows: the noise may grow with how fast the flow changes (timing)
         sigma = noise_model(residual, parts.flow, best.n_params, floor,
-                            parts.nuisance.get('flow_lag'))
+                            rates_of(parts.nuisance))
         left_out = self._isolated(parts, residual, sigma)
         for fit in fits:  # an outlier only if it stays one under each candidate's model
             if not left_out.any():
