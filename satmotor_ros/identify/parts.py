@@ -173,9 +173,10 @@ def loss_parts(model: MotorModel, table: BenchTable) -> tuple[LossParts, np.ndar
         Which rows of `table` were usable (finite, a flow the model can give:
         not a shaft turning with the pressure and no flow that way, the
         channels not taking the whole port drop, dp_i within the model's limit).
-        A shaft at rest may read a flow of either sign: its leak is small against
-        the noise, and keeping only the readings of one sign would bias the rest
-        points by the noise's half-mean (a phantom flow offset).
+        A shaft at rest may read a flow of either sign: its leak is small against the
+        noise, and keeping the readings of one sign only would bias the rest points by
+        the noise's half-mean (a phantom flow offset); a time series' samples are screened
+        further (:func:`~satmotor_ros.identify.transient.at_rest`).
 
     Raises
     ------

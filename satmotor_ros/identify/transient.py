@@ -374,6 +374,41 @@ def _screen(regressors: dict[str, FloatArray],
     return kept, left_out
 
 
+REST_BAND = 5.0
+"""A sample whose speed reads 0 is usable unless its flow runs against the drop by more than
+this many robust spreads of those samples' flow readings, [-]."""
+
+
+def at_rest(flow: FloatArray) -> np.ndarray:
+    """
+    Return which flow readings of samples whose speed reads 0 are usable.
+
+    A shaft at rest passes its leak (small against the noise, so its flow reads either sign)
+    and whatever a valve passes while it stalls (the way the drop pushes). Keeping only the
+    readings the way the drop pushes (:func:`~satmotor_ros.identify.parts.loss_parts` for a
+    turning shaft) would bias the rest samples by the noise's half-mean, a phantom flow
+    offset; a reading against the drop beyond the noise is a shaft that turns while its
+    speed reads 0 (a speed reading that drops out at the start of a pump stroke), which the
+    model cannot explain. The band below zero is :data:`REST_BAND` robust spreads (1.4826
+    median |Q| of these readings), so the noise is cut nowhere near its bulk.
+
+    Parameters
+    ----------
+    flow : ndarray
+        Flow readings of samples whose speed reads 0, in the row's frame, [m^3/s]
+
+    Returns
+    -------
+    ndarray of bool
+        True where the reading is usable.
+
+    """
+    if not flow.size:
+        return np.ones(0, dtype=bool)
+    inside: np.ndarray = flow > -REST_BAND * MAD * float(np.median(np.abs(flow)))
+    return inside
+
+
 def transient_samples(model: MotorModel, table: BenchTable,
                       options: TransientOptions | None = None) -> Samples:
     """
@@ -415,10 +450,15 @@ def transient_samples(model: MotorModel, table: BenchTable,
         channels['revolutions'] = sampled_revolutions(table.speed, time)
     table = replace(table, channels=channels, units={**table.units, 'revolutions': 'rev'})
     all_parts, usable = loss_parts(model, table)
+    still = all_parts.speed == 0.0  # at the usable samples
+    moving = np.zeros(still.size, dtype=bool)
+    moving[still] = ~at_rest(all_parts.flow[still])
+    rest = np.zeros(time.size, dtype=bool)  # speed reads 0, the flow against the drop
+    rest[usable] = moving
     spike, departure, scale = spikes(table.flow, first)
-    if (spike & usable).any():  # a bad sample decides nothing: left out like an unusable one
-        all_parts = parts_at(all_parts, ~spike[usable])
-        usable = usable & ~spike
+    if ((spike | rest) & usable).any():  # a bad sample decides nothing: left out like an
+        all_parts = parts_at(all_parts, ~(spike | rest)[usable])  # unusable one
+        usable = usable & ~spike & ~rest
     size = max(1, int(round(options.bin_seconds / step)) if step > 0.0 else 1)
     size = max(size, int(np.ceil(int(usable.sum()) / options.max_rows)))
     where = np.flatnonzero(usable)  # parts are at the usable samples only
@@ -466,7 +506,8 @@ def transient_samples(model: MotorModel, table: BenchTable,
     note = (f'all samples: {n_samples} of {len(table)} ({100.0 * n_samples / len(table):.0f} %) '
             f'in {n_segments} stretch(es) without a gap, step {step:.4g} s, averaged over '
             f'bins of {size} steps ({size * step:.3g} s, {a.size} rows)'
-            + left_out_samples(model, table, usable | spike, held, int(spike.sum())))
+            + left_out_samples(model, table, usable | spike | rest, held, int(spike.sum()),
+                               int(rest.sum())))
     rows = replace(rows, notes=rows.notes + (note,))
     lags = [nuisance[name] for name in ('speed_lag', 'flow_lag') if name in nuisance]
     correlation = float(np.corrcoef(lags[0], lags[1])[0, 1]) if len(lags) == 2 else np.nan
@@ -568,7 +609,7 @@ def spikes(x: FloatArray, first: np.ndarray) -> tuple[np.ndarray, FloatArray, fl
 
 
 def left_out_samples(model: MotorModel, table: BenchTable, usable: np.ndarray,
-                     held: np.ndarray, n_spikes: int = 0) -> str:
+                     held: np.ndarray, n_spikes: int = 0, n_rest: int = 0) -> str:
     """
     Say why samples are in no row: which the model cannot use, and which no bin holds.
 
@@ -585,6 +626,8 @@ def left_out_samples(model: MotorModel, table: BenchTable, usable: np.ndarray,
         Which a row holds, [-]
     n_spikes : int
         Samples left out as spikes (:func:`spikes`), [-]
+    n_rest : int
+        Samples of a shaft reading no speed left out by :func:`at_rest`, [-]
 
     Returns
     -------
@@ -596,14 +639,16 @@ def left_out_samples(model: MotorModel, table: BenchTable, usable: np.ndarray,
     with np.errstate(invalid='ignore'):
         s = np.where(dp < 0.0, -1.0, 1.0)
         finite = np.isfinite(table.flow) & np.isfinite(table.speed) & np.isfinite(dp)
-        no_flow = finite & ~((s * table.flow > 0.0) | (s * table.speed < 0.0))
+        no_flow = finite & ~((s * table.flow > 0.0) | (s * table.speed <= 0.0))
     reasons = [(int((~finite).sum()), 'without a finite reading'),
                (int((no_flow & ~usable).sum()), 'with no flow the model can give (a shaft '
                 'that turns with the drop and no flow that way)'),
                (int((finite & ~no_flow & ~usable).sum()), 'with a chamber drop outside 0 to '
                 f'{model.dp_limit / 1e6:.3g} MPa'),
                (n_spikes, 'isolated spikes of the flow reading (listed as outliers)'),
-               (int((usable & ~held).sum()) - n_spikes,
+               (n_rest, 'with a speed of 0 and a flow against the drop beyond the noise (a '
+                'shaft that turns while its speed reads 0)'),
+               (int((usable & ~held).sum()) - n_spikes - n_rest,
                 'in runs of usable samples too short for a bin')]
     said = [f'{k} {why}' for k, why in reasons if k]
     return '; left out: ' + ', '.join(said) if said else ''
