@@ -44,7 +44,7 @@ def test_calibrate_finds_the_family_that_made_the_data():
     assert {s.family for s in scores} == set(FAMILY_NAMES)
     own = next(s for s in scores if s.family == 'sliwinski2017')
     assert scores[0].rmse < 0.95 * own.rmse
-    assert cal.family.verdict.startswith(f'{family} cuts the out-of-sample error')
+    assert cal.family.verdict.startswith(f'{family} cuts the noise-weighted out-of-sample error')
 
 
 def test_a_family_that_fits_no_better_does_not_replace_the_motors_own():

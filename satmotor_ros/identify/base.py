@@ -14,7 +14,9 @@ the factors of the linear parts refitted at every f (a profile), on the rows usa
 the whole range of f. The range is physical: in motor mode the chambers must still see
 a drop, so the channel drop may not exceed the port drop (at the
 :data:`PHYSICAL_QUANTILE` of the motor-mode rows, against noise). The factor is
-*fitted* only where the data pin it: the profile's Huber objective at f must beat the
+*fitted* only where the data pin it: the profile's Huber objective at f (each row
+standardised by its noise, :func:`~satmotor_ros.identify.noise.noise_model` of the residuals
+at the kept value: a recording's fast moves, the noisiest rows, do not decide) must beat the
 kept value's by chi2(1) at :data:`ALPHA` (its variance inflated by the correlation of
 neighbouring samples of a time series) and its 95 % profile interval must not span the
 whole range. Otherwise it is *kept*: the packaged value, or the physical bound where the
@@ -33,6 +35,7 @@ from typing import Any
 import numpy as np
 from satmotor_ros.identify.errors import IdentificationError
 from satmotor_ros.identify.fit import HUBER
+from satmotor_ros.identify.noise import noise_model, rates_of
 from satmotor_ros.identify.parts import loss_parts, NO_EFFECT
 from satmotor_ros.identify.table import BenchTable
 from satmotor_ros.identify.transient import variance_inflation
@@ -118,7 +121,7 @@ class _Profile:
                  points: BenchTable, nuisance: Mapping[str, FloatArray]) -> None:
         self.spec, self.liquid, self.names = spec, liquid, names
         self.points, self.nuisance = points, nuisance
-        self.scale: float | None = None
+        self.scale: FloatArray | None = None  # each row's noise, once estimated [m^3/s]
         self.seen: dict[float, float] = {}
 
     def residual(self, factor: float) -> FloatArray:
@@ -132,14 +135,15 @@ class _Profile:
         x = np.column_stack(columns + [np.asarray(v, dtype=float)
                                        for v in self.nuisance.values()])
         y = parts.loss
-        weight = np.ones(y.size)
-        for _ in range(IRLS_STEPS if self.scale else 1):
+        precision = np.ones(y.size) if self.scale is None else 1.0 / self.scale ** 2
+        weight = precision
+        for _ in range(IRLS_STEPS if self.scale is not None else 1):
             root = np.sqrt(weight)
             beta = np.linalg.lstsq(x * root[:, None], y * root, rcond=None)[0]
             r = y - x @ beta
-            if self.scale:
+            if self.scale is not None:
                 z = np.abs(r) / self.scale
-                weight = np.where(z <= HUBER, 1.0, HUBER / np.maximum(z, 1e-300))
+                weight = precision * np.where(z <= HUBER, 1.0, HUBER / np.maximum(z, 1e-300))
         return np.asarray(r, dtype=float)
 
     def __call__(self, factor: float) -> float:
@@ -147,7 +151,7 @@ class _Profile:
         factor = float(factor)
         if factor not in self.seen:
             try:
-                z = np.abs(self.residual(factor)) / (self.scale or LPM)
+                z = np.abs(self.residual(factor)) / (LPM if self.scale is None else self.scale)
                 self.seen[factor] = float(np.sum(np.where(z <= HUBER, z * z,
                                                           2.0 * HUBER * z - HUBER * HUBER)))
             except (IdentificationError, np.linalg.LinAlgError):
@@ -216,8 +220,9 @@ def fit_base(spec: MotorSpec, liquid: str, points: BenchTable,
         residual = profile.residual(kept_factor)
     except (IdentificationError, np.linalg.LinAlgError) as err:
         return _kept(result, names, model, kept_factor, f'the base cannot be fitted ({err})')
-    mad = 1.4826 * float(np.median(np.abs(residual - np.median(residual))))
-    profile.scale = max(mad, 1e-6 * LPM)
+    # each row weighed by its noise (:mod:`.noise`): a recording's fast moves do not decide
+    profile.scale = noise_model(residual, points.flow[rows], 1 + len(profile.nuisance),
+                                1e-6 * LPM, rates_of(profile.nuisance))
     best = _minimum(profile, bound, kept_factor)
     inflation = variance_inflation(profile.residual(best)) if points.time_series else 1.0
     gain = (profile(kept_factor) - profile(best)) / inflation

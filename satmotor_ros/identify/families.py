@@ -5,16 +5,19 @@ The structure before the effect: which model family the data support best, out o
 Each family of :mod:`satmotor_ros.model.families` is fitted to the same points without any
 effect (its channel drop where the data pin it, :mod:`.base`, then one factor per linear
 part of its Q_vl, :func:`~.parts.loss_parts`) and scored by
-its cross-validated error of Q_vl, with the folds and the selector the effect search uses.
+its cross-validated error of Q_vl, with the folds and the selector the effect search uses,
+weighted by the noise (:func:`weighted_rmse`, one noise for all: the families' own estimates
+averaged; a recording's fast moves, whose timing jitter makes them the noisiest rows, do not
+decide).
 The motor's own family (its file's, or the SM-0,75/25's) is kept unless another one cuts
 that error by more than the selector's ``min_gain``: like an effect, a change of structure
 has to earn its place. A family pinned by the user (``--family``) is not compared.
 
 The two best families are a near tie when the runner-up's out-of-sample error is within
 the noise of the winner's: a one-sided paired test (Diebold and Mariano's) on the
-difference of their squared out-of-sample errors of Q_vl at the same points, its variance
-inflated by the correlation of neighbouring rows of a time series, does not reject at the
-selector's ``alpha`` that the runner-up is as good. The data then do not tell the two
+difference of their squared standardised out-of-sample errors of Q_vl at the same points,
+its variance inflated by the correlation of neighbouring rows of a time series, does not reject
+at the selector's ``alpha`` that the runner-up is as good. The data then do not tell the two
 structures apart, whichever was kept.
 """
 
@@ -49,11 +52,13 @@ class FamilyScore:
     factors: tuple[str, ...]  # the factors fitted (one per linear part of Q_vl)
     error: Errors | None  # out of sample, at the points no family calls an outlier
     note: str = ''  # why the family could not be scored, when error is None
+    weighted: float = math.inf  # noise-weighted out-of-sample RMSE (:func:`weighted_rmse`)
+    # at the same points, what the families are ranked by [m^3/s]
 
     @property
     def rmse(self) -> float:
-        """Return the out-of-sample RMSE of Q_vl, inf when not scored, [m^3/s]."""
-        return self.error.rmse_lpm * LPM if self.error is not None else math.inf
+        """Return the noise-weighted out-of-sample RMSE of Q_vl, inf when not scored, [m^3/s]."""
+        return self.weighted if self.error is not None else math.inf
 
 
 @dataclass(frozen=True)
@@ -69,8 +74,9 @@ class NearTie:
     def note(self) -> str:
         """Return the sentence the report and calibration.json give."""
         return (f'near tie: {self.runner_up} is within the noise of {self.winner} (paired test '
-                f'of their squared out-of-sample errors of Q_vl, p = {self.p_value:.2g} >= '
-                f'{self.alpha:g}): the data do not tell the two structures apart')
+                f'of their squared standardised out-of-sample errors of Q_vl, p = '
+                f'{self.p_value:.2g} >= {self.alpha:g}): the data do not tell the two '
+                'structures apart')
 
     def as_dict(self) -> dict[str, Any]:
         """Return the tie for ``calibration.json``'s ``family_comparison``."""
@@ -108,6 +114,30 @@ def paired_p_value(better: FloatArray, worse: FloatArray, inflation: float = 1.0
     return float(special.stdtr(d.size - 1, -t))
 
 
+def weighted_rmse(error: FloatArray, sigma: FloatArray) -> float:
+    """
+    Return the RMSE of errors weighted by the noise, in the units of the errors.
+
+    sqrt(mean((e/sigma)^2) mean(sigma^2)): the plain RMSE when the noise is the same at
+    every point; where it is not, each point counts by its precision, so the noisiest rows
+    (the fast moves of a recording) do not decide.
+
+    Parameters
+    ----------
+    error : ndarray
+        Errors at the points, [m^3/s]
+    sigma : ndarray
+        Noise at the points, [m^3/s]
+
+    Returns
+    -------
+    float
+        The weighted RMSE, [m^3/s]
+
+    """
+    return float(np.sqrt(np.mean((error / sigma) ** 2) * np.mean(sigma ** 2)))
+
+
 @dataclass(frozen=True)
 class FamilyChoice:
     """The comparison of the families and the one the calibration continues with."""
@@ -123,6 +153,8 @@ class FamilyChoice:
         """Return the comparison for ``calibration.json``: one entry per family, best first."""
         return [{'family': s.family, 'factors': list(s.factors),
                  'cv_error': s.error.as_dict() if s.error is not None else None,
+                 **({'cv_error_weighted_lpm': float(f'{s.weighted / LPM:.4g}')}
+                    if s.error is not None else {}),
                  **({'note': s.note} if s.note else {})} for s in self.scores]
 
 
@@ -222,6 +254,7 @@ def compare_families(points: BenchTable, liquid: str, specs: dict[str, MotorSpec
         models[name] = MotorModel.from_spec(bases[name].spec, liquid)
     common, parts = _parts_on(models, points, nuisance or {})
     scored = {}
+    variances: list[FloatArray] = []
     outlier = np.zeros(len(common), dtype=bool)
     for name, p in parts.items():
         if isinstance(p, str):
@@ -232,13 +265,17 @@ def compare_families(points: BenchTable, liquid: str, specs: dict[str, MotorSpec
             parts[name] = str(err)
             continue
         scored[name] = (p, forward.steps[0].baseline.cv_error)
+        variances.append(forward.sigma ** 2)
         outlier |= forward.outliers
     keep = ~outlier if (~outlier).any() else np.ones(len(common), dtype=bool)
+    # one noise for all: the families' own estimates, averaged (their variances)
+    sigma = np.sqrt(np.mean(variances, axis=0))[keep] if variances else np.ones(0)
     scores = []
     for name in specs:
         if name in scored:
             p, error = scored[name]
-            scores.append(FamilyScore(name, p.names, Errors.of(error[keep], p.loss[keep])))
+            scores.append(FamilyScore(name, p.names, Errors.of(error[keep], p.loss[keep]),
+                                      weighted=weighted_rmse(error[keep], sigma)))
         elif name in models:
             scores.append(FamilyScore(name, (), None, str(parts.get(name, 'not fitted'))))
         else:
@@ -250,27 +287,29 @@ def compare_families(points: BenchTable, liquid: str, specs: dict[str, MotorSpec
         msg = f'{points.source}: no model family could be fitted ({own.note})'
         raise IdentificationError(msg)
     n = int(keep.sum())
-    tie = _near_tie(scores, scored, keep, selector())
+    tie = _near_tie(scores, scored, keep, selector(), sigma)
     if best.family == own.family:
-        verdict = f'{own.family} has the least out-of-sample error of the families'
+        verdict = (f'{own.family} has the least noise-weighted out-of-sample error of the '
+                   'families')
         return FamilyChoice(own.family, tuple(scores), n, verdict, tie, bases)
     if own.error is not None and best.rmse >= (1.0 - min_gain) * own.rmse:
-        verdict = (f'{own.family} kept: {best.family} cuts the out-of-sample error by only '
-                   f'{100.0 * (1.0 - best.rmse / own.rmse):.1f} % (need > '
+        verdict = (f'{own.family} kept: {best.family} cuts the noise-weighted out-of-sample '
+                   f'error by only {100.0 * (1.0 - best.rmse / own.rmse):.1f} % (need > '
                    f'{100.0 * min_gain:.0f} %)')
         return FamilyChoice(own.family, tuple(scores), n, verdict, tie, bases)
-    cut = (f'cuts the out-of-sample error of {own.family} by '
+    cut = (f'cuts the noise-weighted out-of-sample error of {own.family} by '
            f'{100.0 * (1.0 - best.rmse / own.rmse):.1f} %' if own.error is not None
            else f'fits where {own.family} cannot')
     return FamilyChoice(best.family, tuple(scores), n, f'{best.family} {cut}', tie, bases)
 
 
 def _near_tie(scores: list[FamilyScore], scored: Mapping[str, tuple[LossParts, FloatArray]],
-              keep: np.ndarray, selector: CrossValidatedSelector) -> NearTie | None:
+              keep: np.ndarray, selector: CrossValidatedSelector,
+              sigma: FloatArray) -> NearTie | None:
     """Return the two best families when the runner-up is within the winner's noise."""
     if len(scores) < 2 or scores[1].error is None:
         return None
-    winner, runner = (scored[s.family][1][keep] for s in scores[:2])
+    winner, runner = (scored[s.family][1][keep] / sigma for s in scores[:2])
     d = runner ** 2 - winner ** 2
     inflation = variance_inflation(d) if selector.correlated else 1.0
     p_value = paired_p_value(winner, runner, inflation)
@@ -280,4 +319,4 @@ def _near_tie(scores: list[FamilyScore], scored: Mapping[str, tuple[LossParts, F
 
 
 __all__ = ['FamilyChoice', 'FamilyScore', 'NearTie', 'compare_families', 'family_specs',
-           'paired_p_value']
+           'paired_p_value', 'weighted_rmse']
