@@ -223,10 +223,11 @@ def test_calibrate_each_mbari_log_with_the_f11_displacement(mbari_calibrations, 
     assert after['rmse_lpm'] < 0.9 * before['rmse_lpm']
     report = (out / 'report.md').read_text()
     assert '## Model family' in report and 'columns mapped by' in report
-    if name == MBARI[0]:  # found where it acts; the search goes on, a further effect must recur
-        # across the recording's blocks: the 11 % flow gain it would name next does not (and
-        # predicts the other log worse)
-        assert ENDS_SEARCH in report and len(result['effects']) == 1
+    if name == MBARI[0]:  # the valve alone: the 11 % flow gain a search after it would name
+        # does not recur across the recording's blocks (and predicts the other log worse).
+        # With the rows' noise growing with the rates of change the valve passes the tests
+        # over every row, not only where it acts
+        assert len(result['effects']) == 1 and ENDS_SEARCH not in report
     assert load_motor(out / 'coefficients.yaml').family == result['family']
 
 
