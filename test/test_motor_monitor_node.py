@@ -253,6 +253,25 @@ def test_bad_input_and_missing_topics_are_counted_reported_and_survived(ros, rec
     assert node.level(snap)[0] >= 1
 
 
+def test_a_flowmeter_that_falls_silent_is_not_replaced_by_the_command(ros):
+    """Once the flowmeter has spoken, a sample without it is stale and the node says so."""
+    context, executor, _ = ros
+    node = _monitor(context, executor, input_timeout=1.0)
+    now = node._now()
+    node._held.update(flow_measured=30.0 * LPM, flow=25.0 * LPM, p_in=10.0 * MPA, p_out=0.5 * MPA)
+    node._heard.update(flow_measured=now - 10.0, flow=now, p_in=now, p_out=now)
+    node._last_heard_joint = now
+    node.take(1.0, 50.0, now)
+    assert node._block['stale'][-1] == 1.0
+    assert CHANNELS['flow_measured'].topic in node.quiet()
+    assert node.level(node.monitor.snapshot())[0] == 1
+    node._heard['flow_measured'] = -math.inf  # no flowmeter at all: the command is the flow
+    node.take(2.0, 50.0, now)
+    assert node._block['stale'][-1] == 0.0 and node._block['flow'][-1] == 25.0 * LPM
+    executor.remove_node(node)
+    node.destroy_node()
+
+
 def test_parameters_have_units_ranges_and_the_shipped_file_lists_them_all():
     """config/motor_monitor.yaml cannot drift from the declared parameters."""
     from pathlib import Path

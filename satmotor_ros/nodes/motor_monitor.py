@@ -319,9 +319,7 @@ class MotorMonitorNode(Node):
         """
         timeout = self._values['input_timeout']
         fresh = {name: now - heard <= timeout for name, heard in self._heard.items()}
-        heard = self._heard  # the flowmeter while it speaks, else the latest of the two
-        flow = ('flow_measured' if fresh['flow_measured']
-                or heard['flow_measured'] >= heard['flow'] else 'flow')
+        flow = self._flow_source()
         stale = not (fresh[flow] and all(fresh[n] for n in REQUIRED))
         for name, on in self._optional.items():
             stale = stale or (on and not fresh[name])
@@ -449,12 +447,23 @@ class MotorMonitorNode(Node):
             return 1, f'inputs refused: {self.last_bad or "joint_states out of order"}'
         return 0, 'learning' if snap.learning else 'healthy'
 
+    def _flow_source(self) -> str:
+        """
+        Return the flow input: the flowmeter once it has spoken, the command before.
+
+        A flowmeter that falls silent makes the samples stale; the command does not stand in
+        for it, since the factor would then measure something else from that sample on.
+        """
+        return 'flow_measured' if self._heard['flow_measured'] > -math.inf else 'flow'
+
     def quiet(self) -> list[str]:
         """Name the topics a sample needs that were not heard within ``input_timeout``."""
         now, timeout = self._now(), self._values['input_timeout']
         quiet = [CHANNELS[n].topic for n in REQUIRED if now - self._heard[n] > timeout]
-        if now - max(self._heard['flow'], self._heard['flow_measured']) > timeout:
-            quiet.append('flow_measured (or flow_command)')
+        flow = self._flow_source()
+        if now - self._heard[flow] > timeout:
+            quiet.append(CHANNELS['flow_measured'].topic if flow == 'flow_measured'
+                         else 'flow_measured (or flow_command)')
         if now - self._last_heard_joint > timeout:
             quiet.append(CHANNELS['measured_speed'].topic)
         return quiet
