@@ -8,7 +8,13 @@ defaults at 0.30 in^3/rev, as :mod:`satmotor_ros.identify.semireal` builds it) a
 measured on that log (white, Gaussian-correlated, spikes and the timing jitter while the
 flow changes), drawn afresh for every 400-440 s tile. Faults act on the motor's volumetric
 losses Q_vl (the model's, at the true state): a step of +20 % at a random time, or a wear
-growing linearly to the limit (2x) at a stated hour. The baseline is the same family's
+growing linearly to the limit (2x) at a stated hour. A factor s on Q_vl is injected as the
+monitor defines the leakage factor (measured Q_vl over the baseline's at the measured point):
+the flow Q solves Q = q_t n + s Q_vl(Q), the channel drop of eq. (35) taken at the larger flow
+(scaling the healthy flow's Q_vl instead left the motor's leak at the healthy chamber pressure,
+and the monitor's trend, right by its definition, read 1.757-1.760 over 4 h at a constant
+1.75; 1.751-1.752 as defined); the fixed point is solved on a grid of s once per log and
+interpolated per sample, and its excess over s = 1 added to the case's healthy flow. The baseline is the same family's
 defaults (the healthy motor); the monitor runs with its defaults (1000 h false-alarm
 interval) on blocks of one tile, as ``satmotor monitor`` would on the logs.
 
@@ -75,6 +81,35 @@ class Tiles:
         used = _monitor().baseline.losses(clean, HealthSettings().min_speed).reason == 0
         dt = np.diff(self.time, prepend=self.time[0])
         self.operating = np.cumsum(np.where(used, dt, 0.0))  # operating seconds in a tile
+        self.grid = np.linspace(1.0, LIMIT, 9)
+        fixed = [self.consistent(s) for s in self.grid]
+        # the healthy flow stays the case's; a factor adds its consistent excess to it
+        self.flows = np.array([q - fixed[0] + self.true for q in fixed])
+
+    def consistent(self, scale: float, iterations: int = 5) -> np.ndarray:
+        """
+        Return the flow whose Q_vl is `scale` times the baseline's there (clean, one tile).
+
+        Q = q_t n + scale Q_vl(Q) by fixed-point steps from the scaled healthy loss (each
+        step shrinks the error ~50x here); samples the monitor skips keep that start.
+        """
+        baseline, min_speed = _monitor().baseline, HealthSettings().min_speed
+        flow = self.true + (scale - 1.0) * self.loss
+        forward = np.where(self.p_a - self.p_b < 0.0, -1.0, 1.0)  # the loss's frame
+        for _ in range(iterations):
+            losses = baseline.losses(HealthSamples(self.time, self.speed, flow, self.p_a,
+                                                   self.p_b), min_speed)
+            flow = flow + np.where(losses.reason == 0, forward * (
+                scale * losses.baseline - losses.measured), 0.0)
+        return flow
+
+    def flow_at(self, scale: np.ndarray) -> np.ndarray:
+        """Return the clean flow with Q_vl times `scale` per sample (linear in the grid)."""
+        step = self.grid[1] - self.grid[0]
+        j = np.clip(((scale - self.grid[0]) // step).astype(int), 0, self.grid.size - 2)
+        w = (scale - self.grid[j]) / step
+        at = np.arange(scale.size)
+        return (1.0 - w) * self.flows[j, at] + w * self.flows[j + 1, at]
 
     def operating_s(self, t1: float, t2: float) -> float:
         """Return the operating seconds (samples the monitor uses) between two times."""
@@ -87,7 +122,7 @@ class Tiles:
     def tile(self, k: int, scale: Callable[[np.ndarray], np.ndarray]) -> HealthSamples:
         """Return tile `k` with fresh noise, Q_vl times scale(t)."""
         t = self.time - self.time[0] + k * self.period
-        reading = self.true + (scale(t) - 1.0) * self.loss
+        reading = self.flow_at(np.broadcast_to(scale(t), t.shape).astype(float))
         extra, _ = _noise(self.noise, self.step_s, t.size, self.rng)
         late = self.noise.jitter_s * _correlated(self.noise.correlation_s / self.step_s,
                                                  t.size, self.rng)

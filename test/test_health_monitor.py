@@ -95,6 +95,61 @@ def test_linear_wear_gives_hours_to_limit_within_thirty_percent_from_halfway() -
     assert snap.trend_per_hour.value == pytest.approx(0.05, rel=0.3)
 
 
+def _as_defined(clean: HealthSamples, baseline: Baseline, scale: np.ndarray | float,
+                noisy: HealthSamples | None = None) -> HealthSamples:
+    """
+    Return `clean` with its flow's Q_vl `scale` times the baseline's at that flow.
+
+    The monitor's definition of the factor: the flow solves Q = q_t n + scale Q_vl(Q), the
+    chamber drop taken at Q itself (fixed-point steps); `noisy`'s noise is then added.
+    """
+    flow = clean.flow
+    forward = np.where(clean.p_in - clean.p_out < 0.0, -1.0, 1.0)
+    for _ in range(5):
+        losses = baseline.losses(dataclasses.replace(clean, flow=flow), QUIET.min_speed)
+        flow = flow + np.where(losses.reason == 0,
+                               forward * (scale * losses.baseline - losses.measured), 0.0)
+    if noisy is not None:
+        flow = flow + noisy.flow - clean.flow
+    return dataclasses.replace(clean, flow=flow)
+
+
+@pytest.mark.parametrize('family', ['paszota', 'balawender'])
+def test_a_large_factor_made_as_defined_is_read_without_bias(family: str) -> None:
+    """
+    Q_vl 1.75x the baseline's at the measured point: the factor reads 1.75, not ~1 % more.
+
+    Scaling the healthy flow's loss instead (the channel drop left at the healthy flow) reads
+    1.752-1.754 here and 1.76 on the MBARI trajectories: a monitor that moved its baseline off
+    the measured point, or a weighting that leans on the large factors, fails this.
+    """
+    baseline = Baseline.for_family(family, DISPLACEMENT)
+    clean = recording(0.5, noise_lpm=0.0, baseline=baseline, rate_hz=2.0)
+    monitor = HealthMonitor(baseline, dataclasses.replace(QUIET, learn_hours=0.1))
+    assert _run(_as_defined(clean, baseline, 1.75), monitor) == []
+    assert monitor.snapshot().leakage_factor.value == pytest.approx(1.75, abs=1e-4)
+
+
+def test_late_in_a_linear_wear_the_interval_still_holds_the_hours_to_limit() -> None:
+    """
+    At 75 % of the way to the limit (2x at 20 h, Q_vl as defined): 5 h to go, inside the CI.
+
+    The bench's 20 runs on the MBARI trajectories held the truth in 10 of 20 at 75 % while
+    their truth was off the factor's definition (bench/bench_health.py); this guards the
+    late interval and its bias on the tests' own generator (seeded).
+    """
+    baseline = Baseline.for_family('paszota', DISPLACEMENT)
+    clean = recording(15.0, seed=3, rate_hz=1.0, noise_lpm=0.0)
+    samples = _as_defined(clean, baseline, 1.0 + clean.time / (20.0 * 3600.0),
+                          recording(15.0, seed=3, rate_hz=1.0))
+    monitor = HealthMonitor(baseline, QUIET)
+    assert _run(samples, monitor, 20000) == []
+    snap = monitor.snapshot()
+    assert snap.hours_to_limit.low <= 5.0 <= snap.hours_to_limit.high
+    assert snap.hours_to_limit.value == pytest.approx(5.0, rel=0.1)
+    assert snap.trend.value == pytest.approx(1.75, abs=0.02)
+
+
 def test_unusable_samples_are_counted_and_skipped() -> None:
     """Non-finite, stalled and repeated samples are counted by reason, not folded in."""
     samples = recording(0.2, seed=1, noise_lpm=0.0)
