@@ -14,9 +14,10 @@ the flow Q solves Q = q_t n + s Q_vl(Q), the channel drop of eq. (35) taken at t
 (scaling the healthy flow's Q_vl instead left the motor's leak at the healthy chamber pressure,
 and the monitor's trend, right by its definition, read 1.757-1.760 over 4 h at a constant
 1.75; 1.751-1.752 as defined); the fixed point is solved on a grid of s once per log and
-interpolated per sample, and its excess over s = 1 added to the case's healthy flow. The baseline is the same family's
-defaults (the healthy motor); the monitor runs with its defaults (1000 h false-alarm
-interval) on blocks of one tile, as ``satmotor monitor`` would on the logs.
+interpolated per sample, and its excess over s = 1 added to the case's healthy flow. The
+baseline is the same family's defaults (the healthy motor); the monitor runs with its
+defaults (1000 h false-alarm interval) on blocks of one tile, as ``satmotor monitor`` would
+on the logs.
 
 Reported:
 - step: the delay from the step to the change alarm in operating minutes (the time the
