@@ -15,7 +15,7 @@ import pytest
 from satmotor_ros.identify.errors import DataError
 from satmotor_ros.identify.health import (Baseline, HealthMonitor, HealthSamples,
                                           HealthSettings)
-from satmotor_ros.identify.health.detector import siegmund_arl, threshold_for
+from satmotor_ros.identify.health.detector import Cusum, siegmund_arl, threshold_for
 
 QUIET = HealthSettings(explain=False)
 
@@ -70,6 +70,26 @@ def test_threshold_inverts_the_run_length_and_grows_with_the_false_alarm_interva
     h = threshold_for(1.0e5, 0.7)
     assert siegmund_arl(h, 0.7) == pytest.approx(1.0e5, rel=1e-6)
     assert threshold_for(1.0e6, 0.7) > h
+
+
+@pytest.mark.parametrize('delta', [0.5, 1.0, 2.0])
+def test_the_cusum_on_standard_noise_runs_as_long_as_siegmund_says(delta: float) -> None:
+    """In control, the two-sided CUSUM alarms after half Siegmund's one-sided run length."""
+    h = threshold_for(400.0, delta)
+    rng = np.random.default_rng(7)
+    runs = []
+    for _ in range(400):
+        cusum = Cusum(h)
+        n = 0
+        while max(cusum.up, cusum.down) < h:
+            cusum.step(float(rng.standard_normal()), delta, float(n))
+            n += 1
+        runs.append(n)
+        cusum.reset()
+        assert (cusum.up, cusum.down) == (0.0, 0.0)
+    # 400 runs of a roughly exponential length: the mean within about 3 standard errors
+    assert np.mean(runs) == pytest.approx(200.0, rel=0.15)
+    assert siegmund_arl(5.0, 1.0) == pytest.approx(938.0, abs=0.5)  # the docstring's figure
 
 
 def test_false_alarm_hours_sets_the_threshold() -> None:
