@@ -8,9 +8,11 @@ injected effect in its coefficient set, evaluated by the effect's own kind
 (:mod:`satmotor_ros.model.effects`), and the sensor effects applied to what
 the sensors report. An :class:`Injection`'s magnitude is turned into the
 effect's coefficient by the kind (:meth:`~satmotor_ros.model.effects.EffectKind.scaled`).
-The injected viscosity law is the liquid's standard one pinned at the mean
-temperature of the data, while the candidate library pins it at the set's
-viscosity, so a test still checks that the fit generalises over the pinning.
+The injected viscosity law is the liquid's standard one, in a bench table pinned at the
+mean temperature of the data, while the candidate library pins it at the set's
+viscosity, so a test still checks that the fit generalises over the pinning. A
+recording's oil is the model's liquid: its law gives the model's viscosity where the
+standard law does, and without the injection it is held there.
 
 A recording can age (:func:`aging`): a wear that grows with the hours of the recording,
 the family's own (:func:`wear_kind`), and a step fault: any injection with an `onset`
@@ -251,8 +253,8 @@ def _temperature(plan: Plan, injections: tuple[Injection, ...], rng: np.random.G
     With ``viscosity_temperature`` injected it spans the injection's magnitude and the
     losses follow it. Without, a bench table's points are set at temperatures drawn over the
     plan's range that the losses ignore (a channel that does not matter, which calibration
-    must not take for an effect); a recording's oil is held at the middle of that range
-    (the losses at the model's viscosity, which does not move): a temperature that moved
+    must not take for an effect); a recording's oil is held where the liquid's standard law
+    gives the model's viscosity (the losses at it, which do not move): a temperature that moved
     while the losses did not would be a motor no oil makes, and a monitor that reads the
     temperature, as it must, would alarm on it.
     """
@@ -269,7 +271,9 @@ def _temperature(plan: Plan, injections: tuple[Injection, ...], rng: np.random.G
     temperature: FloatArray = lo + (hi - lo) * ((1.0 - jitter) * cycles
                                                 + jitter * rng.uniform(0, 1, time.size))
     if recording and not span:  # drawn all the same: the other channels' draws do not move
-        return np.full_like(temperature, 0.5 * (lo + hi))
+        base = base_model(plan)
+        held = standard_law(base.liquid, base.coefficient_set.name).reference_temperature
+        return np.full_like(temperature, held)
     return temperature
 
 
@@ -359,17 +363,27 @@ def base_model(plan: Plan) -> MotorModel:
 
 
 def _motor_flow(plan: Plan, injections: tuple[Injection, ...], speed: FloatArray,
-                dp: FloatArray, channels: dict[str, FloatArray]) -> tuple[Spans, FloatArray]:
-    """Return the injected effects per span and the flow the motor absorbs with them, [m^3/s]."""
+                dp: FloatArray, channels: dict[str, FloatArray],
+                recording: bool = True) -> tuple[Spans, FloatArray]:
+    """
+    Return the injected effects per span and the flow the motor absorbs with them, [m^3/s].
+
+    In a recording the viscosity law is pinned where the liquid's standard law gives the
+    model's viscosity (:func:`_temperature`), not at the data's mean temperature.
+    """
     base = base_model(plan)
+    law = standard_law(base.liquid, base.coefficient_set.name)
     time = channels['time']
     steps = sorted({i.onset for i in injections if i.onset > time[0]})
     effect_of = {}
     for i, injection in enumerate(injections):  # each scaled on the rows it acts on
         rows = time >= injection.onset
         if rows.any():
-            effect_of[i] = injected_effect(base, injection, speed[rows], dp[rows],
-                                           {k: v[rows] for k, v in channels.items()})
+            effect = injected_effect(base, injection, speed[rows], dp[rows],
+                                     {k: v[rows] for k, v in channels.items()})
+            if recording and effect is not None and effect.name == 'viscosity_temperature':
+                effect = replace(effect, reference_temperature=law.reference_temperature)
+            effect_of[i] = effect
     which = np.searchsorted(np.asarray(steps), time, side='right')
     flow = np.empty_like(speed)
     spans = []
@@ -471,7 +485,7 @@ def generate(plan: Plan, injection: Injection | Sequence[Injection],
     injections = _injections(injection)
     channels = _channels(plan, injections, rng, time, n, np.arange(n), recording=False)
     channels['revolutions'] = revolutions(speed, np.diff(time, prepend=0.0))
-    spans, flow = _motor_flow(plan, injections, speed, dp, channels)
+    spans, flow = _motor_flow(plan, injections, speed, dp, channels, recording=False)
     return _measure(plan, spans, rng, flow, speed, dp, channels, 1.0)
 
 

@@ -10,7 +10,7 @@ factor (the pooled factor over ``window_s``), the trend (:mod:`.trend`) and the 
 detector (:mod:`.detector`).
 
 The first ``learn_hours`` of operation teach the monitor the data: first (a third of it)
-the sample noise model and the temperature the baseline holds at; then the level k_ref, the
+the sample noise model; then the level k_ref, the
 bins' variance inflation c^2 and autocorrelation phi, the reference operating point and the
 detector's threshold. The detector's level and noise model keep learning slowly
 (``reference_hours``) while the detector is quiet, so a slow wear shows as a trend and a
@@ -79,7 +79,7 @@ spread evenly, so more would only cost memory and state-file size), [1/s]."""
 LEVEL_POINTS = 6
 """Trend points (an hour at the default 10 min) before its line is the detector's level."""
 
-STATE_VERSION = 1
+STATE_VERSION = 2
 """Version of the saved state's layout."""
 
 
@@ -122,13 +122,11 @@ class HealthMonitor:
         self.n_samples = 0
         self.skipped = dict.fromkeys(SKIP_REASONS, 0)
         self.op_s = 0.0  # operating seconds used
-        # stage 1: the sample noise model and the temperature the baseline holds at
+        # stage 1: the sample noise model
         self.noise_rate: list[FloatArray] = []
         self.noise_residual: list[FloatArray] = []
-        self.noise_temperature: list[FloatArray] = []
         self.var_a = math.nan
         self.var_b = math.nan
-        self.t_ref = math.nan  # [degC]
         # bins
         self.bin_index = -1
         self.open_bin = np.zeros(len(FIELDS))
@@ -189,7 +187,7 @@ class HealthMonitor:
         time = np.asarray(block.time, dtype=float)
         if math.isnan(self.t0) and np.isfinite(time).any():
             self.t0 = float(time[np.isfinite(time)][0])
-        losses = self.baseline.losses(block, s.min_speed, self.t_ref)
+        losses = self.baseline.losses(block, s.min_speed)
         reason = losses.reason.copy()
         # stale: time that does not advance (a repeated or late sample)
         previous = np.concatenate([[self.t_last], time[:-1]])
@@ -217,9 +215,7 @@ class HealthMonitor:
             early[:int(np.argmin(early)) + 1] = True  # up to the sample that completes it
             teach = used & early
             self.op_s += float(op[teach].sum())
-            self._gather_noise(rate[teach], residual[teach], block, teach)
-            if math.isfinite(self.t_ref):  # the rest of the block at the temperature learned
-                losses = self.baseline.losses(block, s.min_speed, self.t_ref)
+            self._gather_noise(rate[teach], residual[teach])
             used = used & ~early
             op = np.where(used, op, 0.0)
             if math.isnan(self.var_a) or not used.any():
@@ -288,13 +284,10 @@ class HealthMonitor:
         while self.recent and self.recent[0].time[-1] < horizon:
             self.recent.popleft()
 
-    def _gather_noise(self, rate: FloatArray, residual: FloatArray, block: HealthSamples,
-                      used: np.ndarray) -> None:
+    def _gather_noise(self, rate: FloatArray, residual: FloatArray) -> None:
         """Stage 1: keep residuals until a third of the learning time, then fit the noise."""
         self.noise_rate.append(rate)
         self.noise_residual.append(residual)
-        if block.temperature is not None:
-            self.noise_temperature.append(np.asarray(block.temperature)[used])
         if self.op_s < self.settings.learn_hours * 3600.0 / 3.0 * (1.0 - EPS):
             return
         rate_all, residual_all = np.concatenate(self.noise_rate), np.concatenate(
@@ -303,11 +296,7 @@ class HealthMonitor:
             pick = np.linspace(0, rate_all.size - 1, NOISE_SAMPLES).astype(int)
             rate_all, residual_all = rate_all[pick], residual_all[pick]
         self.var_a, self.var_b = fit_variance(rate_all, residual_all)
-        finite = (np.concatenate(self.noise_temperature) if self.noise_temperature
-                  else np.zeros(0))
-        finite = finite[np.isfinite(finite)]
-        self.t_ref = float(np.median(finite)) if finite.size else math.nan
-        self.noise_rate, self.noise_residual, self.noise_temperature = [], [], []
+        self.noise_rate, self.noise_residual = [], []
 
     # ------------------------------------------------------------------ bins
     def _close_bin(self, sums: FloatArray, index: int) -> list[Alarm]:
@@ -400,7 +389,8 @@ class HealthMonitor:
         needs = self.baseline.model.channels
         if not needs:
             return None
-        values = {'p_case': 0.0, 'p_out': 0.0, 'temperature': self.t_ref, 'time': 0.0}
+        values = {'p_case': 0.0, 'p_out': 0.0, 'time': 0.0,
+                  'temperature': self.baseline.reference_temperature}
         return {name: np.array([values.get(name, 0.0)]) for name in needs}
 
     def _detect(self, k_b: float, sbb: float, sbm: float, start_s: float,
@@ -607,7 +597,8 @@ class HealthMonitor:
             statistic=0.0 if self.learning else self.cusum.statistic, threshold=self.cusum.h,
             noise={'sample_var_rest': self.var_a, 'sample_var_per_rate2': self.var_b,
                    'bin_inflation': c2, 'bin_autocorrelation': phi,
-                   'trend_autocorrelation': phi_t, 'reference_temperature': self.t_ref},
+                   'trend_autocorrelation': phi_t,
+                   'reference_temperature': self.baseline.reference_temperature},
             n_samples=self.n_samples, n_skipped=sum(self.skipped.values()),
             skipped=dict(self.skipped), alarms=tuple(self.alarms), change_s=self.change_s,
             what_changed=self.what_changed)
@@ -716,8 +707,6 @@ class HealthMonitor:
         state['trend_point'] = np.asarray(state['trend_point'], dtype=float)
         state['noise_rate'] = [np.asarray(x, dtype=float) for x in state['noise_rate']]
         state['noise_residual'] = [np.asarray(x, dtype=float) for x in state['noise_residual']]
-        state['noise_temperature'] = [np.asarray(x, dtype=float)
-                                      for x in state['noise_temperature']]
         for key, value in state.items():
             if not hasattr(monitor, key):
                 msg = f'{path}: {key}: not a field of the health state'
