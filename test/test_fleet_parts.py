@@ -312,3 +312,25 @@ def test_the_synthetic_fleet_program_says_one_line_and_replaces_only_its_own(tmp
     assert synthetic([str(root), '--days', '1']) == 0
     assert synthetic([str(root), '--days', '2']) == 0  # its own: replaced
     assert sorted(p.name for p in (root / 'vessel_a').iterdir()) == ['day00.csv', 'day01.csv']
+
+
+def test_a_mapping_or_motor_file_edited_in_place_is_a_new_key(tmp_path):
+    """A rerun redoes a motor whose column mapping or motor file changed, not only its path."""
+    from satmotor_ros.fleet.config import MotorRule
+    from satmotor_ros.fleet.tasks import baseline_rule_key, recording_options, RunOptions
+    mapping, motor = tmp_path / 'cols.yaml', tmp_path / 'motor.yaml'
+    mapping.write_text('columns: {p_a: {column: pa, unit: MPa}}\n')
+    motor.write_text('name: m\n')
+    rule = MotorRule('m/*', 'm', columns=str(mapping), motor_file=str(motor))
+    run = RunOptions(out=str(tmp_path / 'out'))
+
+    def keys():
+        return (options_key(recording_options(rule, run, 'b')), baseline_rule_key(rule, run))
+
+    before = keys()
+    assert keys() == before
+    mapping.write_text('columns: {p_a: {column: pa, unit: bar}}\n')
+    after_mapping = keys()
+    assert after_mapping[0] != before[0] and after_mapping[1] != before[1]
+    motor.write_text('name: m2\n')
+    assert keys()[0] != after_mapping[0]

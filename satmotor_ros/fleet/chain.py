@@ -25,8 +25,8 @@ from satmotor_ros.fleet.config import MotorRule
 from satmotor_ros.fleet.discover import Motor, Recording
 from satmotor_ros.fleet.resume import content_of, options_key, read_marker, stat_of
 from satmotor_ros.fleet.tasks import (columns_of, input_of, load_screened, MONITOR_DIR,
-                                      motor_options, no_baseline, Refused, RunOptions, STATE,
-                                      STEP)
+                                      motor_options, no_baseline, Refused, rule_identity,
+                                      RunOptions, STATE, STEP)
 
 CHAIN = 'monitor-chain-v1'
 """Names the chain in each step's key: a new one redoes every step."""
@@ -36,10 +36,8 @@ STEADY = 'no time column: the health monitor has nothing to watch'
 
 def step_options(rule: MotorRule, run: RunOptions, baseline_key: str) -> str:
     """Hash what a step depends on besides its data and the step before."""
-    return options_key({'rule': [rule.pattern, rule.motor, rule.liquid, rule.family,
-                                 rule.displacement, rule.motor_file, rule.columns,
-                                 rule.columns_inline],
-                        'liquid': run.liquid, 'baseline': baseline_key, 'chain': CHAIN})
+    return options_key({'rule': rule_identity(rule), 'liquid': run.liquid,
+                        'baseline': baseline_key, 'chain': CHAIN})
 
 
 def read_step(directory: Path) -> dict[str, Any] | None:

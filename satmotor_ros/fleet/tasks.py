@@ -253,11 +253,23 @@ def no_baseline(baseline: dict[str, Any], rec: Recording) -> Refused:
     return Refused(own['reason'] if own else baseline.get('reason', 'no baseline'))
 
 
+def rule_identity(rule: MotorRule) -> list[Any]:
+    """
+    Return what a motor's fleet.yaml entry puts into a result: its fields and its files.
+
+    A column mapping or motor file edited in place changes every result read through it, so
+    the content of each file the entry names is part of it, not only the path.
+    """
+    files = [content_of(name) if name and Path(name).is_file() else ''
+             for name in (rule.motor_file, rule.columns)]
+    return [rule.pattern, rule.motor, rule.liquid, rule.family, rule.displacement,
+            rule.motor_file, rule.columns, rule.columns_inline, *files]
+
+
 def baseline_rule_key(rule: MotorRule, run: RunOptions) -> str:
     """Hash what a calibrated baseline depends on besides its data."""
-    return options_key({'rule': [rule.pattern, rule.motor, rule.liquid, rule.family,
-                                 rule.displacement, rule.columns, rule.columns_inline],
-                        'liquid': run.liquid, 'alpha': run.alpha, 'folds': run.folds})
+    return options_key({'rule': rule_identity(rule), 'liquid': run.liquid, 'alpha': run.alpha,
+                        'folds': run.folds})
 
 
 def given_baseline(motor: Motor, run: RunOptions) -> dict[str, Any]:
@@ -280,9 +292,7 @@ def _write_baseline(directory: Path, found: dict[str, Any]) -> None:
 def recording_options(rule: MotorRule, run: RunOptions, baseline_key: str) -> dict[str, Any]:
     """Return what a recording's outputs depend on besides its data (hashed in its marker)."""
     from satmotor_ros.fleet.health import ESTIMATOR
-    return {'rule': [rule.pattern, rule.motor, rule.liquid, rule.family, rule.displacement,
-                     rule.motor_file, rule.columns, rule.columns_inline],
-            'calibrate': run.calibrate, 'validate': run.validate, 'liquid': run.liquid,
+    return {'rule': rule_identity(rule), 'calibrate': run.calibrate, 'validate': run.validate, 'liquid': run.liquid,
             'alpha': run.alpha, 'folds': run.folds, 'baseline': baseline_key,
             'estimator': ESTIMATOR}
 
