@@ -161,6 +161,26 @@ def test_ranking_is_soonest_to_the_limit_first():
     assert [v['motor'] for v in rank(views)] == ['fast', 'slow', 'flat', 'none']
 
 
+def test_ranking_puts_a_motor_near_its_limit_after_a_step_ahead_of_a_slow_drift():
+    """A leak to 1.95 (limit 2) two days ago has no trend yet: still ranked first."""
+    rng = np.random.default_rng(3)
+    leak = np.r_[np.ones(8), 1.95, 1.95] + rng.normal(0, 0.002, 10)
+    views = [motor_view('slow', '', _markers(1.0 + 0.0004 * np.arange(10)), None, limit=2.0),
+             motor_view('leak', '', _markers(leak), None, limit=2.0)]
+    assert views[1]['days_to_limit'] is None
+    assert [v['motor'] for v in rank(views)] == ['leak', 'slow']
+
+
+def test_ranking_counts_days_from_the_fleets_latest_recording():
+    """A motor last seen 120 days ago with 90 days left reaches its limit before one seen
+    today with 70 left."""
+    old = motor_view('old', '', _markers(1.0 + 0.01 * np.arange(5)), None, limit=2.0)
+    new = motor_view('new', '', _markers(1.0 + 0.01 * np.arange(5), EPOCH + 120 * DAY), None,
+                     limit=2.0)
+    assert old['days_to_limit'] == pytest.approx(new['days_to_limit'])  # the same drift
+    assert [v['motor'] for v in rank([new, old])] == ['old', 'new']
+
+
 def test_fleet_command_refuses_a_bad_fleet_yaml_and_an_out_it_did_not_write(tmp_path, capsys):
     _csv(tmp_path / 'root' / 'm1' / 'a.csv')
     bad = tmp_path / 'bad.yaml'

@@ -111,11 +111,14 @@ def _view(motor: str, liquid: str, markers: list[dict[str, Any]],
     refused = [{'path': m['recording'], 'reason': m.get('reason', ''),
                 'status': m.get('status')} for m in markers if m.get('status') != 'done']
     sources = sorted({m.get('time_source', '') for m in markers})
+    times = [float(m['time']) for m in markers
+             if m.get('status') == 'done' and isinstance(m.get('time'), (int, float))]
     return {'motor': motor, 'liquid': liquid, 'recordings': len(markers), 'refused': refused,
             'leakage_factor': series, 'trend_per_day': trend, 'days_to_limit': days,
             'alarms': alarms, 'limit': limit, 'last': series[-1]['value'] if series else None,
             'baseline': _baseline_line(baseline), 'time_sources': sources,
-            'estimator': estimator, 'trend_clock': clock}
+            'estimator': estimator, 'trend_clock': clock,
+            'last_time': max(times) if times else None}
 
 
 def _monitored(motor: str, liquid: str, markers: list[dict[str, Any]],
@@ -244,13 +247,21 @@ def _slope(t: np.ndarray, v: np.ndarray) -> tuple[float | None, float]:
     return slope, (scatter / float(days @ days)) ** 0.5
 
 
+NEAR = 0.1
+"""A motor whose last factor is within this share of the way from 1 to its limit is near it,
+[-]: with no trend to project (a step just before, too few recordings since) it is ranked as
+if it reached the limit now, not after every motor that has a projection."""
+
+
 def rank(motors: list[dict[str, Any]]) -> list[dict[str, Any]]:
     """
-    Order motors soonest to the limit first.
+    Order motors soonest to the limit first, on one calendar.
 
-    A motor past its limit comes first (0 days), then by days to the limit; motors not
-    drifting toward it follow, by their latest leakage factor (highest first), and those
-    with no figure at all last.
+    A motor past its limit comes first, then by the days from the fleet's latest recording
+    to the date each motor's trend reaches its limit (a motor last recorded long ago has used
+    some of its days since; a motor near its limit with no trend counts as reaching it now);
+    motors not drifting toward it follow, by their latest leakage factor (highest first), and
+    those with no figure at all last.
 
     Parameters
     ----------
@@ -263,14 +274,22 @@ def rank(motors: list[dict[str, Any]]) -> list[dict[str, Any]]:
         The same entries, ranked.
 
     """
-    def key(m: dict[str, Any]) -> tuple[int, float, float, str]:
-        days = m['days_to_limit']
-        last = m['last']
+    known = [m['last_time'] for m in motors if m.get('last_time') is not None]
+    now = max(known) if known else None
+
+    def key(m: dict[str, Any]) -> tuple[int, float, str]:
+        days, last, limit = m['days_to_limit'], m['last'], m.get('limit', LIMIT)
+        if last is None:
+            return (3, 0.0, m['motor'])
+        if last >= limit or days == 0.0:
+            return (0, -last, m['motor'])
         if days is not None:
-            return (0, days, 0.0, m['motor'])
-        if last is not None:
-            return (1, 0.0, -last, m['motor'])
-        return (2, 0.0, 0.0, m['motor'])
+            since = (now - m['last_time']) / DAY if now is not None and m.get(
+                'last_time') is not None else 0.0
+            return (1, days - since, m['motor'])
+        if last >= limit - NEAR * (limit - 1.0):
+            return (1, 0.0, m['motor'])
+        return (2, -last, m['motor'])
     return sorted(motors, key=key)
 
 
@@ -280,5 +299,5 @@ def iso_now() -> str:
 
 
 __all__ = ['CHANGE_SIGMAS', 'DAY', 'EPOCH_S', 'LIMIT', 'MIN_STEP', 'MIN_TREND_POINTS',
-           'MONITOR_EPOCH', 'RECORDING_TIMES', 'iso_now',
+           'MONITOR_EPOCH', 'NEAR', 'RECORDING_TIMES', 'iso_now',
            'motor_view', 'rank']
