@@ -172,8 +172,7 @@ def test_ranking_puts_a_motor_near_its_limit_after_a_step_ahead_of_a_slow_drift(
 
 
 def test_ranking_counts_days_from_the_fleets_latest_recording():
-    """A motor last seen 120 days ago with 90 days left reaches its limit before one seen
-    today with 70 left."""
+    """A motor last seen 120 days ago reaches its limit before one seen today, same drift."""
     old = motor_view('old', '', _markers(1.0 + 0.01 * np.arange(5)), None, limit=2.0)
     new = motor_view('new', '', _markers(1.0 + 0.01 * np.arange(5), EPOCH + 120 * DAY), None,
                      limit=2.0)

@@ -292,8 +292,8 @@ def _write_baseline(directory: Path, found: dict[str, Any]) -> None:
 def recording_options(rule: MotorRule, run: RunOptions, baseline_key: str) -> dict[str, Any]:
     """Return what a recording's outputs depend on besides its data (hashed in its marker)."""
     from satmotor_ros.fleet.health import ESTIMATOR
-    return {'rule': rule_identity(rule), 'calibrate': run.calibrate, 'validate': run.validate, 'liquid': run.liquid,
-            'alpha': run.alpha, 'folds': run.folds, 'baseline': baseline_key,
+    return {'rule': rule_identity(rule), 'calibrate': run.calibrate, 'validate': run.validate,
+            'liquid': run.liquid, 'alpha': run.alpha, 'folds': run.folds, 'baseline': baseline_key,
             'estimator': ESTIMATOR}
 
 
