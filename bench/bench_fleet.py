@@ -7,7 +7,8 @@ bench tables, three damaged recordings). Each configuration processes the same r
 into a fresh output directory, doing exactly the work of ``satmotor fleet`` (a baseline
 calibration per motor, then the health step per recording, done-markers written):
 
-- plain loop, 1 process: the tasks called one after the other in this process;
+- plain loop, 1 process: the tasks called one after the other in this process (each motor's
+  baseline, its recordings, then its monitor chain, as ``run_on`` does);
 - plain loop, N processes: a ``ProcessPoolExecutor`` of N processes, one motor at a time
   each (the baseline, then its recordings), as a shell loop per motor would;
 - Dask, N workers: :func:`satmotor_ros.fleet.engine.run_on` on a local cluster of N worker
@@ -38,6 +39,7 @@ os.environ.setdefault('OPENBLAS_NUM_THREADS', '1')
 
 import psutil  # noqa: E402
 
+from satmotor_ros.fleet.chain import monitor_step  # noqa: E402
 from satmotor_ros.fleet.config import FleetConfig, load_fleet  # noqa: E402
 from satmotor_ros.fleet.discover import discover, Motor  # noqa: E402
 from satmotor_ros.fleet.engine import connect, plan, run_on  # noqa: E402
@@ -57,10 +59,15 @@ def _warm(wait: float = 0.0) -> int:
 
 
 def _motor(motor: Motor, run: RunOptions) -> int:
-    """Do one motor as a plain loop: its baseline, then each recording."""
+    """Do one motor as a plain loop: its baseline, each recording, then its monitor chain."""
+    chain_from = plan([motor], run).chain_from  # what run_on chains: the same work
     baseline = calibrate_baseline(motor, run)
     for rec in motor.recordings:
         process_recording(rec, motor.rule, baseline, run)
+    if motor.motor in chain_from:
+        before = None
+        for rec in motor.recordings[chain_from[motor.motor]:]:
+            before = monitor_step(rec, motor.rule, baseline, run, before)
     return len(motor.recordings)
 
 
