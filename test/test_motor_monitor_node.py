@@ -25,6 +25,7 @@ from rclpy.qos import qos_profile_sensor_data
 from satmotor_ros.cli.monitor import command
 from satmotor_ros.identify.bag import read_bag
 from satmotor_ros.identify.health import Baseline, HealthMonitor, HealthSamples
+from satmotor_ros.identify.health.records import NEVER_HOURS
 from satmotor_ros.identify.synthetic import generate_series, Injection, Plan, write_bag_of
 from satmotor_ros.interface import CHANNELS, HEALTH_TOPICS, JOINT_NAME
 from satmotor_ros.model.units import ATMOSPHERE, LPM, MPA
@@ -134,7 +135,7 @@ def _numbers(snap):
 def _cli_numbers(doc):
     """Return monitor.json's figures in the order of :func:`_numbers` (None as NaN)."""
     def number(x):
-        return math.nan if x is None else x
+        return math.nan if x is None else math.inf if x == NEVER_HOURS else x
     now = doc['leakage_factor_now']
     return [number(x) for x in (
         now['value'], *now['ci95'], doc['trend_per_hour'], *doc['trend_per_hour_ci95'],

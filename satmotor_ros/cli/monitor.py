@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 from pathlib import Path
 
 from satmotor_ros.cli._bench import load_data, run_bench_command
@@ -150,7 +151,6 @@ def _monitor(data: list[str], out: str, options: MotorOptions, columns: str, for
     if state:
         monitor.save(state)
     alarms = ', '.join(f'{a.kind} at {a.time_s / 3600:.3g} h ({a.what})' for a in snap.alarms)
-    to_limit = content['hours_to_limit']
     flags = ''.join(f'; WARNING: {flag}' for flag in content['flags'])
     notes = ''.join(f'; {note}' for note in run.notes)
     if snap.learning and not snap.alarms:
@@ -160,12 +160,19 @@ def _monitor(data: list[str], out: str, options: MotorOptions, columns: str, for
         figures = (f'leakage factor {snap.leakage_factor.value:.4g} '
                    f'[{snap.leakage_factor.low:.4g}, {snap.leakage_factor.high:.4g}], trend '
                    f'{snap.trend_per_hour.value:+.3g}/h, hours to limit '
-                   + ('none (' + content['hours_to_limit_note'].removeprefix('null: ') + ')'
-                      if to_limit is None else f'{to_limit:.3g}'))
+                   + _hours_text(snap.hours_to_limit.value))
     return ((f'WARNING: {settled.warning}; ' if settled.warning else '')
             + f'{figures}; alarms: {alarms or "none"}{flags}{notes}; '
             f'{snap.n_samples} samples, {snap.n_skipped} skipped; wrote {out}/monitor.json, '
             'health.csv, report.md, leakage_factor.png, detector.png')
+
+
+def _hours_text(hours: float) -> str:
+    if math.isfinite(hours):
+        return f'{hours:.3g}'
+    if math.isinf(hours):
+        return 'never (the trend does not rise significantly towards the limit)'
+    return 'none yet (not enough operation for a trend)'
 
 
 __all__ = ['add_arguments', 'command', 'DESCRIPTION']

@@ -130,6 +130,7 @@ def _watch(table: Any, baseline: dict[str, Any], state: str, out: Path) -> dict[
     from satmotor_ros.cli._output import output_dir
     from satmotor_ros.identify import IdentificationError
     from satmotor_ros.identify.health import HealthMonitor, HealthSettings
+    from satmotor_ros.identify.health.records import NEVER_HOURS
     from satmotor_ros.identify.health.report import write_monitor
     from satmotor_ros.identify.health.run import monitor_recordings
     from satmotor_ros.model import ModelError
@@ -146,11 +147,12 @@ def _watch(table: Any, baseline: dict[str, Any], state: str, out: Path) -> dict[
         text = str(err).strip().splitlines()
         raise Refused('the health monitor: ' + (text[0] if text else type(err).__name__)) \
             from None
+    hours = content.get('hours_to_limit')  # NEVER_HOURS: not drifting
     snap = run.snapshot  # its alarms carry their final names (update()'s may be 'pending')
     span = run.recordings[0] if run.recordings else None
     return {'leakage_factor': snap.leakage_factor.as_dict(), 'learning': snap.learning,
             'trend_per_hour': content.get('trend_per_hour'),
-            'hours_to_limit': content.get('hours_to_limit'),
+            'hours_to_limit': None if hours == NEVER_HOURS else hours,  # days_to_limit null
             'alarms': [a.as_dict() for a in snap.alarms],
             'span_s': [span.start_s + monitor.t0, span.end_s + monitor.t0] if span else None,
             'n_samples': snap.n_samples, 'n_skipped': snap.n_skipped}

@@ -39,6 +39,7 @@ from satmotor_ros.identify.coverage import calibrated_envelope
 from satmotor_ros.identify.errors import DataError
 from satmotor_ros.identify.health import (Baseline, HealthMonitor, HealthSamples,
                                           HealthSettings, HealthSnapshot)
+from satmotor_ros.identify.health.records import hours_note
 from satmotor_ros.interface import CHANNELS, DIAGNOSTICS, HEALTH_TOPICS, JOINT_NAME
 from satmotor_ros.model import ModelError
 from satmotor_ros.model.units import gauge
@@ -505,6 +506,7 @@ def _figures(snap: HealthSnapshot) -> dict[str, Any]:
         'trend_per_hour ci95 [1/h]': _interval(snap.trend_per_hour),
         'hours_to_limit [h]': f'{snap.hours_to_limit.value:.4g}',
         'hours_to_limit ci95 [h]': _interval(snap.hours_to_limit),
+        'hours_to_limit note': hours_note(snap.hours_to_limit.value),
         'limit_leakage_factor [-]': f'{snap.limit_leakage_factor:.4g}',
         'volumetric_efficiency [-]': f'{snap.volumetric_efficiency:.4g}',
         'volumetric_efficiency reference [-]':

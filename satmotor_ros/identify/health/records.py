@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 import math
+import sys
 
 import numpy as np
 
@@ -14,6 +15,57 @@ from satmotor_ros.model._typing import FloatArray
 
 SKIP_REASONS = ('stalled', 'outside_envelope', 'outside_model', 'stale', 'non_finite')
 """Why a sample is not used, as :attr:`HealthSnapshot.skipped` counts them."""
+
+NEVER_HOURS = sys.float_info.max
+"""``hours_to_limit`` in ``monitor.json`` when the trend does not rise towards the limit: the
+topic's inf (DESIGN.md), written as the largest double since JSON has no Infinity (jq writes
+an infinity so too); it reads back as a float no real figure reaches, [h]."""
+
+
+def hours_json(x: float) -> float | None:
+    """
+    Return hours to the limit as ``monitor.json`` writes them.
+
+    Parameters
+    ----------
+    x : float
+        Hours; inf when the trend does not rise towards the limit, NaN with no trend yet, [h]
+
+    Returns
+    -------
+    float or None
+        6 digits; :data:`NEVER_HOURS` for inf; None (null) for NaN: no figure yet.
+
+    """
+    if math.isnan(x):
+        return None
+    if math.isinf(x):
+        return NEVER_HOURS if x > 0 else -NEVER_HOURS
+    return float(f'{x:.6g}')
+
+
+def hours_note(x: float) -> str:
+    """
+    Say what an hours-to-limit figure means, as ``monitor.json`` and the diagnostics do.
+
+    Parameters
+    ----------
+    x : float
+        Hours to the limit, [h]
+
+    Returns
+    -------
+    str
+        One line.
+
+    """
+    if math.isnan(x):
+        return 'null: not enough operation for a trend yet'
+    if math.isinf(x):
+        return ('never: the trend does not rise significantly towards the limit (its 95 % '
+                'interval holds no rise); written as the largest double, 1.7976931348623157e308 '
+                '(JSON has no Infinity); ci95[0] is the soonest crossing it allows')
+    return "hours of the recording's time from the last sample (95 % interval in ci95)"
 
 
 @dataclass(frozen=True)
@@ -216,4 +268,4 @@ class HealthSnapshot:
 
 
 __all__ = ['Alarm', 'Estimate', 'HealthPoint', 'HealthSamples', 'HealthSettings',
-           'HealthSnapshot', 'SKIP_REASONS']
+           'HealthSnapshot', 'hours_json', 'hours_note', 'NEVER_HOURS', 'SKIP_REASONS']

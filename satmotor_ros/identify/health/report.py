@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from satmotor_ros.identify.health.records import Estimate, HealthPoint
+from satmotor_ros.identify.health.records import Estimate, HealthPoint, hours_json, hours_note
 from satmotor_ros.identify.health.run import MonitorRun
 from satmotor_ros.identify.plot_tools import portable
 from satmotor_ros.identify.report import pyplot
@@ -44,7 +44,8 @@ def summary(run: MonitorRun) -> dict[str, Any]:
     -------
     dict
         ``alarms``, ``leakage_factor`` (time series with intervals), ``trend_per_hour``,
-        ``hours_to_limit`` (null when the trend does not reach the limit), ``n_samples``,
+        ``hours_to_limit`` (a number: :data:`~.records.NEVER_HOURS` when the trend does
+        not rise towards the limit; null only before there is a trend), ``n_samples``,
         ``n_skipped`` first, then the figures now, the detector and the recordings; times
         are seconds from the first sample, ``t0_s`` that sample on the data's own time column
         (``t0_epoch`` too for an epoch clock).
@@ -52,22 +53,15 @@ def summary(run: MonitorRun) -> dict[str, Any]:
     """
     snap = run.snapshot
     to_limit = snap.hours_to_limit
-    if math.isfinite(to_limit.value):
-        why = "hours of the recording's time from the last sample (95 % interval in ci95)"
-    elif math.isinf(to_limit.value):
-        why = ('null: the trend does not rise significantly towards the limit (its 95 % '
-               'interval holds no rise); ci95[0] is the soonest crossing it allows')
-    else:
-        why = 'null: not enough operation for a trend yet'
     out: dict[str, Any] = {
         'alarms': [a.as_dict() for a in snap.alarms],
         'leakage_factor': [{'time_s': _num(p.time_s, 9), **p.leakage_factor.as_dict(),
                             'learning': p.learning} for p in run.points],
         'trend_per_hour': _num(snap.trend_per_hour.value),
         'trend_per_hour_ci95': snap.trend_per_hour.as_dict()['ci95'],
-        'hours_to_limit': _num(to_limit.value),
-        'hours_to_limit_ci95': to_limit.as_dict()['ci95'],
-        'hours_to_limit_note': why,
+        'hours_to_limit': hours_json(to_limit.value),
+        'hours_to_limit_ci95': [hours_json(to_limit.low), hours_json(to_limit.high)],
+        'hours_to_limit_note': hours_note(to_limit.value),
         'n_samples': snap.n_samples, 'n_skipped': snap.n_skipped, 'skipped': snap.skipped,
         'limit_leakage_factor': _num(snap.limit_leakage_factor),
         'leakage_factor_now': snap.leakage_factor.as_dict(),
