@@ -84,6 +84,35 @@ def test_discovery_groups_by_first_level_and_orders_by_time_and_says_how(tmp_pat
         ('m2/bag1', 'bag', BAG_START)]
 
 
+def test_motor_ids_are_distinct_and_never_a_report_file(tmp_path):
+    """Directories that make one safe id, or a report's name, stay apart (F7, F8)."""
+    root = tmp_path / 'root'
+    for top in ('a b', 'a_b', 'a?b', 'plots', 'fleet.json', 'FLEET', 'given', 'root'):
+        _csv(root / top / 'r.csv')
+    _csv(root / 'x.csv')  # ROOT's own file: motor 'root', apart from the directory 'root'
+    _csv(root / 'ships' / 'r.csv')
+    (root / 'fleet.yaml').write_text('motors: [{pattern: "ships/**", motor: given}]\n')
+    motors = discover(root, load_fleet(root / 'fleet.yaml'))
+    ids = {m.motor: [r.relative for r in m.recordings] for m in motors}
+    assert len(ids) == 10 and ids['a_b'] == ['a_b/r.csv'] and ids['given'] == ['ships/r.csv']
+    reserved = {'fleet', 'fleet.json', 'fleet.md', 'plots'}
+    assert not {i.lower() for i in ids} & reserved
+    again = {m.motor for m in discover(root, load_fleet(root / 'fleet.yaml'))}
+    assert again == set(ids)  # deterministic
+    assert ids['root'] == ['root/r.csv']
+    assert sorted(i.split('~')[0] for i in set(ids) - {'a_b', 'given', 'root'}) == [
+        'FLEET', 'a_b', 'a_b', 'fleet.json', 'given', 'plots', 'root']
+
+
+@pytest.mark.parametrize('motor', ['fleet.json', 'fleet.md', 'plots', 'Fleet'])
+def test_a_fleet_yaml_motor_named_as_a_report_file_is_refused_in_one_line(tmp_path, motor):
+    path = tmp_path / 'fleet.yaml'
+    path.write_text(f'motors: [{{pattern: "a/**", motor: {motor}}}]')
+    with pytest.raises(FleetError, match=f"motor = '{motor}': the name of the report") as err:
+        load_fleet(path)
+    assert '\n' not in str(err.value)
+
+
 def test_path_date_takes_the_last_date_of_the_path():
     assert path_date('2025-01-01/run_20260301_120000.csv') == EPOCH + 12 * 3600
     assert path_date('unit7/run_99.csv') is None

@@ -16,6 +16,13 @@ from satmotor_ros.model.units import parse_quantity
 FLEET_FILE = 'fleet.yaml'
 """The fleet description looked for in ROOT when ``--fleet`` is not given."""
 
+REPORT_JSON, REPORT_MD, PLOTS, FLEET_PLOT = 'fleet.json', 'fleet.md', 'plots', 'fleet'
+"""The fleet's own files in DIR: its report, the plots' directory and the fleet's plot
+(``plots/fleet.png``) beside each motor's (``plots/<motor>.png``)."""
+
+RESERVED = (REPORT_JSON, REPORT_MD, PLOTS, FLEET_PLOT)
+"""Names no motor id may take (in any case): its directory or plot would be a report file."""
+
 LIQUIDS = ('oil', 'water')
 """The liquids a fleet.yaml entry may name (the packaged coefficient sets)."""
 
@@ -195,6 +202,9 @@ def _rule(entry: Any, where: str, base: Path) -> MotorRule:
     if not _MOTOR_ID.fullmatch(entry['motor']):
         raise FleetError(f"{where}: motor = {shown(entry['motor'])}: need letters, digits, "
                          "'.', '_' or '-' (it names a directory), at most 100")
+    if entry['motor'].lower() in RESERVED:
+        raise FleetError(f"{where}: motor = {shown(entry['motor'])}: the name of the report's "
+                         f"own {', '.join(RESERVED)} (in DIR): name the motor otherwise")
     liquid = entry.get('liquid', '')
     if liquid and liquid not in LIQUIDS:
         raise FleetError(f'{where}: liquid = {shown(liquid)}: need one of {", ".join(LIQUIDS)}')
@@ -244,4 +254,5 @@ def _columns(value: Any, where: str, base: Path) -> tuple[str, dict[str, Any] | 
     return (str(local.resolve()) if local.exists() else value), None
 
 
-__all__ = ['FLEET_FILE', 'FleetConfig', 'LIQUIDS', 'MotorRule', 'glob_regex', 'load_fleet']
+__all__ = ['FLEET_FILE', 'FLEET_PLOT', 'FleetConfig', 'LIQUIDS', 'MotorRule', 'PLOTS', 'REPORT_JSON',
+           'REPORT_MD', 'RESERVED', 'glob_regex', 'load_fleet']

@@ -14,13 +14,14 @@ here (a bag's metadata, a CSV's first two lines), nothing of the data.
 from __future__ import annotations
 
 from dataclasses import dataclass
+import hashlib
 from datetime import datetime, timezone
 import os
 from pathlib import Path
 import re
 
 from satmotor_ros.bounded_yaml import read_yaml, YamlLimitError
-from satmotor_ros.fleet.config import FLEET_FILE, FleetConfig, MotorRule
+from satmotor_ros.fleet.config import FLEET_FILE, FleetConfig, MotorRule, RESERVED
 
 BAG_START = 'bag start time'
 TIME_COLUMN = 'time column (epoch s)'
@@ -92,18 +93,23 @@ def discover(root: str | Path, config: FleetConfig, skip: tuple[Path, ...] = ())
     """
     base = Path(root).resolve()
     skipped = {p.resolve() for p in skip}
-    found: dict[str, list[Recording]] = {}
-    rules: dict[str, MotorRule] = {}
+    placed: list[tuple[Path, str, str, MotorRule | None, str]] = []
     for path, kind in _walk(base, skipped):
         relative = path.relative_to(base).as_posix()
         rule = config.rule_for(relative)
-        if rule is None:
-            top = relative.split('/')[0] if '/' in relative else base.name
-            rule = MotorRule('', _motor_id(top))
+        top = relative.split('/')[0] if '/' in relative else '/' + base.name  # ROOT's files
+        columns = rule is not None and bool(rule.columns or rule.columns_inline)
         if kind == 'text':
-            if path.suffix.lower() != '.csv' and not (rule.columns or rule.columns_inline):
+            if path.suffix.lower() != '.csv' and not columns:
                 continue
-            kind = 'log' if rule.columns or rule.columns_inline else 'csv'
+            kind = 'log' if columns else 'csv'
+        placed.append((path, relative, kind, rule, top))
+    ids = derived_ids({top for *_, rule, top in placed if rule is None},
+                      {rule.motor for rule in config.rules})
+    found: dict[str, list[Recording]] = {}
+    rules: dict[str, MotorRule] = {}
+    for path, relative, kind, given, top in placed:
+        rule = given if given is not None else MotorRule('', ids[top])
         rules.setdefault(rule.motor, rule)
         time, source = recording_time(path, kind)
         found.setdefault(rule.motor, []).append(
@@ -114,6 +120,51 @@ def discover(root: str | Path, config: FleetConfig, skip: tuple[Path, ...] = ())
         ordered = tuple(sorted(found[motor], key=lambda r: (r.time, r.relative)))
         motors.append(Motor(motor, rules[motor], _unique(ordered)))
     return motors
+
+
+def derived_ids(tops: set[str], given: set[str]) -> dict[str, str]:
+    """
+    Name the motors no fleet.yaml pattern matched, each directory its own id.
+
+    A directory's id is its name made safe (:func:`_motor_id`). Where that id is another
+    directory's too (``a b`` and ``a_b``), a motor fleet.yaml names, or a name of the report
+    (:data:`~satmotor_ros.fleet.config.RESERVED`), it gets ``~`` and six hexadecimal digits
+    of its name's hash: the same whatever else is in the tree. A directory whose name is its
+    id already keeps it when only altered names collide with it (``a_b`` above).
+
+    Parameters
+    ----------
+    tops : set of str
+        First-level directory names under ROOT; ``'/'`` and ROOT's name for its own files
+        (their motor is named after ROOT, apart from a directory of that name), [-]
+    given : set of str
+        The motor ids fleet.yaml names, [-]
+
+    Returns
+    -------
+    dict
+        Each name's motor id, all distinct and none of `given` or of the report's.
+
+    Examples
+    --------
+    >>> ids = derived_ids({'a b', 'a_b', 'plots', 'm1'}, {'m1'})
+    >>> ids['a_b'], ids['a b'] != 'a_b', ids['plots'] != 'plots', ids['m1'] != 'm1'
+    ('a_b', True, True, True)
+
+    """
+    safe = {top: _motor_id(top.lstrip('/')) for top in tops}
+    taken = {id_.lower() for id_ in given} | set(RESERVED)
+    out = {}
+    for top, id_ in safe.items():
+        rivals = [t for t, other in safe.items() if other.lower() == id_.lower() and t != top]
+        clash = id_.lower() in taken or bool(rivals) and (top != id_ or any(t == safe[t]
+                                                                        for t in rivals))
+        if clash:
+            digest = hashlib.blake2b(top.encode('utf-8', 'surrogateescape'),
+                                     digest_size=3).hexdigest()
+            id_ = f'{id_}~{digest}'
+        out[top] = id_
+    return out
 
 
 def _walk(base: Path, skipped: set[Path]) -> list[tuple[Path, str]]:
@@ -268,4 +319,4 @@ def path_date(text: str) -> float | None:
 
 
 __all__ = ['BAG_FILES', 'BAG_START', 'EPOCH_RANGE', 'LOG_SUFFIXES', 'MTIME', 'Motor', 'PATH_DATE',
-           'Recording', 'TIME_COLUMN', 'discover', 'path_date', 'recording_time']
+           'Recording', 'TIME_COLUMN', 'derived_ids', 'discover', 'path_date', 'recording_time']

@@ -12,10 +12,8 @@ from typing import Any
 import numpy as np
 
 from satmotor_ros.cli._output import png_metadata
+from satmotor_ros.fleet.config import FLEET_PLOT, PLOTS, REPORT_JSON, REPORT_MD
 from satmotor_ros.fleet.health import RATIO
-
-PLOTS = 'plots'
-"""The plots' directory under DIR: one PNG per motor and ``fleet.png``."""
 
 
 def _replace(path: Path, text: str) -> None:
@@ -41,9 +39,9 @@ def write_report(out: Path, motors: list[dict[str, Any]], header: dict[str, Any]
     (out / PLOTS).mkdir(parents=True, exist_ok=True)
     for motor in motors:
         plot_motor(out / PLOTS / f"{motor['motor']}.png", motor)
-    plot_fleet(out / PLOTS / 'fleet.png', motors)
-    _replace(out / 'fleet.json', json.dumps({**header, 'motors': motors}, indent=1) + '\n')
-    _replace(out / 'fleet.md', markdown(motors, header))
+    plot_fleet(out / PLOTS / f'{FLEET_PLOT}.png', motors)
+    _replace(out / REPORT_JSON, json.dumps({**header, 'motors': motors}, indent=1) + '\n')
+    _replace(out / REPORT_MD, markdown(motors, header))
 
 
 def _days(value: float | None) -> str:
