@@ -113,6 +113,28 @@ def test_a_fleet_yaml_motor_named_as_a_report_file_is_refused_in_one_line(tmp_pa
     assert '\n' not in str(err.value)
 
 
+def test_a_mapped_log_is_timed_by_its_epoch_column_and_roots_own_date_is_not_one(tmp_path):
+    """F4: a log read through a mapping by its ``time`` column (in ms), not its mtime; a date
+    in ROOT's own path is not a recording's."""
+    root = tmp_path / '2024-05-01' / 'fleet'
+    log = root / 'rig' / 'run.log'
+    log.parent.mkdir(parents=True)
+    log.write_text('stamp\tn\tq\tpa\tpb\n'
+                   + ''.join(f'{(EPOCH + 2 * DAY + i) * 1e3:.0f}\t1000\t20\t10\t1\n'
+                             for i in range(3)))
+    os.utime(log, (EPOCH, EPOCH))
+    _csv(root / 'm2' / 'no_time.csv')  # neither time column nor date below ROOT: mtime
+    os.utime(root / 'm2' / 'no_time.csv', (EPOCH + DAY, EPOCH + DAY))
+    (root / 'fleet.yaml').write_text(
+        'motors: [{pattern: "rig/**", motor: rig, columns: {columns: {time: {column: stamp, '
+        'unit: ms}, speed: {column: n, unit: rpm}, flow: {column: q, unit: l/min}, '
+        'p_in: {column: pa, unit: MPa}, p_out: {column: pb, unit: MPa}}}}]\n')
+    m2, rig = discover(root, load_fleet(root / 'fleet.yaml'))
+    assert [(r.kind, r.time_source, r.time) for r in rig.recordings] == [
+        ('log', TIME_COLUMN, EPOCH + 2 * DAY)]
+    assert [(r.time_source, r.time) for r in m2.recordings] == [(MTIME, EPOCH + DAY)]
+
+
 def test_path_date_takes_the_last_date_of_the_path():
     assert path_date('2025-01-01/run_20260301_120000.csv') == EPOCH + 12 * 3600
     assert path_date('unit7/run_99.csv') is None

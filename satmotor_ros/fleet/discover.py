@@ -6,9 +6,10 @@ A recording is a rosbag2 directory (one with ``metadata.yaml`` or a storage file
 entered), a bench CSV, or, for a motor whose fleet.yaml entry gives ``columns``, any other
 text log. Its motor is the first fleet.yaml pattern that matches it (or a parent directory), else
 the first directory level under ROOT. Its time is the bag's start time, else the first
-value of a ``time`` column when it holds epoch seconds, else a date (and time) in its
-path, else -- said as such -- the file's modification time. Only what these need is read
-here (a bag's metadata, a CSV's first two lines), nothing of the data.
+value of a ``time`` column when it holds epoch seconds (a log's read through its motor's
+column mapping), else a date (and time) in its path below ROOT, else -- said as such -- the
+file's modification time. Only what these need is read here (a bag's metadata, a CSV's first
+two lines, a log's first 64 kB), nothing more of the data.
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ from datetime import datetime, timezone
 import os
 from pathlib import Path
 import re
+from typing import Any
 
 from satmotor_ros.bounded_yaml import read_yaml, YamlLimitError
 from satmotor_ros.fleet.config import FLEET_FILE, FleetConfig, MotorRule, RESERVED
@@ -108,10 +110,13 @@ def discover(root: str | Path, config: FleetConfig, skip: tuple[Path, ...] = ())
                       {rule.motor for rule in config.rules})
     found: dict[str, list[Recording]] = {}
     rules: dict[str, MotorRule] = {}
+    mappings: dict[str, Any] = {}
     for path, relative, kind, given, top in placed:
         rule = given if given is not None else MotorRule('', ids[top])
         rules.setdefault(rule.motor, rule)
-        time, source = recording_time(path, kind)
+        if kind == 'log' and rule.motor not in mappings:
+            mappings[rule.motor] = _mapping(rule)
+        time, source = recording_time(path, kind, relative, mappings.get(rule.motor))
         found.setdefault(rule.motor, []).append(
             Recording(str(path), relative, rule.motor, kind, time, source,
                       _name(relative, rule)))
@@ -219,7 +224,8 @@ def _unique(recordings: tuple[Recording, ...]) -> tuple[Recording, ...]:
     return tuple(out)
 
 
-def recording_time(path: Path, kind: str) -> tuple[float, str]:
+def recording_time(path: Path, kind: str, relative: str = '',
+                   mapping: Any = None) -> tuple[float, str]:
     """
     Find when a recording started, and how.
 
@@ -229,6 +235,11 @@ def recording_time(path: Path, kind: str) -> tuple[float, str]:
         The file or bag directory, [-]
     kind : str
         ``'bag'``, ``'csv'`` or ``'log'``, [-]
+    relative : str
+        Its path below ROOT, where a date counts (one in ROOT's own path is not the
+        recording's); '' for the file's name only, [-]
+    mapping : ColumnMapping or None
+        A log's column mapping (its ``time`` column is read through it); None for none, [-]
 
     Returns
     -------
@@ -244,13 +255,56 @@ def recording_time(path: Path, kind: str) -> tuple[float, str]:
         found = _time_column(path)
         if found is not None:
             return found, TIME_COLUMN
-    found = path_date(str(path))
+    elif kind == 'log' and mapping is not None:
+        found = _mapped_time(path, mapping)
+        if found is not None:
+            return found, TIME_COLUMN
+    found = path_date(relative or path.name)
     if found is not None:
         return found, PATH_DATE
     try:
         return path.stat().st_mtime, MTIME
     except OSError:
         return 0.0, MTIME
+
+
+def _mapping(rule: MotorRule) -> Any:
+    """Return a motor's column mapping, or None when it cannot be read (its runs say why)."""
+    from satmotor_ros.identify import DataError
+    from satmotor_ros.identify.columns import load_mapping, mapping_from_dict
+    try:
+        if rule.columns_inline is not None:
+            return mapping_from_dict(rule.columns_inline)
+        return load_mapping(rule.columns) if rule.columns else None
+    except DataError:
+        return None
+
+
+def _mapped_time(path: Path, mapping: Any) -> float | None:
+    """
+    Return a log's first ``time`` value through its mapping when it is epoch seconds.
+
+    Only the log's head is read (its first 64 kB, to the last whole line), through the
+    mapping as the run reads the whole (units converted: a time in ms is seconds here too).
+    """
+    import tempfile
+    from satmotor_ros.identify.columns import read_log
+    if 'time' not in mapping.fields:
+        return None
+    try:
+        with path.open('rb') as file:
+            head = file.read(_HEAD_BYTES)
+        head = head[:head.rfind(b'\n') + 1]
+        if not head:
+            return None
+        with tempfile.TemporaryDirectory(prefix='satmotor-fleet-') as scratch:
+            part = Path(scratch) / path.name
+            part.write_bytes(head)
+            table = read_log(part, mapping)
+        value = float(table.channels['time'][0])
+    except Exception:  # noqa: B902 - a log the mapping cannot read is timed otherwise
+        return None
+    return value if EPOCH_RANGE[0] <= value <= EPOCH_RANGE[1] else None
 
 
 def _bag_start(path: Path) -> float | None:
