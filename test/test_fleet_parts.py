@@ -114,8 +114,11 @@ def test_a_fleet_yaml_motor_named_as_a_report_file_is_refused_in_one_line(tmp_pa
 
 
 def test_a_mapped_log_is_timed_by_its_epoch_column_and_roots_own_date_is_not_one(tmp_path):
-    """F4: a log read through a mapping by its ``time`` column (in ms), not its mtime; a date
-    in ROOT's own path is not a recording's."""
+    """
+    F4: a log is timed by its epoch ``time`` column through its mapping, not its mtime.
+
+    A date in ROOT's own path is no recording's.
+    """
     root = tmp_path / '2024-05-01' / 'fleet'
     log = root / 'rig' / 'run.log'
     log.parent.mkdir(parents=True)

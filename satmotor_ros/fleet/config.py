@@ -254,5 +254,5 @@ def _columns(value: Any, where: str, base: Path) -> tuple[str, dict[str, Any] | 
     return (str(local.resolve()) if local.exists() else value), None
 
 
-__all__ = ['FLEET_FILE', 'FLEET_PLOT', 'FleetConfig', 'LIQUIDS', 'MotorRule', 'PLOTS', 'REPORT_JSON',
-           'REPORT_MD', 'RESERVED', 'glob_regex', 'load_fleet']
+__all__ = ['FLEET_FILE', 'FLEET_PLOT', 'FleetConfig', 'LIQUIDS', 'MotorRule', 'PLOTS',
+           'REPORT_JSON', 'REPORT_MD', 'RESERVED', 'glob_regex', 'load_fleet']

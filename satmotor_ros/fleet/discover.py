@@ -15,8 +15,8 @@ two lines, a log's first 64 kB), nothing more of the data.
 from __future__ import annotations
 
 from dataclasses import dataclass
-import hashlib
 from datetime import datetime, timezone
+import hashlib
 import os
 from pathlib import Path
 import re
@@ -162,8 +162,8 @@ def derived_ids(tops: set[str], given: set[str]) -> dict[str, str]:
     out = {}
     for top, id_ in safe.items():
         rivals = [t for t, other in safe.items() if other.lower() == id_.lower() and t != top]
-        clash = id_.lower() in taken or bool(rivals) and (top != id_ or any(t == safe[t]
-                                                                        for t in rivals))
+        yields = top != id_ or any(t == safe[t] for t in rivals)  # to a name that is its id
+        clash = id_.lower() in taken or bool(rivals) and yields
         if clash:
             digest = hashlib.blake2b(top.encode('utf-8', 'surrogateescape'),
                                      digest_size=3).hexdigest()
