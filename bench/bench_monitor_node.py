@@ -20,9 +20,7 @@ from __future__ import annotations
 import argparse
 import os
 from pathlib import Path
-import subprocess
 import sys
-import threading
 import time
 import uuid
 
@@ -31,9 +29,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))  # this source tree's satmotor_ros
 
 from diagnostic_msgs.msg import DiagnosticArray  # noqa: E402
-from rclpy.context import Context  # noqa: E402
-from rclpy.executors import SingleThreadedExecutor  # noqa: E402
-from rclpy.node import Node  # noqa: E402
+import node_process  # noqa: E402
 from rclpy.qos import qos_profile_sensor_data  # noqa: E402
 from satmotor_ros.identify.health import (Baseline, HealthMonitor, HealthSamples,  # noqa: E402
                                           HealthSettings)
@@ -63,11 +59,6 @@ def run_floor() -> None:
     finally:
         node.destroy_node()
         rclpy.try_shutdown()
-
-
-def _cpu_seconds(pid: int) -> float:
-    fields = Path(f'/proc/{pid}/stat').read_text().rsplit(')', 1)[1].split()
-    return (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK')
 
 
 def estimator_us(samples: HealthSamples, block: int, learn_hours: float) -> float:
@@ -107,77 +98,48 @@ def measure(seconds: float, rate: float, learn_hours: float,
     table = generate_series(Plan(), [Injection()], seed=1, samples=n, rate=rate)
     samples = HealthSamples.from_table(table)
     namespace = f'/bench_{uuid.uuid4().hex[:8]}'
-    env = dict(os.environ, PYTHONPATH=str(ROOT))
     code = ('import sys; sys.path.insert(0, %r); import bench_monitor_node as b; '
             'b.run_floor()' % str(ROOT / 'bench')) if floor else \
         'from satmotor_ros.nodes.motor_monitor import main; main()'
     params = [] if floor else ['-p', f'motor_file:={PACKAGED}', '-p',
                                f'learn_hours:={learn_hours}', '-p', 'diagnostics_period:=1.0']
-    proc = subprocess.Popen([sys.executable, '-c', code, '--ros-args', '-r',
-                             f'__ns:={namespace}', *params], env=env)
-    context = Context()
-    context.init(args=[])
-    node = Node(f'bench_{uuid.uuid4().hex[:8]}', context=context)
-    executor = SingleThreadedExecutor(context=context)
-    executor.add_node(node)
-    sensor = qos_profile_sensor_data
-    pressure = {name: node.create_publisher(FluidPressure, f'{namespace}/{CHANNELS[name].topic}',
-                                            sensor) for name in ('p_in', 'p_out', 'p_case')}
-    flow = node.create_publisher(Float64, f'{namespace}/{CHANNELS["flow_measured"].topic}',
-                                 sensor)
-    temperature = node.create_publisher(
-        Temperature, f'{namespace}/{CHANNELS["temperature"].topic}', sensor)
-    joint = node.create_publisher(JointState, f'{namespace}/{CHANNELS["measured_speed"].topic}',
-                                  sensor)
-    taken = [0]
+    proc = node_process.start(code, '-r', f'__ns:={namespace}', *params)
+    with node_process.driver(proc) as (node, executor):
+        sensor = qos_profile_sensor_data
+        pressure = {name: node.create_publisher(
+            FluidPressure, f'{namespace}/{CHANNELS[name].topic}', sensor)
+            for name in ('p_in', 'p_out', 'p_case')}
+        flow = node.create_publisher(Float64, f'{namespace}/{CHANNELS["flow_measured"].topic}',
+                                     sensor)
+        temperature = node.create_publisher(
+            Temperature, f'{namespace}/{CHANNELS["temperature"].topic}', sensor)
+        joint = node.create_publisher(
+            JointState, f'{namespace}/{CHANNELS["measured_speed"].topic}', sensor)
+        taken = [0]
 
-    def on_diagnostics(msg: DiagnosticArray) -> None:
-        for status in msg.status:
-            if status.name.startswith(namespace):
-                taken[0] = int({kv.key: kv.value for kv in status.values}['samples taken'])
-    node.create_subscription(DiagnosticArray, DIAGNOSTICS, on_diagnostics, 10)
-    try:
-        deadline = time.monotonic() + 30.0
-        while time.monotonic() < deadline and not joint.get_subscription_count():
-            executor.spin_once(timeout_sec=0.05)
+        def on_diagnostics(msg: DiagnosticArray) -> None:
+            for status in msg.status:
+                if status.name.startswith(namespace):
+                    taken[0] = int({kv.key: kv.value for kv in status.values}['samples taken'])
+        node.create_subscription(DiagnosticArray, DIAGNOSTICS, on_diagnostics, 10)
+        node_process.spin_until(executor, lambda: bool(joint.get_subscription_count()))
         time.sleep(1.0)  # the node's own start-up, outside the measurement
-        cpu0, taken0 = _cpu_seconds(proc.pid), taken[0]
+        cpu0, taken0 = node_process.cpu_seconds(proc.pid), taken[0]
 
-        def feed() -> None:
-            period = 1.0 / rate
-            start = time.monotonic()
-            for k in range(n):
-                target = start + k * period
-                while (now := time.monotonic()) < target:
-                    time.sleep(min(target - now, 2e-4))
-                for name, values in (('p_in', samples.p_in), ('p_out', samples.p_out),
-                                     ('p_case', samples.p_case)):
-                    pressure[name].publish(FluidPressure(
-                        fluid_pressure=float(values[k]) + ATMOSPHERE))
-                temperature.publish(Temperature(temperature=float(samples.temperature[k])))
-                flow.publish(Float64(data=float(samples.flow[k])))
-                msg = JointState(name=[JOINT_NAME], velocity=[float(samples.speed[k])])
-                msg.header.stamp = node.get_clock().now().to_msg()
-                joint.publish(msg)
+        def publish(k: int) -> None:
+            for name, values in (('p_in', samples.p_in), ('p_out', samples.p_out),
+                                 ('p_case', samples.p_case)):
+                pressure[name].publish(FluidPressure(
+                    fluid_pressure=float(values[k]) + ATMOSPHERE))
+            temperature.publish(Temperature(temperature=float(samples.temperature[k])))
+            flow.publish(Float64(data=float(samples.flow[k])))
+            msg = JointState(name=[JOINT_NAME], velocity=[float(samples.speed[k])])
+            msg.header.stamp = node.get_clock().now().to_msg()
+            joint.publish(msg)
 
-        feeder = threading.Thread(target=feed)
-        feeder.start()
-        while feeder.is_alive():
-            executor.spin_once(timeout_sec=0.01)
-        end = time.monotonic() + 2.5  # the last update and diagnostics
-        while time.monotonic() < end:
-            executor.spin_once(timeout_sec=0.01)
-        cpu = _cpu_seconds(proc.pid) - cpu0
-    finally:
-        executor.shutdown()
-        node.destroy_node()
-        context.try_shutdown()
-        proc.send_signal(2)
-        try:
-            proc.wait(10)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait()
+        # drain 2.5 s: the last update and diagnostics
+        node_process.spin_feeding(executor, node_process.on_schedule(rate, n, publish), 2.5)
+        cpu = node_process.cpu_seconds(proc.pid) - cpu0
     got = n if floor else max(taken[0] - taken0, 1)
     own = estimator_us(samples, max(1, int(rate)), learn_hours)
     return {'sent': n, 'taken': got, 'cpu_us': cpu / got * 1e6, 'estimator_us': own,

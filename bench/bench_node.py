@@ -22,9 +22,7 @@ from __future__ import annotations
 import argparse
 import os
 from pathlib import Path
-import subprocess
 import sys
-import threading
 import time
 import uuid
 
@@ -32,10 +30,9 @@ os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))  # this source tree's satmotor_ros
 
+import node_process  # noqa: E402
 import numpy as np  # noqa: E402
 import rclpy  # noqa: E402
-from rclpy.context import Context  # noqa: E402
-from rclpy.executors import SingleThreadedExecutor  # noqa: E402
 from rclpy.node import Node  # noqa: E402
 from satmotor_ros.model import MotorModel  # noqa: E402
 from satmotor_ros.model.units import LPM, MPA  # noqa: E402
@@ -68,11 +65,6 @@ def run_relay() -> None:
         rclpy.try_shutdown()
 
 
-def _cpu_seconds(pid: int) -> float:
-    fields = Path(f'/proc/{pid}/stat').read_text().rsplit(')', 1)[1].split()
-    return (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK')
-
-
 def measure(kind: str, seconds: float, rate: float, namespace: str,
             parameters: tuple[str, ...] = ()) -> dict[str, float]:
     """
@@ -97,76 +89,46 @@ def measure(kind: str, seconds: float, rate: float, namespace: str,
         p50, p99 [ms], drops, sent, cpu per message [us].
 
     """
-    env = dict(os.environ, PYTHONPATH=str(ROOT))
     code = ('import sys; sys.path.insert(0, %r); import bench_node; bench_node.run_relay()'
             % str(ROOT / 'bench')) if kind == 'relay' else \
         'from satmotor_ros.nodes.motor_model import main; main()'
     extra = [arg for p in parameters for arg in ('-p', p)]
-    proc = subprocess.Popen([sys.executable, '-c', code, '--ros-args', '-r',
-                             f'__ns:={namespace}', *extra], env=env)
-    context = Context()
-    context.init(args=[])  # not this script's own options (rcl would read NAME:=VALUE)
-    node = Node(f'bench_{uuid.uuid4().hex[:8]}', context=context)
-    executor = SingleThreadedExecutor(context=context)
-    executor.add_node(node)
+    proc = node_process.start(code, '-r', f'__ns:={namespace}', *extra)
     n = int(seconds * rate)
     flows = (5.0 + 30.0 * np.arange(n) / n) * LPM
     received: list[tuple[int, float]] = []
-    flow_pub = node.create_publisher(Float64, f'{namespace}/flow_command', 10)
-    p_in = node.create_publisher(FluidPressure, f'{namespace}/inlet_pressure', 10)
-    p_out = node.create_publisher(FluidPressure, f'{namespace}/outlet_pressure', 10)
-    if kind == 'relay':
-        node.create_subscription(Float64, f'{namespace}/relay_out',
-                                 lambda m: received.append((time.monotonic_ns(), m.data)), 10)
-    else:
-        node.create_subscription(
-            JointState, f'{namespace}/predicted_joint_state',
-            lambda m: received.append((time.monotonic_ns(), m.velocity[0])), 10)
     sent = np.zeros(n, dtype=np.int64)
-    try:
-        deadline = time.monotonic() + 30.0
-        while time.monotonic() < deadline and not (
-                flow_pub.get_subscription_count() and node.count_publishers(
-                    f'{namespace}/relay_out' if kind == 'relay'
-                    else f'{namespace}/predicted_joint_state')):
-            executor.spin_once(timeout_sec=0.05)
+    with node_process.driver(proc) as (node, executor):
+        flow_pub = node.create_publisher(Float64, f'{namespace}/flow_command', 10)
+        p_in = node.create_publisher(FluidPressure, f'{namespace}/inlet_pressure', 10)
+        p_out = node.create_publisher(FluidPressure, f'{namespace}/outlet_pressure', 10)
+        if kind == 'relay':
+            output = f'{namespace}/relay_out'
+            node.create_subscription(Float64, output,
+                                     lambda m: received.append((time.monotonic_ns(), m.data)),
+                                     10)
+        else:
+            output = f'{namespace}/predicted_joint_state'
+            node.create_subscription(
+                JointState, output,
+                lambda m: received.append((time.monotonic_ns(), m.velocity[0])), 10)
+        node_process.spin_until(executor, lambda: bool(
+            flow_pub.get_subscription_count() and node.count_publishers(output)))
         for _ in range(20):  # the pressures arrive before the first flow_command
             p_in.publish(FluidPressure(fluid_pressure=P_IN))
             p_out.publish(FluidPressure(fluid_pressure=P_OUT))
             executor.spin_once(timeout_sec=0.01)
-        cpu0 = _cpu_seconds(proc.pid)
+        cpu0 = node_process.cpu_seconds(proc.pid)
 
-        def feed() -> None:
-            period = 1.0 / rate
-            start = time.monotonic()
-            for k in range(n):
-                target = start + k * period
-                while (now := time.monotonic()) < target:
-                    time.sleep(min(target - now, 2e-4))
-                if k % max(1, int(rate / 100)) == 0:
-                    p_in.publish(FluidPressure(fluid_pressure=P_IN))
-                    p_out.publish(FluidPressure(fluid_pressure=P_OUT))
-                sent[k] = time.monotonic_ns()
-                flow_pub.publish(Float64(data=flows[k]))
+        def publish(k: int) -> None:
+            if k % max(1, int(rate / 100)) == 0:
+                p_in.publish(FluidPressure(fluid_pressure=P_IN))
+                p_out.publish(FluidPressure(fluid_pressure=P_OUT))
+            sent[k] = time.monotonic_ns()
+            flow_pub.publish(Float64(data=flows[k]))
 
-        feeder = threading.Thread(target=feed)
-        feeder.start()
-        while feeder.is_alive():
-            executor.spin_once(timeout_sec=0.01)
-        end = time.monotonic() + 1.0
-        while time.monotonic() < end:
-            executor.spin_once(timeout_sec=0.01)
-        cpu = _cpu_seconds(proc.pid) - cpu0
-    finally:
-        executor.shutdown()
-        node.destroy_node()
-        context.try_shutdown()
-        proc.send_signal(2)
-        try:
-            proc.wait(10)
-        except subprocess.TimeoutExpired:  # stuck in its shutdown: its numbers are taken
-            proc.kill()
-            proc.wait()
+        node_process.spin_feeding(executor, node_process.on_schedule(rate, n, publish), 1.0)
+        cpu = node_process.cpu_seconds(proc.pid) - cpu0
     if kind == 'relay':
         keys = flows
     else:

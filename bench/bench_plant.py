@@ -20,8 +20,6 @@ import argparse
 from collections.abc import Callable
 import os
 import platform
-import signal
-import subprocess
 import sys
 import time
 
@@ -60,7 +58,6 @@ def cycle(plant: Plant, steps: int, measure: bool = False) -> Callable[[], None]
 
 
 LISTENER = """
-import sys
 import rclpy
 from rclpy.executors import ExternalShutdownException
 from rclpy.qos import qos_profile_sensor_data
@@ -69,7 +66,7 @@ from satmotor_ros.nodes._spin import spin
 from sensor_msgs.msg import FluidPressure, JointState, Temperature
 from std_msgs.msg import Float64
 rclpy.init()
-node = rclpy.create_node('listener', namespace=sys.argv[1])
+node = rclpy.create_node('listener')
 for kind, topic in ((FluidPressure, 'inlet_pressure'), (FluidPressure, 'outlet_pressure'),
                     (FluidPressure, 'case_pressure'), (Float64, 'flow_measured'),
                     (JointState, 'joint_states'), (Temperature, 'fluid_temperature'),
@@ -80,7 +77,7 @@ try:
 except (KeyboardInterrupt, ExternalShutdownException):
     pass
 """
-"""A subscriber to every sensor topic and /clock, run in its own process."""
+"""A subscriber to every sensor topic and /clock, run in its own process (``__ns`` remapped)."""
 
 
 def node_factor(seconds: float, subscribed: bool) -> tuple[float, float]:
@@ -105,6 +102,8 @@ def node_factor(seconds: float, subscribed: bool) -> tuple[float, float]:
     from rclpy.executors import SingleThreadedExecutor
     from rclpy.parameter import Parameter
 
+    import node_process
+
     from satmotor_ros.nodes.virtual_motor import VirtualMotorNode
 
     context = Context()
@@ -118,16 +117,11 @@ def node_factor(seconds: float, subscribed: bool) -> tuple[float, float]:
                                      Parameter('clock_mode', value='sim'),
                                      Parameter('load.torque', value=40.0)])
         executor.add_node(motor)
-        repo = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-        listener = subprocess.Popen([sys.executable, '-c', LISTENER, namespace],
-                                    env={**os.environ, 'PYTHONPATH': os.pathsep.join(
-                                        filter(None, (repo, os.environ.get('PYTHONPATH'))))}) \
+        listener = node_process.start(LISTENER, '-r', f'__ns:={namespace}') \
             if subscribed else None
-        deadline = time.monotonic() + 30.0
-        while listener is not None and motor.count_subscribers(f'{namespace}/joint_states') == 0:
-            executor.spin_once(timeout_sec=0.1)
-            if time.monotonic() > deadline:
-                raise RuntimeError('the listener process did not subscribe within 30 s')
+        if listener is not None and not node_process.spin_until(
+                executor, lambda: motor.count_subscribers(f'{namespace}/joint_states') > 0):
+            raise RuntimeError('the listener process did not subscribe within 30 s')
         motor._command = 20.0 * LPM
         executor.spin_once()
         sim0, wall0, cpu0 = motor.plant.state.time, time.perf_counter(), time.process_time()
@@ -137,12 +131,7 @@ def node_factor(seconds: float, subscribed: bool) -> tuple[float, float]:
         return sim / (time.perf_counter() - wall0), sim / (time.process_time() - cpu0)
     finally:
         if listener is not None:
-            listener.send_signal(signal.SIGINT)
-            try:
-                listener.wait(timeout=10.0)
-            except subprocess.TimeoutExpired:
-                listener.kill()
-                listener.wait()
+            node_process.stop(listener)
         executor.shutdown()
         if motor is not None:
             motor.destroy_node()
