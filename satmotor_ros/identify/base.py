@@ -34,7 +34,7 @@ from typing import Any
 
 import numpy as np
 from satmotor_ros.identify.errors import IdentificationError
-from satmotor_ros.identify.fit import HUBER
+from satmotor_ros.identify.fit import HUBER, huber_rho
 from satmotor_ros.identify.noise import noise_model, rates_of
 from satmotor_ros.identify.parts import loss_parts, NO_EFFECT
 from satmotor_ros.identify.table import BenchTable
@@ -152,8 +152,7 @@ class _Profile:
         if factor not in self.seen:
             try:
                 z = np.abs(self.residual(factor)) / (LPM if self.scale is None else self.scale)
-                self.seen[factor] = float(np.sum(np.where(z <= HUBER, z * z,
-                                                          2.0 * HUBER * z - HUBER * HUBER)))
+                self.seen[factor] = float(np.sum(huber_rho(z)))
             except (IdentificationError, np.linalg.LinAlgError):
                 self.seen[factor] = math.inf
         return self.seen[factor]

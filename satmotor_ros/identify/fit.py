@@ -102,39 +102,27 @@ def check_identifiable(parts: LossParts) -> None:
             raise IdentificationError(msg)
 
 
-def huber_root(z: FloatArray, c: float) -> FloatArray:
-    """
-    Return sign(z) sqrt(rho(z)), Huber's rho: z^2 within c, 2 c |z| - c^2 beyond.
-
-    Least squares on these minimise the sum of rho; the map is smooth at |z| = c.
-
-    Parameters
-    ----------
-    z : ndarray
-        Standardised residuals, [-]
-    c : float
-        Huber's constant, [-]
-
-    Returns
-    -------
-    ndarray
-        The transformed residuals, [-]
-
-    """
+def huber_rho(z: FloatArray, c: float = HUBER) -> FloatArray:
+    """Return 2 rho(z), Huber's loss: z^2 within `c`, 2 c |z| - c^2 beyond, [-]."""
     a = np.abs(z)
-    return np.where(a <= c, z, np.sign(z) * np.sqrt(np.maximum(2.0 * c * a - c * c, 0.0)))
+    return np.where(a <= c, z * z, 2.0 * c * a - c * c)
 
 
-def tukey_root(z: FloatArray, c: float) -> FloatArray:
+def robust_root(z: FloatArray, c: float, redescending: bool = False) -> FloatArray:
     """
-    Return sign(z) sqrt(2 rho(z)), Tukey's biweight rho: a point beyond c weighs nothing.
+    Return sign(z) sqrt(2 rho(z)): Huber's rho, or Tukey's biweight rho if `redescending`.
+
+    Least squares on these minimise the sum of rho. Huber's (:func:`huber_rho`) is smooth
+    at |z| = c; under Tukey's a point beyond c weighs nothing.
 
     Parameters
     ----------
     z : ndarray
         Standardised residuals, [-]
     c : float
-        Tukey's constant, [-]
+        Huber's or Tukey's constant (:data:`HUBER`, :data:`TUKEY`), [-]
+    redescending : bool
+        Tukey's biweight instead of Huber's, [-]
 
     Returns
     -------
@@ -142,8 +130,10 @@ def tukey_root(z: FloatArray, c: float) -> FloatArray:
         The transformed residuals, [-]
 
     """
-    u = np.minimum((z / c) ** 2, 1.0)
-    return np.sign(z) * c * np.sqrt((1.0 - (1.0 - u) ** 3) / 3.0)
+    if redescending:
+        u = np.minimum((z / c) ** 2, 1.0)
+        return np.sign(z) * c * np.sqrt((1.0 - (1.0 - u) ** 3) / 3.0)
+    return np.where(np.abs(z) <= c, z, np.sign(z) * np.sqrt(np.maximum(huber_rho(z, c), 0.0)))
 
 
 @dataclass(frozen=True)
@@ -286,10 +276,8 @@ class LossFit:
 
         def residual(u: FloatArray) -> FloatArray:
             z = (flow - self._predict(parts, u)[index]) / sigma
-            if tukey:
-                z = tukey_root(z, TUKEY)
-            elif c:
-                z = huber_root(z, c)
+            if tukey or c:
+                z = robust_root(z, TUKEY if tukey else c, tukey)
             return np.concatenate((z, (u[:m] - 1.0) / PRIOR_SD)) if prior else z
 
         best = None

@@ -25,7 +25,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from satmotor_ros.identify.fit import HUBER
+from satmotor_ros.identify.fit import huber_rho
 from satmotor_ros.model._typing import FloatArray
 from scipy import special
 
@@ -92,8 +92,9 @@ def acting(additive: FloatArray | float, n: int) -> np.ndarray | None:
     return at
 
 
-def _huber(z: FloatArray) -> FloatArray:
-    return np.where(np.abs(z) <= HUBER, z * z, 2.0 * HUBER * np.abs(z) - HUBER ** 2)
+def _weighted_rho(error: FloatArray, sigma: FloatArray) -> FloatArray:
+    """Return Huber's 2 rho of errors standardised by the noise, back in their units, [-]."""
+    return huber_rho(error / sigma) * sigma * sigma
 
 
 def local_gain(at: np.ndarray, base_error: FloatArray, error: FloatArray, sigma: FloatArray,
@@ -125,8 +126,8 @@ def local_gain(at: np.ndarray, base_error: FloatArray, error: FloatArray, sigma:
         return LocalGain(0, 0, 0, 0.0, 0.0)
     rows = index[where]
     s = sigma[rows]
-    before = _huber(base_error[rows] / s) * s * s
-    after = _huber(error[rows] / s) * s * s
+    before = _weighted_rho(base_error[rows], s)
+    after = _weighted_rho(error[rows], s)
     cut = np.split(np.arange(where.size), np.flatnonzero(np.diff(where) > max(block, 1)) + 1)
     # an event's few rows: whether the flow as read is predicted better (the noise model,
     # fitted to the whole recording, weighs a handful of rows by little more than chance)
@@ -196,7 +197,7 @@ def recurrence(base_error: FloatArray, error: FloatArray, sigma: FloatArray,
     """
     rows = np.asarray(index)
     s = sigma[rows]
-    cut = _huber(base_error[rows] / s) * s * s - _huber(error[rows] / s) * s * s
+    cut = _weighted_rho(base_error[rows], s) - _weighted_rho(error[rows], s)
     edges = np.arange(0, rows.size, max(block, 1))
     sums = np.add.reduceat(cut, edges) if rows.size else np.zeros(0)
     if sums.size < 2:

@@ -61,7 +61,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from satmotor_ros.identify.candidates import Candidate
 from satmotor_ros.identify.errors import IdentificationError
-from satmotor_ros.identify.fit import HUBER, LossFit
+from satmotor_ros.identify.fit import HUBER, huber_rho, LossFit
 from satmotor_ros.identify.noise import noise_model, outliers, rates_of, robust_scale
 from satmotor_ros.identify.parts import LossParts
 from satmotor_ros.identify.regional import (acting, local_gain, LocalGain, RECUR_ALPHA,
@@ -350,8 +350,7 @@ class CrossValidatedSelector:
             u = full.without(_guarded(test, self.guard, index.size))
             error[index[test]] = parts.flow[index[test]] - full.predict(parts, index[test], u)
         z = error[index] / sigma[index]
-        rho = np.where(np.abs(z) <= HUBER, z * z, 2.0 * HUBER * np.abs(z) - HUBER ** 2)
-        cv = float(np.sqrt(np.mean(rho) * np.mean(sigma[index] ** 2)))
+        cv = float(np.sqrt(np.mean(huber_rho(z)) * np.mean(sigma[index] ** 2)))
         p_value = 1.0
         if baseline is not None:
             q = full.n_params - baseline.fit.n_params
