@@ -9,9 +9,9 @@ import pytest
 
 from satmotor_ros.cli import validate as validate_cli
 from satmotor_ros.identify import calibrate, write_csv
+from satmotor_ros.identify.calibrated import Calibrated
 from satmotor_ros.identify.columns import load_mapping, read_log
-from satmotor_ros.identify.coverage import (calibrated_envelope, envelope, envelope_share,
-                                            outside)
+from satmotor_ros.identify.coverage import envelope, envelope_share, outside
 from satmotor_ros.identify.errors import DataError
 from satmotor_ros.identify.output import write_yaml
 from satmotor_ros.identify.synthetic import (generate, generate_transient, Injection, Plan,
@@ -69,7 +69,7 @@ def test_validate_gives_the_share_of_samples_outside_the_calibrated_envelope(tmp
     write_yaml(cal, tmp_path / 'coefficients.yaml')
     written = yaml.safe_load((tmp_path / 'coefficients.yaml').read_text())
     assert written['coverage'] == cal.summary()['coverage']
-    assert calibrated_envelope(tmp_path / 'coefficients.yaml') == written['coverage']['envelope']
+    assert Calibrated(tmp_path / 'coefficients.yaml').envelope == written['coverage']['envelope']
     # every sample counts: on its own data, the few rows the calibration left out may be beyond
     for table, name, low, high in ((narrow, 'own', 0.0, 0.02), (wide, 'wide', 0.4, 0.6)):
         out = tmp_path / name
@@ -88,11 +88,11 @@ def test_validate_gives_the_share_of_samples_outside_the_calibrated_envelope(tmp
 def test_a_motor_file_without_an_envelope_says_so_and_a_malformed_one_is_refused(tmp_path):
     plain = tmp_path / 'plain.yaml'
     plain.write_text('motor: x\n')
-    assert calibrated_envelope(plain) is None
+    assert Calibrated(plain).envelope is None
     bad = tmp_path / 'bad.yaml'
     bad.write_text('coverage:\n  envelope:\n    positive: {dp_mpa: [5, 1], speed_rpm: [0, 1]}\n')
     with pytest.raises(DataError, match=r'coverage\.envelope\.positive\.dp_mpa'):
-        calibrated_envelope(bad)
+        Calibrated(bad).envelope
 
 
 def test_the_samples_left_out_of_every_row_are_counted_by_reason():

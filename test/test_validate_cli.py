@@ -13,11 +13,11 @@ import pytest
 from satmotor_ros.cli import validate as validate_cli
 from satmotor_ros.cli._output import MARKER
 from satmotor_ros.identify import calibrate, Errors, write_csv
+from satmotor_ros.identify.calibrated import Calibrated
 from satmotor_ros.identify.output import write_yaml
 from satmotor_ros.identify.pipeline import Options
 from satmotor_ros.identify.synthetic import (generate, generate_transient, Injection, Plan,
                                              REALISTIC_DYNAMICS)
-from satmotor_ros.identify.validate import calibrated_dynamics
 from satmotor_ros.model.units import LPM, MPA, RPM
 from satmotor_ros.options import MotorOptions
 
@@ -174,7 +174,7 @@ def test_validate_applies_the_calibrations_transient_terms_unchanged(
     tmp, cal, data = transient_file
     fitted = {d['term']: d['coefficient'] for d in cal.summary()['dynamics']
               if 'coefficient' in d}
-    assert calibrated_dynamics(tmp / 'coefficients.yaml') == fitted
+    assert Calibrated(tmp / 'coefficients.yaml').dynamics == fitted
     assert fitted['flow_lag'] == pytest.approx(REALISTIC_DYNAMICS.flow_lag, rel=0.2)
     runs = {}
     for name, dynamics in (('own', fitted), ('spoilt', {**fitted, 'flow_lag': 0.0}),

@@ -11,7 +11,7 @@ from satmotor_ros.cli._bench import load_data, run_bench_command
 from satmotor_ros.cli._common import add_motor_options, CliError
 from satmotor_ros.cli._liquid import settle_liquid
 from satmotor_ros.cli._output import add_out_dir, check_target, output_dir, written_by
-from satmotor_ros.identify.coverage import calibrated_envelope
+from satmotor_ros.identify.calibrated import Calibrated
 from satmotor_ros.identify.errors import DataError
 from satmotor_ros.identify.health import Baseline, HealthMonitor, HealthSettings
 from satmotor_ros.identify.health.report import write_monitor
@@ -132,7 +132,7 @@ def _monitor(data: list[str], out: str, options: MotorOptions, columns: str, for
     options = settled.options
     model = options.build_model()
     motor_file = options.motor_file
-    baseline = Baseline(model, calibrated_envelope(motor_file) if motor_file else None,
+    baseline = Baseline(model, Calibrated(motor_file).envelope if motor_file else None,
                         motor_file or model.name)
     # a resumed monitor keeps the settings it was started with: its history was judged so
     monitor = (HealthMonitor.resume(state, baseline) if state and Path(state).exists()

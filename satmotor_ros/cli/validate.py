@@ -13,9 +13,9 @@ from satmotor_ros.cli._bench import (add_data_arguments, open_bench, run_bench_c
 from satmotor_ros.cli._common import add_motor_options
 from satmotor_ros.cli._output import output_dir
 from satmotor_ros.identify import BenchTable
-from satmotor_ros.identify.coverage import calibrated_envelope
+from satmotor_ros.identify.calibrated import Calibrated
 from satmotor_ros.identify.pipeline import Mode, MODES
-from satmotor_ros.identify.validate import calibrated_dynamics, validate
+from satmotor_ros.identify.validate import validate
 from satmotor_ros.identify.validation_report import write_validation
 from satmotor_ros.options import MotorOptions
 
@@ -67,9 +67,10 @@ def validate_into(data: str, out: str, mode: Mode, options: MotorOptions, column
     options = settled.options
     model = options.build_model()
     motor_file = options.motor_file
+    written = Calibrated(motor_file) if motor_file else None
     result = validate(table, model, options.liquid, mode,
-                      calibrated=calibrated_envelope(motor_file) if motor_file else None,
-                      dynamics=calibrated_dynamics(motor_file) if motor_file else None)
+                      calibrated=written.envelope if written else None,
+                      dynamics=written.dynamics if written else None)
     with output_dir('--out', out, 'validate', inputs, force) as tmp:
         summary = write_validation(result, tmp)
     target = Path(out)

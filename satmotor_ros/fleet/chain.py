@@ -160,11 +160,11 @@ def _watch(table: Any, baseline: dict[str, Any], state: str, out: Path) -> dict[
 
 def _baseline(baseline: dict[str, Any]) -> Any:
     """Build the monitor's baseline as ``satmotor monitor`` does for a motor file."""
-    from satmotor_ros.identify.coverage import calibrated_envelope
+    from satmotor_ros.identify.calibrated import Calibrated
     from satmotor_ros.identify.health import Baseline
     from satmotor_ros.options import MotorOptions
     options = MotorOptions(liquid=baseline['liquid'], motor_file=baseline['coefficients'])
-    return Baseline(options.build_model(), calibrated_envelope(options.motor_file),
+    return Baseline(options.build_model(), Calibrated(options.motor_file).envelope,
                     options.motor_file)
 
 

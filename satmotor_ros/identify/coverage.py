@@ -12,13 +12,10 @@ the samples is not part of it.
 
 from __future__ import annotations
 
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from satmotor_ros.bounded_yaml import read_yaml_or
-from satmotor_ros.identify.errors import DataError
 from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.units import MPA, RPM
 
@@ -153,69 +150,6 @@ def outside(env: dict[str, Any], dp: FloatArray, speed: FloatArray) -> np.ndarra
     return out
 
 
-def calibrated_blocks(path: str | Path) -> dict[str, Any]:
-    """
-    Read the top-level blocks of a ``coefficients.yaml`` (``coverage``, ``dynamics``, ...).
-
-    Parameters
-    ----------
-    path : str or pathlib.Path
-        A motor file, [-]
-
-    Returns
-    -------
-    dict
-        Block name -> block as read; empty when the file is no mapping.
-
-    Raises
-    ------
-    DataError
-        If the file cannot be read.
-
-    """
-    doc = read_yaml_or(path, DataError, str(path), str(path))
-    return doc if isinstance(doc, dict) else {}
-
-
-def calibrated_envelope(path: str | Path) -> dict[str, Any] | None:
-    """
-    Read the envelope a calibrated ``coefficients.yaml`` was fitted on (its ``coverage``).
-
-    Parameters
-    ----------
-    path : str or pathlib.Path
-        A motor file, [-]
-
-    Returns
-    -------
-    dict or None
-        The envelope as :func:`envelope` gives it; None when the file holds none (a
-        motor file that no calibration wrote).
-
-    Raises
-    ------
-    DataError
-        If the file's ``coverage.envelope`` is malformed (the message names the field).
-
-    """
-    doc = calibrated_blocks(path)
-    if 'coverage' not in doc:
-        return None
-    env = doc['coverage'].get('envelope') if isinstance(doc['coverage'], dict) else None
-    if not isinstance(env, dict) or not set(env) <= {name for name, _ in DIRECTIONS}:
-        msg = f'{path}: coverage.envelope = {env!r}: need a mapping of positive/negative'
-        raise DataError(msg)
-    for name, side in env.items():
-        for key in ('dp_mpa', 'speed_rpm'):
-            span = side.get(key) if isinstance(side, dict) else None
-            if not (isinstance(span, list) and len(span) == 2
-                    and all(isinstance(v, (int, float)) and np.isfinite(v) for v in span)
-                    and span[0] <= span[1]):
-                msg = f'{path}: coverage.envelope.{name}.{key} = {span!r}: need [min, max]'
-                raise DataError(msg)
-    return env
-
-
 def _margin(lo: float, hi: float) -> float:
     """Return the slack at an envelope's edge: the rounding of a written bound."""
     return 1e-3 * max(abs(lo), abs(hi))
@@ -250,5 +184,5 @@ def coverage(samples_used: int, samples_total: int, dp: FloatArray,
     return out
 
 
-__all__ = ['COVERED', 'MOST', 'TAIL', 'calibrated_blocks', 'calibrated_envelope', 'coverage',
+__all__ = ['COVERED', 'DIRECTIONS', 'MOST', 'TAIL', 'coverage',
            'envelope', 'envelope_share', 'outside']

@@ -25,12 +25,11 @@ labelled in sample.
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from satmotor_ros.identify.coverage import calibrated_blocks, outside
+from satmotor_ros.identify.coverage import outside
 from satmotor_ros.identify.effects import CalibratedModel
 from satmotor_ros.identify.errors import DataError, IdentificationError
 from satmotor_ros.identify.parts import loss_parts, LossParts
@@ -38,7 +37,7 @@ from satmotor_ros.identify.pipeline import Mode, Options, read_rows
 from satmotor_ros.identify.selection import Errors
 from satmotor_ros.identify.steady import SteadyTolerance
 from satmotor_ros.identify.table import BenchTable
-from satmotor_ros.identify.transient import averaged, DYNAMIC_TERMS, parts_at, Samples
+from satmotor_ros.identify.transient import averaged, parts_at, Samples
 from satmotor_ros.model import MotorModel
 from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.effects import Effect, flow_reading, kind_of
@@ -113,43 +112,6 @@ def _with(model: MotorModel, effects: tuple[Effect, ...]) -> MotorModel:
                       model.displacement_law, model.name)
 
 
-def calibrated_dynamics(path: str | Path) -> dict[str, float] | None:
-    """
-    Read the transient terms a calibrated ``coefficients.yaml`` holds (its ``dynamics``).
-
-    Parameters
-    ----------
-    path : str or pathlib.Path
-        A motor file, [-]
-
-    Returns
-    -------
-    dict or None
-        Term name -> coefficient (SI); None when the file holds none (a motor file no
-        calibration on every sample wrote).
-
-    Raises
-    ------
-    DataError
-        If ``dynamics`` is malformed (the message names the field).
-
-    """
-    doc = calibrated_blocks(path)
-    if 'dynamics' not in doc:
-        return None
-    terms = doc['dynamics']
-    known = {term.name for term in DYNAMIC_TERMS}
-    if not isinstance(terms, dict) or not set(terms) <= known:
-        msg = f'{path}: dynamics = {terms!r}: need a mapping of {", ".join(sorted(known))}'
-        raise DataError(msg)
-    for name, value in terms.items():
-        if isinstance(value, bool) or not isinstance(value, (int, float)) \
-                or not np.isfinite(value):
-            msg = f'{path}: dynamics.{name} = {value!r}: need a finite number'
-            raise DataError(msg)
-    return {name: float(value) for name, value in terms.items()}
-
-
 def validate(table: BenchTable, model: MotorModel, liquid: str, mode: Mode = 'auto',
              tol: SteadyTolerance | None = None,
              calibrated: dict[str, Any] | None = None,
@@ -172,10 +134,11 @@ def validate(table: BenchTable, model: MotorModel, liquid: str, mode: Mode = 'au
         Steady-state tolerances, [-]
     calibrated : dict, optional
         The envelope the model was calibrated on
-        (:func:`~satmotor_ros.identify.coverage.calibrated_envelope`); every sample of
+        (:attr:`~satmotor_ros.identify.calibrated.Calibrated.envelope`); every sample of
         `table` is counted against it, [-]
     dynamics : dict, optional
-        The calibration's transient terms (:func:`calibrated_dynamics`), applied unchanged
+        The calibration's transient terms
+        (:attr:`~satmotor_ros.identify.calibrated.Calibrated.dynamics`), applied unchanged
         when the rows are samples; without them the headline error has no transient terms,
         [-]
 

@@ -35,7 +35,7 @@ from rclpy.event_handler import PublisherEventCallbacks, SubscriptionEventCallba
 from rclpy.node import Node
 from rclpy.qos import qos_profile_sensor_data
 from rclpy.time import Time
-from satmotor_ros.identify.coverage import calibrated_envelope
+from satmotor_ros.identify.calibrated import Calibrated
 from satmotor_ros.identify.errors import DataError
 from satmotor_ros.identify.health import (Baseline, HealthMonitor, HealthSamples,
                                           HealthSettings, HealthSnapshot)
@@ -146,7 +146,7 @@ def baseline_from(values: dict[str, Any]) -> Baseline:
     path = values['motor_file']
     if not path:
         return Baseline(model)
-    return Baseline(model, calibrated_envelope(path), path)
+    return Baseline(model, Calibrated(path).envelope, path)
 
 
 class MotorMonitorNode(Node):

@@ -18,7 +18,8 @@ from typing import Any
 
 import numpy as np
 
-from satmotor_ros.identify.coverage import calibrated_envelope, outside
+from satmotor_ros.identify.calibrated import Calibrated
+from satmotor_ros.identify.coverage import outside
 from satmotor_ros.identify.effects import CalibratedModel
 from satmotor_ros.identify.health.records import HealthSamples
 from satmotor_ros.identify.parts import loss_parts
@@ -61,7 +62,8 @@ class Baseline:
     model : MotorModel
         The model, effects included (a calibrated ``coefficients.yaml``'s), [-]
     envelope : dict, optional
-        The envelope it was calibrated on (:func:`calibrated_envelope`); samples outside
+        The envelope it was calibrated on
+        (:attr:`~satmotor_ros.identify.calibrated.Calibrated.envelope`); samples outside
         are skipped, [-]
     source : str
         Where it came from, for reports, [-]
@@ -110,7 +112,7 @@ class Baseline:
 
         """
         model = MotorModel.from_spec(load_motor(path), liquid)
-        return cls(model, calibrated_envelope(path), str(path))
+        return cls(model, Calibrated(path).envelope, str(path))
 
     @classmethod
     def for_family(cls, family: str, displacement: float, liquid: str = 'oil') -> Baseline:
