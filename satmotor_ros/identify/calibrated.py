@@ -48,7 +48,7 @@ class Calibrated:
     @property
     def envelope(self) -> dict[str, Any] | None:
         """
-        The envelope the model was fitted on, as :func:`~.coverage.envelope` gives it.
+        Return the envelope the model was fitted on, as :func:`~.coverage.envelope` gives it.
 
         None when the file holds none (a motor file that no calibration wrote); DataError
         naming the field when ``coverage.envelope`` is malformed.
@@ -74,7 +74,7 @@ class Calibrated:
     @property
     def dynamics(self) -> dict[str, float] | None:
         """
-        The transient terms: term name -> coefficient (SI).
+        Return the transient terms: term name -> coefficient (SI).
 
         None when the file holds none (a motor file no calibration on every sample wrote);
         DataError naming the field when ``dynamics`` is malformed.
