@@ -4,13 +4,9 @@ A recording and its mirror are the same motor: the calibration should not care w
 
 Mirroring swaps the ports (p_a <-> p_b) and turns the signs of the speed and the flow. Every
 figure of the calibration should be the same, and an effect that acts in one direction should
-act in the other. The line compliance (T1 of :mod:`satmotor_ros.identify.transient`) reads
-port A's pressure in both directions, so today it is not: the real 2021 MBARI log gives 1.12
-l/min before any effect and names its relief valve; its mirror gives 0.80 and names none. The
-symmetric term (the inlet's, the higher port's, in each row's frame) was tried: mirror-exact,
-a base error of 0.88 on the log, but the negative-side valve is then lost and a positive
-"valve" at 10.3 MPa named on 15 rows at the starts of moves (doc/calibration.md, issue 20).
-The tests are strict xfails until the asymmetry is resolved.
+act in the other. The line compliance (T1 of :mod:`satmotor_ros.identify.transient`) has a
+volume for each port, so the mirror's fit is the recording's with the two volumes swapped.
+With port A's alone, the real 2021 MBARI log named its relief valve and its mirror did not.
 """
 
 from dataclasses import replace
@@ -25,6 +21,7 @@ from satmotor_ros.options import MotorOptions
 from vendored_data import data_path
 
 SWAPPED = {'positive': 'negative', 'negative': 'positive', 'both': 'both'}
+PORTS = {'line_compliance': 'line_compliance_b', 'line_compliance_b': 'line_compliance'}
 
 
 def mirrored(table):
@@ -41,11 +38,14 @@ def _figures(cal):
             {d['term']: d.get('coefficient') for d in summary.get('dynamics', [])})
 
 
+def _ports_swapped(dynamics):
+    return {PORTS.get(term, term): value for term, value in dynamics.items()}
+
+
 def _same(a, b, rtol):
     assert a[0] == pytest.approx(b[0], rel=rtol) and a[1] == pytest.approx(b[1], rel=rtol)
 
 
-@pytest.mark.xfail(strict=True, reason='T1 reads port A in both directions (issue 20)')
 def test_a_mirrored_transient_recording_gives_the_mirrored_calibration():
     plan = Plan(liquid='water', reverse_share=0.5)  # both frames: the inlet is A, then B
     table = generate_transient(plan, Injection.realistic('none', 1.0, 'water'),
@@ -53,14 +53,14 @@ def test_a_mirrored_transient_recording_gives_the_mirrored_calibration():
     options = Options(mode='transient', compare_families=False)
     one, other = (calibrate(t, 'water', options=options) for t in (table, mirrored(table)))
     first, second = _figures(one), _figures(other)
-    _same(first, second, 1e-6)
+    _same(first, second, 1e-4)  # the noise model settles to 1e-3
     assert first[2] == second[2] == []
-    assert first[3] == pytest.approx(second[3], rel=1e-6)
+    assert first[3] == pytest.approx(_ports_swapped(second[3]), rel=1e-3)
     assert first[3]['line_compliance'] == pytest.approx(5.0e-13, rel=0.1)
+    assert second[3]['line_compliance_b'] == pytest.approx(5.0e-13, rel=0.1)
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason='T1 reads port A in both directions (issue 20)')
 def test_the_mirrored_mbari_log_gives_the_mirrored_calibration():
     log = data_path('real', 'mbari_pto', '2021.07.26T10.51.44.exp')
     table = read_log(log, load_mapping('mbari_pto'))
@@ -71,3 +71,5 @@ def test_the_mirrored_mbari_log_gives_the_mirrored_calibration():
     _same(first, second, 0.02)
     named = [(e, SWAPPED[d]) for e, d in first[2]]
     assert second[2] == sorted(named)
+    assert ('threshold:dp', 'negative') in first[2]
+    assert first[3] == pytest.approx(_ports_swapped(second[3]), rel=0.02)

@@ -148,9 +148,10 @@ def test_dynamic_parameters_are_recovered_within_their_intervals():
     assert 'tau_n - tau_Q' in found['speed_lag']['note']
 
 
-@pytest.mark.parametrize('term', ['line_compliance', 'speed_lag', 'flow_lag'])
+@pytest.mark.parametrize('term', ['line_compliance', 'line_compliance_b', 'speed_lag',
+                                  'flow_lag'])
 def test_one_dynamic_term_alone_is_found_and_the_others_are_not(term):
-    dynamics = replace(Dynamics(), **{term: getattr(REALISTIC_DYNAMICS, term)})
+    dynamics = replace(Dynamics(), **{term: getattr(REALISTIC_DYNAMICS, term) or 5e-13})
     cal = calibrate(_recording('oil', dynamics=dynamics, seed=3), 'oil', options=Options(
         mode='transient'))
     for name, d in _dynamics(cal).items():
@@ -261,9 +262,11 @@ def test_transient_bag_through_satmotor_calibrate(tmp_path, capsys):
     assert result['mode'] == 'transient' and result['n_samples'] == len(table)
     assert 'steady windows' in result['mode_reason']
     terms = {d['term']: d for d in result['dynamics']}
-    assert set(terms) == {'line_compliance', 'speed_lag', 'flow_lag'}
+    assert set(terms) == {'line_compliance', 'line_compliance_b', 'speed_lag', 'flow_lag'}
     lo, hi = terms['line_compliance']['ci95']
     assert terms['line_compliance']['unit'] == 'm^3/Pa' and lo < 5e-13 < hi
+    lo, hi = terms['line_compliance_b']['ci95']  # the rig meters port A's line only
+    assert lo < 0.0 < hi and hi - lo < 5e-13
     report = (tmp_path / 'out' / 'report.md').read_text()
     assert '## Transient terms' in report and 'Mode `transient`' in report
 

@@ -602,7 +602,8 @@ def first_order(x: FloatArray, dt: float, tau: float) -> FloatArray:
 class Dynamics:
     """The transient terms to inject into a generated recording (eqs. T1-T3 of `.transient`)."""
 
-    line_compliance: float = 0.0  # V/K of the inlet line between flowmeter and motor [m^3/Pa]
+    line_compliance: float = 0.0  # V_a/K of port A's line, flowmeter upstream [m^3/Pa]
+    line_compliance_b: float = 0.0  # V_b/K of port B's line, flowmeter downstream [m^3/Pa]
     speed_lag: float = 0.0  # first-order time constant of the speed reading [s]
     flow_lag: float = 0.0  # first-order time constant of the flow reading [s]
 
@@ -620,8 +621,8 @@ def generate_transient(plan: Plan, injection: Injection | Sequence[Injection],
     Generate a recording whose set-points change every `hold_s` seconds, with its dynamics.
 
     Speed, pressure drop and outlet pressure follow random set-points through a
-    first-order lag `tau_s`. The flowmeter sits upstream of the inlet line and reads
-    the motor's flow plus (V/K) dp_in/dt (T1); the speed and flow readings lag
+    first-order lag `tau_s`. The flowmeter reads the motor's flow plus
+    (V_a/K) dp_a/dt - (V_b/K) dp_b/dt (T1); the speed and flow readings lag
     through first-order filters (T2, T3). Simulated at `oversample` times the rate.
 
     Parameters
@@ -666,7 +667,8 @@ def generate_transient(plan: Plan, injection: Injection | Sequence[Injection],
     channels['p_out'] = first_order(channels['p_out'], dt, tau_s)
     channels['revolutions'] = revolutions(speed, dt)
     spans, flow = _motor_flow(plan, injections, speed, dp, channels)
-    flow = flow + dynamics.line_compliance * np.gradient(channels['p_out'] + dp, dt)
+    flow = (flow + dynamics.line_compliance * np.gradient(channels['p_out'] + dp, dt)
+            - dynamics.line_compliance_b * np.gradient(channels['p_out'], dt))
     flow = first_order(flow, dt, dynamics.flow_lag)
     read_speed = first_order(speed, dt, dynamics.speed_lag)
     pick = slice(None, None, oversample)

@@ -7,8 +7,13 @@ While the operating point moves, what the sensors read differs from the steady m
 in one parameter, so it enters every fit as a nuisance regressor (``LossParts.nuisance``: a
 free coefficient, no prior):
 
-- (T1) line compliance: the flowmeter sits upstream of a line volume V, so it also reads the
-  flow that compresses the liquid in it, :math:`Q_{meas} = Q + (V/K)\,\dot p_{in}`;
+- (T1) line compliance: the flowmeter sits upstream of port A's line volume :math:`V_a`,
+  so it also reads the flow that compresses the liquid in it, and downstream of port B's
+  :math:`V_b`, so it misses what that line's liquid gives up as it expands,
+  :math:`Q_{meas} = Q + (V_a/K)\,\dot p_a - (V_b/K)\,\dot p_b`. A rig metered on one
+  line has one volume near 0; a displacement meter (a cylinder's piston) has both. With a
+  volume for each port the fit does not depend on which port is called A: a log and its
+  mirror (ports swapped, speed and flow turned) give the same fit, the two volumes swapped;
 - (T2) speed lag: the speed reading lags the shaft by :math:`\tau_n`, so the model's flow at
   the true speed is :math:`Q(n_{true}) = Q(n) + \tau_n\,(\partial Q/\partial n)\,\dot n`
   (:math:`n_{true} = n + \tau_n \dot n` is exact for a first-order lag; :math:`\partial
@@ -40,7 +45,7 @@ from typing import Any
 import numpy as np
 from satmotor_ros.identify.errors import DataError, IdentificationError
 from satmotor_ros.identify.fit import FitReport, written
-from satmotor_ros.identify.noise import MAD
+from satmotor_ros.identify.noise import MAD, RATE_TERMS
 from satmotor_ros.identify.parts import loss_parts, LossParts, NO_EFFECT
 from satmotor_ros.identify.table import BenchTable
 from satmotor_ros.model import MotorModel
@@ -86,8 +91,10 @@ class DynamicTerm:
 
 
 DYNAMIC_TERMS = (
-    DynamicTerm('line_compliance', 'V/K', 'dp_in/dt', 'm^3/Pa', 'T1',
-                'flow into the inlet line volume V at bulk modulus K (flowmeter upstream)'),
+    DynamicTerm('line_compliance', 'V_a/K', 'dp_a/dt', 'm^3/Pa', 'T1',
+                "flow into port A's line volume V_a at bulk modulus K (flowmeter upstream)"),
+    DynamicTerm('line_compliance_b', 'V_b/K', '-dp_b/dt', 'm^3/Pa', 'T1',
+                "flow out of port B's line volume V_b (flowmeter downstream)"),
     DynamicTerm('speed_lag', 'tau_n', 'dQ/dn*dn/dt', 's', 'T2',
                 'the speed reading lags the shaft (first-order time constant)'),
     DynamicTerm('flow_lag', 'tau_Q', '-dQ/dt', 's', 'T3',
@@ -140,18 +147,18 @@ class Samples:
     """Rows a test fold keeps out of training on each side: neighbours share a sample."""
 
 
-def dynamic_regressors(dp_in_dt: FloatArray, dn_dt: FloatArray, dq_dt: FloatArray,
-                       dq_dn: FloatArray) -> dict[str, FloatArray]:
+def dynamic_regressors(dp_a_dt: FloatArray, dp_b_dt: FloatArray, dn_dt: FloatArray,
+                       dq_dt: FloatArray, dq_dn: FloatArray) -> dict[str, FloatArray]:
     r"""
     Compute the flow per unit coefficient of each transient term, eqs. (T1)-(T3).
 
-    .. math:: Q_{meas} = Q(n, \Delta p_i) + \frac{V}{K}\,\dot p_{in}
+    .. math:: Q_{meas} = Q(n, \Delta p_i) + \frac{V_a}{K}\,\dot p_a - \frac{V_b}{K}\,\dot p_b
         + \tau_n\,\frac{\partial Q}{\partial n}\,\dot n - \tau_Q\,\dot Q_{meas}
 
     Parameters
     ----------
-    dp_in_dt : ndarray
-        Rate of change of the inlet pressure, [Pa/s]
+    dp_a_dt, dp_b_dt : ndarray
+        Rates of change of the pressures at ports A and B, [Pa/s]
     dn_dt : ndarray
         Rate of change of the speed reading, [rad/s^2]
     dq_dt : ndarray
@@ -162,11 +169,12 @@ def dynamic_regressors(dp_in_dt: FloatArray, dn_dt: FloatArray, dq_dt: FloatArra
     Returns
     -------
     dict of str to ndarray
-        Term name -> regressor: dp_in/dt [Pa/s] for V/K, dQ/dn dn/dt [m^3/s^2] for
-        tau_n, -dQ/dt [m^3/s^2] for tau_Q.
+        Term name -> regressor: dp_a/dt [Pa/s] for V_a/K, -dp_b/dt for V_b/K,
+        dQ/dn dn/dt [m^3/s^2] for tau_n, -dQ/dt [m^3/s^2] for tau_Q.
 
     """
-    return {'line_compliance': dp_in_dt, 'speed_lag': dq_dn * dn_dt, 'flow_lag': -dq_dt}
+    return {'line_compliance': dp_a_dt, 'line_compliance_b': -dp_b_dt,
+            'speed_lag': dq_dn * dn_dt, 'flow_lag': -dq_dt}
 
 
 def flow_per_speed(parts: LossParts, qt: float) -> FloatArray:
@@ -486,10 +494,11 @@ def transient_samples(model: MotorModel, table: BenchTable,
         replace(c, pieces=tuple((k, mean(at_samples(x))) for k, x in c.pieces))
         for c in all_parts.components)
     parts = replace(all_parts, **averaged)
-    ends = [smooth(x, first, END_SAMPLES) for x in (table.p_in, table.speed, table.flow)]
+    ends = [smooth(x, first, END_SAMPLES)
+            for x in (table.p_in, table.p_out, table.speed, table.flow)]
     sign = frame[a]  # the row's frame: its flow, loss and regressors are s times the readings'
-    rates = [sign * (x[b] - x[a]) / (time[b] - time[a]) for x in ends]
-    regressors = dynamic_regressors(rates[0], rates[1], rates[2],
+    dp_a, dp_b, dn, dq = (sign * (x[b] - x[a]) / (time[b] - time[a]) for x in ends)
+    regressors = dynamic_regressors(dp_a, dp_b, dn, dq,
                                     flow_per_speed(parts, model.geometry.displacement))
     nuisance, left_out = _screen(regressors, parts)
     parts = parts.with_nuisance(nuisance)
@@ -509,7 +518,7 @@ def transient_samples(model: MotorModel, table: BenchTable,
             + left_out_samples(model, table, usable | spike | rest, held, int(spike.sum()),
                                int(rest.sum())))
     rows = replace(rows, notes=rows.notes + (note,))
-    lags = [nuisance[name] for name in ('speed_lag', 'flow_lag') if name in nuisance]
+    lags = [nuisance[name] for name in RATE_TERMS if name in nuisance]
     correlation = float(np.corrcoef(lags[0], lags[1])[0, 1]) if len(lags) == 2 else np.nan
     return Samples(rows, parts, n_samples, size, step, n_segments, tuple(left_out),
                    correlation, table, usable, (a, b), held, np.flatnonzero(spike),
@@ -737,7 +746,7 @@ def dynamics_summary(fit: FitReport, samples: Samples) -> list[dict[str, Any]]:
             if value < 0.0:
                 entry['impossible'] = (f'{term.symbol} < 0 cannot be (it is >= 0): not an '
                                        'estimate; the term absorbs what the model lacks')
-            if term.name != 'line_compliance' and abs(samples.correlation) > LAG_CORRELATION:
+            if term.name in RATE_TERMS and abs(samples.correlation) > LAG_CORRELATION:
                 entry['note'] = (f"the two lags' regressors correlate (r = "
                                  f'{samples.correlation:.4f}): the data determine tau_n - '
                                  'tau_Q far better than either')
