@@ -225,9 +225,9 @@ def test_calibrate_each_mbari_log_with_the_f11_displacement(mbari_calibrations, 
     assert '## Model family' in report and 'columns mapped by' in report
     if name == MBARI[0]:  # the valve alone: the 11 % flow gain a search after it would name
         # does not recur across the recording's blocks (and predicts the other log worse).
-        # With the rows' noise growing with the rates of change the valve passes the tests
-        # over every row, not only where it acts
-        assert len(result['effects']) == 1 and ENDS_SEARCH not in report
+        # Over every row the fast moves' timing noise swamps it (a 1.9 % cut with a line
+        # volume on each port): it passes where it acts, in 5 of its 5 openings
+        assert len(result['effects']) == 1 and ENDS_SEARCH in report
     assert load_motor(out / 'coefficients.yaml').family == result['family']
 
 
