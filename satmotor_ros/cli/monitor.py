@@ -58,6 +58,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     group.add_argument('--state', default='', metavar='FILE',
                        help='resume from this state file if it exists, and save the state '
                             'there after the last sample (a later run continues the history)')
+    group.add_argument('--acknowledge', action='store_true',
+                       help="acknowledge the --state's alarms (those the last run reported): "
+                            'they stay in the history, marked acknowledged; alarms the new '
+                            'data raise are new')
     add_motor_options(parser, liquid_from_data=True)
 
 
@@ -65,7 +69,8 @@ def command(data: list[str], out: str, options: MotorOptions, columns: str = '',
             force: bool = False, false_alarm_hours: float = 1000.0,
             limit_leakage_factor: float = 2.0,
             limit_volumetric_efficiency: float | None = None, change_fraction: float = 0.2,
-            learn_hours: float = 0.25, explain: bool = True, state: str = '') -> int:
+            learn_hours: float = 0.25, explain: bool = True, state: str = '',
+            acknowledge: bool = False) -> int:
     """
     Run the health monitor over the recordings and write its outputs.
 
@@ -87,6 +92,8 @@ def command(data: list[str], out: str, options: MotorOptions, columns: str = '',
         Name what changed on a change, [-]
     state : str
         State file to resume from and save to; '' for none, [-]
+    acknowledge : bool
+        Acknowledge the alarms of the resumed `state` before the data, [-]
 
     Returns
     -------
@@ -99,7 +106,7 @@ def command(data: list[str], out: str, options: MotorOptions, columns: str = '',
               'limit_volumetric_efficiency': limit_volumetric_efficiency,
               'change_fraction': change_fraction, 'learn_hours': learn_hours}
     return run_bench_command(out, lambda: _monitor(data, out, options, columns, force, values,
-                                                   explain, state))
+                                                   explain, state, acknowledge))
 
 
 def _settings(values: dict[str, float | None], explain: bool) -> HealthSettings:
@@ -122,8 +129,12 @@ def _same_settings(saved: HealthSettings, given: HealthSettings, state: str) -> 
 
 
 def _monitor(data: list[str], out: str, options: MotorOptions, columns: str, force: bool,
-             values: dict[str, float | None], explain: bool, state: str) -> str:
+             values: dict[str, float | None], explain: bool, state: str,
+             acknowledge: bool) -> str:
     settings = _settings(values, explain)
+    if acknowledge and not (state and Path(state).is_file()):
+        raise CliError(f'--acknowledge: no alarms to acknowledge without a --state file '
+                       f'({state or "none given"}): the alarms are those of a previous run')
     inputs = [name for name in (*data, options.motor_file, columns) if name]
     check_target('--out', Path(out), inputs, force, written_by('monitor'), 'monitor')
     if state and not Path(state).parent.is_dir():  # found out only after --out was written
@@ -138,6 +149,8 @@ def _monitor(data: list[str], out: str, options: MotorOptions, columns: str, for
     monitor = (HealthMonitor.resume(state, baseline) if state and Path(state).exists()
                else HealthMonitor(baseline, settings))
     _same_settings(monitor.settings, settings, state)
+    if acknowledge:
+        monitor.acknowledge()
     tables = [load_data(path, columns, model.geometry.displacement) for path in data]
     run = monitor_recordings(tables, baseline, monitor=monitor)
     snap = run.snapshot
@@ -150,7 +163,9 @@ def _monitor(data: list[str], out: str, options: MotorOptions, columns: str, for
         content = write_monitor(run, tmp)
     if state:
         monitor.save(state)
-    alarms = ', '.join(f'{a.kind} at {a.time_s / 3600:.3g} h ({a.what})' for a in snap.alarms)
+    alarms = ', '.join(f'{a.kind} at {a.time_s / 3600:.3g} h ({a.what})'
+                       + (' acknowledged' if n < snap.acknowledged else '')
+                       for n, a in enumerate(snap.alarms))
     flags = ''.join(f'; WARNING: {flag}' for flag in content['flags'])
     notes = ''.join(f'; {note}' for note in run.notes)
     if snap.learning and not snap.alarms:

@@ -8,7 +8,8 @@ and ``fluid_temperature`` (names and types from :mod:`satmotor_ros.interface`);
 publishes ``health/leakage_factor``, ``health/volumetric_efficiency`` (at the current
 operating point), ``health/hours_to_limit`` (std_msgs/Float64; inf when not drifting)
 and ``/diagnostics``: OK; WARN when the trend reaches the limit within ``warn_hours``
-or an input is missing or bad; ERROR on a detected change or a crossed limit.
+or an input is missing or bad; ERROR on a detected change or a crossed limit, until
+acknowledged (``acknowledged_alarms``: the alarms stay in the history).
 
 A sample is taken on every ``joint_states`` message (its header stamp is the sample's
 time, on the data's own clock), with the latest value of each other topic; a topic not
@@ -81,6 +82,9 @@ PARAMETERS = (
     *SETTINGS,
     ParamSpec('warn_hours', 100.0, 'WARN when the trend reaches the limit within this',
               'h', 0.0, 1.0e9),
+    ParamSpec('acknowledged_alarms', 0, 'the first this many alarms are acknowledged (kept, '
+              "no longer ERROR); set it to the diagnostics' alarms count; it never goes back",
+              '-', 0, 1000000000),
     ParamSpec('joint_name', JOINT_NAME, 'joint whose velocity in joint_states is the speed'),
     ParamSpec('input_timeout', 0.5, 'a held topic older than this makes a sample stale', 's',
               0.001, 3600.0),
@@ -172,6 +176,7 @@ class MotorMonitorNode(Node):
         self._state_note = ''  # what happened to the state file
         self._may_save = True  # False: the state file is someone else's
         self._build(values, resume=True)
+        self._acknowledge()
         self._held = {name: math.nan for name in INPUTS}
         self._heard = {name: -math.inf for name in INPUTS}  # node clock at reception [s]
         self._block: dict[str, array[float]] = {c: array('d') for c in _COLUMNS}
@@ -253,6 +258,14 @@ class MotorMonitorNode(Node):
                         self.create_timer(values[key], callback))
         if 'state_file' in names:
             self._may_save, self._state_note = True, ''
+        if 'acknowledged_alarms' in names:
+            self._acknowledge()
+
+    def _acknowledge(self) -> None:
+        """Acknowledge the first ``acknowledged_alarms`` alarms (the estimator keeps them)."""
+        if self.monitor is not None and self._values['acknowledged_alarms'] > 0:
+            count = self.monitor.acknowledge(self._values['acknowledged_alarms'])
+            self.get_logger().info(f'{count} of {len(self.monitor.alarms)} alarms acknowledged')
 
     # -- inputs -----------------------------------------------------------------------------
 
@@ -428,13 +441,13 @@ class MotorMonitorNode(Node):
             return 2, self._error or 'no estimator'
         if self._problems:
             return 2, f'parameter {"; ".join(self._problems.values())}'
-        if snap.alarms:
-            last = snap.alarms[-1]
-            if last.kind == 'change':
-                return 2, (f'change at {last.change_s:.1f} s (alarm at {last.time_s:.1f} s): '
-                           f'{last.what}')
+        new = snap.unacknowledged
+        if new and new[-1].kind == 'change':
+            last = new[-1]
+            return 2, (f'change at {last.change_s:.1f} s (alarm at {last.time_s:.1f} s): '
+                       f'{last.what}')
         if snap.leakage_factor.value >= snap.limit_leakage_factor or (
-                snap.alarms and snap.alarms[-1].kind == 'limit'):
+                new and new[-1].kind == 'limit'):
             return 2, f'limit crossed: leakage factor {snap.leakage_factor.value:.3g} ' \
                       f'(limit {snap.limit_leakage_factor:.3g})'
         if snap.hours_to_limit.value < self._values['warn_hours']:
@@ -446,7 +459,9 @@ class MotorMonitorNode(Node):
             return 1, self._state_note
         if self.bad or self.out_of_order or self.no_joint:
             return 1, f'inputs refused: {self.last_bad or "joint_states out of order"}'
-        return 0, 'learning' if snap.learning else 'healthy'
+        state = 'learning' if snap.learning else 'healthy'
+        return 0, state + (f' ({snap.acknowledged} alarms acknowledged)'
+                           if snap.acknowledged else '')
 
     def _flow_source(self) -> str:
         """
@@ -517,7 +532,7 @@ def _figures(snap: HealthSnapshot) -> dict[str, Any]:
         'learning': snap.learning, 'statistic [-]': f'{snap.statistic:.4g}',
         'samples': snap.n_samples, 'skipped': snap.n_skipped,
         **{f'skipped {reason}': count for reason, count in snap.skipped.items()},
-        'alarms': len(snap.alarms),
+        'alarms': len(snap.alarms), 'alarms acknowledged': snap.acknowledged,
         'last alarm': 'none' if last is None else f'{last.kind} at {last.time_s:.1f} s',
         'change_time [s]': f'{snap.change_s:.1f}' if math.isfinite(snap.change_s) else 'none',
         'what changed': snap.what_changed or 'none',

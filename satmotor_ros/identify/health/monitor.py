@@ -159,6 +159,7 @@ class HealthMonitor:
         self.last_point: HealthPoint | None = None
         self.points: list[HealthPoint] = []
         self.alarms: list[Alarm] = []
+        self.acknowledged = 0  # the first this many alarms are acknowledged
         self.in_limit = False
         self.change_s = math.nan
         self.what_changed = ''
@@ -539,6 +540,33 @@ class HealthMonitor:
             self.in_limit = False
         return []
 
+    def acknowledge(self, count: int | None = None) -> int:
+        """
+        Acknowledge the alarms raised so far, or the first `count` of them.
+
+        An acknowledged alarm stays in :attr:`alarms` (the history is kept) and changes no
+        figure: the detector's reference is already the level learned since the change, and
+        the leakage factor stays against the baseline, since the limit is on it. It only says
+        that someone has seen the alarm, so that a status (the node's) goes back to OK;
+        acknowledgements only grow, and an alarm raised later is new.
+
+        Parameters
+        ----------
+        count : int, optional
+            Alarms acknowledged from the first; all raised so far by default (more than
+            were raised: all of them), [-]
+
+        Returns
+        -------
+        int
+            The alarms acknowledged now.
+
+        """
+        raised = len(self.alarms)
+        wanted = raised if count is None else min(max(int(count), 0), raised)
+        self.acknowledged = max(self.acknowledged, wanted)
+        return self.acknowledged
+
     # ------------------------------------------------------------------ figures out
     def _window_factor(self) -> Estimate:
         """Return the pooled factor over the window with its 95 % interval."""
@@ -601,7 +629,7 @@ class HealthMonitor:
                    'reference_temperature': self.baseline.reference_temperature},
             n_samples=self.n_samples, n_skipped=sum(self.skipped.values()),
             skipped=dict(self.skipped), alarms=tuple(self.alarms), change_s=self.change_s,
-            what_changed=self.what_changed)
+            what_changed=self.what_changed, acknowledged=self.acknowledged)
 
     def pop_points(self) -> list[HealthPoint]:
         """

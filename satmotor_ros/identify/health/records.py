@@ -265,6 +265,12 @@ class HealthSnapshot:
     alarms: tuple[Alarm, ...] = ()  # every alarm raised
     change_s: float = math.nan  # start of the last change [s]
     what_changed: str = ''  # its explanation ('' before any change)
+    acknowledged: int = 0  # the first this many alarms are acknowledged [-]
+
+    @property
+    def unacknowledged(self) -> tuple[Alarm, ...]:
+        """Return the alarms raised since the last acknowledgement, in time order."""
+        return self.alarms[self.acknowledged:]
 
 
 __all__ = ['Alarm', 'Estimate', 'HealthPoint', 'HealthSamples', 'HealthSettings',

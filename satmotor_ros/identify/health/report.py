@@ -54,7 +54,8 @@ def summary(run: MonitorRun) -> dict[str, Any]:
     snap = run.snapshot
     to_limit = snap.hours_to_limit
     out: dict[str, Any] = {
-        'alarms': [a.as_dict() for a in snap.alarms],
+        'alarms': [{**a.as_dict(), 'acknowledged': n < snap.acknowledged}
+                   for n, a in enumerate(snap.alarms)],
         'leakage_factor': [{'time_s': _num(p.time_s, 9), **p.leakage_factor.as_dict(),
                             'learning': p.learning} for p in run.points],
         'trend_per_hour': _num(snap.trend_per_hour.value),
@@ -228,7 +229,9 @@ def _report(run: MonitorRun, out: dict[str, Any]) -> str:
     if snap.alarms:
         lines += ['| # | time [h] | kind | what | statistic | began [h] | before | after |',
                   '| --- | --- | --- | --- | --- | --- | --- | --- |']
-        lines += [f'| {n} | {a.time_s / 3600:.4g} | {a.kind} | {a.what} | {a.statistic:.3g} | '
+        lines += [f'| {n} | {a.time_s / 3600:.4g} | {a.kind}'
+                  f'{" (acknowledged)" if n <= snap.acknowledged else ""} | {a.what} | '
+                  f'{a.statistic:.3g} | '
                   f'{a.change_s / 3600:.4g} | {a.before:.4g} | {a.after:.4g} |'
                   for n, a in enumerate(snap.alarms, start=1)]
     else:
