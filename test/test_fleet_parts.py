@@ -172,6 +172,50 @@ def test_a_recording_whose_output_was_deleted_is_not_done(tmp_path):
     assert is_done(out, data, key) is None
 
 
+def test_a_rerun_on_other_options_leaves_no_earlier_output_behind(tmp_path):
+    """F6: validate/ of a run with --validate is gone after one without, and not listed; a
+    directory of the user's, or one of ours the user wrote into, is kept (not the tool's)."""
+    from satmotor_ros.fleet.resume import read_done
+    from satmotor_ros.fleet.synthetic import write_recording
+    from satmotor_ros.fleet.tasks import process_recording, RunOptions
+    from satmotor_ros.model.io.config import default_config_path
+    write_recording(tmp_path / 'root' / 'm1' / 'd00.csv', 1.2, 1, 30, EPOCH)
+    motor = discover(tmp_path / 'root', FleetConfig())[0]
+    rec = motor.recordings[0]
+    baseline = {'recording': None, 'coefficients': str(default_config_path('sm075_25.yaml')),
+                'liquid': 'water', 'key': 'b'}
+    out = tmp_path / 'out' / 'm1' / rec.name
+    (out / 'mine').mkdir(parents=True)
+    (out / 'mine' / 'notes.txt').write_text('keep')
+
+    def run(validate):
+        marker = process_recording(rec, motor.rule, baseline,
+                                   RunOptions(str(tmp_path / 'out'), validate=validate,
+                                              liquid='water'))
+        assert marker['status'] == 'done', marker['reason']
+        return {o.split('/')[0] for o in read_done(out)['outputs']}
+
+    assert run(True) == {'health', 'validate'}
+    assert run(False) == {'health'} and not (out / 'validate').exists()
+    assert run(True) == {'health', 'validate'}
+    (out / 'validate' / 'extra.txt').write_text('the user wrote into it: theirs now')
+    assert run(False) == {'health'} and (out / 'validate' / 'extra.txt').is_file()
+    assert (out / 'mine' / 'notes.txt').read_text() == 'keep'
+
+
+def test_a_report_drops_the_plots_of_motors_it_no_longer_has(tmp_path):
+    """F6: a motor gone (renamed, removed) since the last report leaves no plot behind."""
+    from satmotor_ros.fleet.report import write_report
+    header = {'root': 'r', 'written': 'w', 'recordings': 1, 'refused': 0, 'ran': 1,
+              'reused': 0, 'estimator': 'e', 'limit': 2.0}
+    views = [motor_view(m, 'water', [], None) for m in ('a', 'b')]
+    write_report(tmp_path, views, header)
+    (tmp_path / 'plots' / 'c.png').write_bytes(b'never in a report: not ours')
+    write_report(tmp_path, views[1:], header)
+    assert sorted(p.name for p in (tmp_path / 'plots').iterdir()) == ['b.png', 'c.png',
+                                                                      'fleet.png']
+
+
 def _markers(values, start=EPOCH, half=0.003):
     return [{'status': 'done', 'recording': f'r{i}.csv', 'date': f'd{i:02d}',
              'time': start + i * DAY, 'time_source': TIME_COLUMN,

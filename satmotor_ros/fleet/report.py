@@ -37,11 +37,23 @@ def write_report(out: Path, motors: list[dict[str, Any]], header: dict[str, Any]
 
     """
     (out / PLOTS).mkdir(parents=True, exist_ok=True)
+    _drop_plots(out, {m['motor'] for m in motors})
     for motor in motors:
         plot_motor(out / PLOTS / f"{motor['motor']}.png", motor)
     plot_fleet(out / PLOTS / f'{FLEET_PLOT}.png', motors)
     _replace(out / REPORT_JSON, json.dumps({**header, 'motors': motors}, indent=1) + '\n')
     _replace(out / REPORT_MD, markdown(motors, header))
+
+
+def _drop_plots(out: Path, motors: set[str]) -> None:
+    """Remove the plots the last report drew of motors this one has not (gone, renamed)."""
+    from satmotor_ros.fleet.resume import read_marker
+    earlier = (read_marker(out / REPORT_JSON) or {}).get('motors')
+    for entry in earlier if isinstance(earlier, list) else ():
+        name = entry.get('motor') if isinstance(entry, dict) else None
+        if isinstance(name, str) and name not in motors and '/' not in name \
+                and name.lower() != FLEET_PLOT:
+            (out / PLOTS / f'{name}.png').unlink(missing_ok=True)
 
 
 def _days(value: float | None) -> str:

@@ -135,18 +135,19 @@ def is_done(directory: Path, path: str | Path, options: str) -> dict[str, Any] |
         return None
 
 
-def write_done(directory: Path, marker: dict[str, Any], skip: tuple[str, ...] = ()) -> None:
+def write_done(directory: Path, marker: dict[str, Any], only: tuple[str, ...] | None = None) \
+        -> None:
     """
     Write the done-marker whole (a temporary name renamed into place), last.
 
     It lists the output files the directory holds now (``outputs``; not the temporaries an
-    interrupted run left, nor the entries named in `skip`: another task's), which
-    :func:`is_done` checks are all still there.
+    interrupted run left; with `only`, those under the entries it names: this run's, not
+    another task's or an earlier run's), which :func:`is_done` checks are all still there.
     """
     directory.mkdir(parents=True, exist_ok=True)
     files = (p.relative_to(directory) for p in directory.rglob('*') if p.is_file())
     marker = {**marker, 'outputs': sorted(
-        f.as_posix() for f in files if f.name != DONE and f.parts[0] not in skip
+        f.as_posix() for f in files if f.name != DONE and (only is None or f.parts[0] in only)
         and not any('.partial-' in part or '.old-' in part for part in f.parts))}
     temporary = directory / f'{DONE}.partial-{os.getpid()}'
     temporary.write_text(json.dumps(marker, indent=1, sort_keys=True) + '\n', encoding='utf-8')

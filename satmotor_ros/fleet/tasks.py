@@ -30,6 +30,9 @@ CALIBRATE_DIR, VALIDATE_DIR = 'calibrate', 'validate'
 
 ZERO_PRESSURE = 'every pressure is zero'
 
+OUTPUTS = {CALIBRATE_DIR: 'calibrate', VALIDATE_DIR: 'validate', 'health': 'fleet-health'}
+"""A recording's output directories, each with the command its marker names."""
+
 STEP, STATE, MONITOR_DIR = '.fleet-monitor.json', '.monitor-state.json', 'monitor'
 """The motor's monitor chain's files in a recording's directory (:mod:`~satmotor_ros.fleet.chain`):
 its step's marker, the monitor's state after it and ``satmotor monitor``'s output."""
@@ -323,7 +326,7 @@ def process_recording(rec: Recording, rule: MotorRule, baseline: dict[str, Any],
     from satmotor_ros.cli.calibrate import calibrate_into
     from satmotor_ros.cli.validate import validate_into
     from satmotor_ros.cli._common import CliError
-    from satmotor_ros.fleet.health import recording_health
+    from satmotor_ros.fleet.health import HEALTH_DIR, recording_health
     from satmotor_ros.identify import IdentificationError
     from satmotor_ros.model import ModelError
     out = Path(run.out) / rec.motor / rec.name
@@ -336,6 +339,7 @@ def process_recording(rec: Recording, rule: MotorRule, baseline: dict[str, Any],
     if done is not None:
         return done
     columns = columns_of(rule, run)
+    written = [CALIBRATE_DIR] if rec.relative == baseline.get('recording') else []
     try:
         if baseline.get('recording') is None and not baseline.get('coefficients'):
             raise no_baseline(baseline, rec)
@@ -344,18 +348,39 @@ def process_recording(rec: Recording, rule: MotorRule, baseline: dict[str, Any],
         if run.calibrate and rec.relative != baseline.get('recording'):
             calibrate_into(rec.path, str(out / CALIBRATE_DIR), 'auto', run.alpha, run.folds,
                            settled, columns, False, table)
+            written.append(CALIBRATE_DIR)
         if run.validate:
             validate_into(rec.path, str(out / VALIDATE_DIR), 'auto', base, columns, False,
                           table)
+            written.append(VALIDATE_DIR)
         health = recording_health(rec.relative, table, base, out)
+        written.append(HEALTH_DIR)
     except Refused as err:
         marker.update(status='refused', reason=str(err), result=None)
     except (CliError, IdentificationError, ModelError, OptionError, OSError) as err:
         marker.update(status='refused', reason=_line(err), result=None)
     else:
         marker.update(status='done', reason='', result=health.as_dict())
-    write_done(out, marker, skip=(STEP, STATE, MONITOR_DIR))  # the chain's, written apart
+    drop_stale(out, tuple(written))
+    write_done(out, marker, only=tuple(written))
     return marker
+
+
+def drop_stale(out: Path, keep: tuple[str, ...]) -> None:
+    """
+    Remove what an earlier run wrote in a recording's directory and this one did not.
+
+    A rerun on other options (``--calibrate`` or ``--validate`` dropped, a recording now
+    refused, the baseline moved to another recording) leaves no earlier output behind. Only
+    a directory its command's marker names as wholly its own is removed
+    (:func:`~satmotor_ros.cli._output.written_by`): never a file the tool did not write.
+    """
+    import shutil
+    from satmotor_ros.cli._output import written_by
+    for name, command in OUTPUTS.items():
+        target = out / name
+        if name not in keep and target.is_dir() and written_by(command)(target):
+            shutil.rmtree(target)
 
 
 def _line(err: BaseException) -> str:
@@ -365,6 +390,7 @@ def _line(err: BaseException) -> str:
 
 
 __all__ = ['BASELINE', 'CALIBRATE_DIR', 'MONITOR_DIR', 'MotorRefused', 'NO_LIQUID', 'RunOptions',
-           'Refused', 'STATE', 'STEP', 'VALIDATE_DIR', 'ZERO_PRESSURE', 'baseline_rule_key',
+           'OUTPUTS', 'Refused', 'STATE', 'STEP', 'VALIDATE_DIR', 'ZERO_PRESSURE',
+           'baseline_rule_key', 'drop_stale',
            'calibrate_baseline', 'columns_of', 'given_baseline', 'input_of', 'load_screened',
            'motor_options', 'no_baseline', 'process_recording', 'recording_options']
