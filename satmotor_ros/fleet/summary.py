@@ -192,7 +192,10 @@ def _changes(series: list[dict[str, Any]], times: np.ndarray, values: np.ndarray
 
     A day-to-day step is a change when it stands out of the motor's other steps (their
     median is the wear rate, their spread the noise) by :data:`CHANGE_SIGMAS` of the two
-    recordings' intervals and that spread, and by :data:`MIN_STEP` at least.
+    recordings' intervals and that spread, and by :data:`MIN_STEP` at least. With one other
+    step (three recordings) the faster step is judged by how far the middle recording lies
+    off the line through the other two, half the steps' difference, and the slower is not a
+    change: a steady wear (two like steps) is a trend, a flat step then a jump one change.
     """
     alarms: list[dict[str, Any]] = []
     start = 0
@@ -201,7 +204,7 @@ def _changes(series: list[dict[str, Any]], times: np.ndarray, values: np.ndarray
     for i in range(1, len(series)):
         others = np.delete(steps, i - 1)
         days = max((times[i] - times[i - 1]) / DAY, 1.0 / 24.0)
-        typical = float(np.median(others)) * days if others.size >= 2 else 0.0
+        typical = _wear_rate(steps[i - 1], others) * days
         spread = 1.4826 * float(np.median(np.abs(others - np.median(others)))) * days \
             if others.size >= 2 else 0.0
         step = values[i] - values[i - 1] - typical
@@ -216,6 +219,16 @@ def _changes(series: list[dict[str, Any]], times: np.ndarray, values: np.ndarray
                            'recording': series[i]['recording']})
             start = i
     return alarms, start
+
+
+def _wear_rate(own: float, others: np.ndarray) -> float:
+    """Return the wear rate a step is judged against: the other steps' median, per day."""
+    if others.size >= 2:
+        return float(np.median(others))
+    if others.size == 1:  # three recordings: the middle one's distance from the line
+        other = float(others[0])  # through the ends, (own - other) / 2, on the faster step
+        return own if abs(own) <= abs(other) else (own + other) / 2.0
+    return 0.0  # two recordings: a step cannot be told from wear
 
 
 def _trend(t: np.ndarray, v: np.ndarray, limit: float) -> tuple[float | None, float | None]:
