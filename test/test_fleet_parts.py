@@ -173,8 +173,11 @@ def test_a_recording_whose_output_was_deleted_is_not_done(tmp_path):
 
 
 def test_a_rerun_on_other_options_leaves_no_earlier_output_behind(tmp_path):
-    """F6: validate/ of a run with --validate is gone after one without, and not listed; a
-    directory of the user's, or one of ours the user wrote into, is kept (not the tool's)."""
+    """
+    F6: validate/ of a run with --validate is gone after one without, and not listed.
+
+    A directory of the user's, or one of ours the user wrote into, is kept (not the tool's).
+    """
     from satmotor_ros.fleet.resume import read_done
     from satmotor_ros.fleet.synthetic import write_recording
     from satmotor_ros.fleet.tasks import process_recording, RunOptions
@@ -234,8 +237,11 @@ def test_wear_gives_a_trend_and_days_to_limit_but_no_change_alarm():
 
 @pytest.mark.parametrize('n', range(3, 11))
 def test_a_steady_wear_of_3_to_10_recordings_is_a_trend_not_changes(n):
-    """F5: wear of 0.12 a day (past MIN_STEP each day) is a trend; three recordings read as
-    two change alarms when a lone other step was taken for no wear at all."""
+    """
+    F5: wear of 0.12 a day (past MIN_STEP each day) is a trend, not changes.
+
+    Three recordings read as two change alarms when a lone other step was taken for no wear.
+    """
     rng = np.random.default_rng(n)
     values = 1.0 + 0.12 * np.arange(n) + rng.normal(0, 0.002, n)
     view = motor_view('w', 'water', _markers(values), None, limit=3.0)
