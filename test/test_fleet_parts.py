@@ -219,6 +219,46 @@ def test_a_report_drops_the_plots_of_motors_it_no_longer_has(tmp_path):
                                                                       'fleet.png']
 
 
+def test_a_touched_recording_is_hashed_once_and_a_motor_file_once_per_run(tmp_path,
+                                                                         monkeypatch):
+    """
+    F9: a touched recording (same content) is hashed by the first rerun only.
+
+    Its hash is kept by its new stat in DIR; a motor's file is hashed once a run, not once a
+    recording.
+    """
+    from satmotor_ros.fleet import resume, tasks
+    from satmotor_ros.fleet.engine import plan
+    from satmotor_ros.model.io.config import default_config_path
+    root = tmp_path / 'root'
+    for day in range(3):
+        _csv(root / 'm1' / f'r{day}.csv', EPOCH + day * DAY)
+    motor_file = str(default_config_path('sm075_25.yaml'))
+    (root / 'fleet.yaml').write_text('motors: [{pattern: "m1/**", motor: m1, liquid: water, '
+                                     f'motor_file: {motor_file}}}]\n')
+    motors = discover(root, load_fleet(root / 'fleet.yaml'))
+    run = tasks.RunOptions(str(tmp_path / 'out'))
+    key = options_key(tasks.recording_options(motors[0].rule, run,
+                                              tasks.given_baseline(motors[0], run)['key']))
+    for rec in motors[0].recordings:
+        write_done(tmp_path / 'out' / 'm1' / rec.name, {'options': key, **tasks.input_of(rec)})
+    calls = []
+    real = resume.content_of
+    for module in (resume, tasks):
+        monkeypatch.setattr(module, 'content_of', lambda p: calls.append(str(p)) or real(p))
+
+    def hashed():
+        calls.clear()
+        assert len(plan(motors, run).done) == 3
+        assert calls.count(motor_file) <= 1
+        return [c for c in calls if c != motor_file]
+
+    assert hashed() == []  # the stat says it: no data read
+    os.utime(motors[0].recordings[0].path, (EPOCH, EPOCH))  # touched: same content
+    assert hashed() == [motors[0].recordings[0].path]
+    assert hashed() == []
+
+
 def _markers(values, start=EPOCH, half=0.003):
     return [{'status': 'done', 'recording': f'r{i}.csv', 'date': f'd{i:02d}',
              'time': start + i * DAY, 'time_source': TIME_COLUMN,

@@ -23,7 +23,8 @@ from typing import Any
 
 from satmotor_ros.fleet.config import MotorRule
 from satmotor_ros.fleet.discover import Motor, Recording
-from satmotor_ros.fleet.resume import content_of, options_key, read_marker, stat_of
+from satmotor_ros.fleet.resume import (content_of, HashCache, options_key, read_marker,
+                                       stat_of)
 from satmotor_ros.fleet.tasks import (columns_of, input_of, load_screened, MONITOR_DIR,
                                       motor_options, no_baseline, Refused, rule_identity,
                                       RunOptions, STATE, STEP)
@@ -45,12 +46,14 @@ def read_step(directory: Path) -> dict[str, Any] | None:
     return read_marker(directory / STEP)
 
 
-def valid_steps(motor: Motor, run: RunOptions, baseline_key: str) -> list[dict[str, Any]]:
+def valid_steps(motor: Motor, run: RunOptions, baseline_key: str,
+                hashes: HashCache | None = None) -> list[dict[str, Any]]:
     """
     Return the markers of the motor's first steps that still hold, in time order.
 
     A step holds when it was run after the step that holds before it, on the same options,
-    on its recording as it is now (same stat, or same content), with its outputs there.
+    on its recording as it is now (same stat, or same content: known to `hashes`, else
+    hashed), with its outputs there.
     """
     options = step_options(motor.rule, run, baseline_key)
     held: list[dict[str, Any]] = []
@@ -66,8 +69,8 @@ def valid_steps(motor: Motor, run: RunOptions, baseline_key: str) -> list[dict[s
                 Path(run.out) / motor.motor / rec.name / MONITOR_DIR / 'monitor.json').is_file():
             break
         try:
-            if marker.get('stat') != stat_of(rec.path) and \
-                    marker.get('content') != content_of(rec.path):
+            if marker.get('stat') != stat_of(rec.path) and marker.get('content') != (
+                    hashes.content(rec.path) if hashes is not None else content_of(rec.path)):
                 break
         except OSError:
             break

@@ -25,7 +25,7 @@ from typing import Any
 from satmotor_ros.fleet.chain import monitor_step, valid_steps
 from satmotor_ros.fleet.discover import Motor, Recording
 from satmotor_ros.fleet.errors import FleetError
-from satmotor_ros.fleet.resume import content_of, is_done, options_key, stat_of
+from satmotor_ros.fleet.resume import HashCache, is_done, options_key, stat_of
 from satmotor_ros.fleet.tasks import (BASELINE, baseline_rule_key, calibrate_baseline,
                                       given_baseline, process_recording, recording_options,
                                       RunOptions)
@@ -90,28 +90,31 @@ def plan(motors: list[Motor], run: RunOptions) -> Plan:
 
     """
     result = Plan(motors)
+    hashes = HashCache(run.out)
     for motor in motors:
-        baseline = _valid_baseline(motor, run)
+        baseline = _valid_baseline(motor, run, hashes)
         if baseline is None:
             result.todo.extend(motor.recordings)
             result.chain_from[motor.motor] = 0
             continue
         result.baselines[motor.motor] = baseline
-        held = valid_steps(motor, run, baseline['key'])
+        held = valid_steps(motor, run, baseline['key'], hashes)
         result.steps.update({m['recording']: m for m in held})
         if len(held) < len(motor.recordings):
             result.chain_from[motor.motor] = len(held)
+        key = options_key(recording_options(motor.rule, run, baseline['key']))  # per motor
         for rec in motor.recordings:
-            key = options_key(recording_options(motor.rule, run, baseline['key']))
-            marker = is_done(Path(run.out) / motor.motor / rec.name, rec.path, key)
+            marker = is_done(Path(run.out) / motor.motor / rec.name, rec.path, key, hashes)
             if marker is None:
                 result.todo.append(rec)
             else:
                 result.done[rec.relative] = marker
+    hashes.save()
     return result
 
 
-def _valid_baseline(motor: Motor, run: RunOptions) -> dict[str, Any] | None:
+def _valid_baseline(motor: Motor, run: RunOptions,
+                    hashes: HashCache) -> dict[str, Any] | None:
     """Return the motor's baseline when it still holds for the recordings as they are now."""
     if motor.rule.motor_file:
         return given_baseline(motor, run)
@@ -129,7 +132,8 @@ def _valid_baseline(motor: Motor, run: RunOptions) -> dict[str, Any] | None:
     stats = found.get('stats', {})
     for rec, content in zip(motor.recordings, contents):
         try:
-            if stats.get(rec.relative) != stat_of(rec.path) and content_of(rec.path) != content:
+            if stats.get(rec.relative) != stat_of(rec.path) and hashes.content(rec.path) \
+                    != content:
                 return None
         except OSError:
             return None

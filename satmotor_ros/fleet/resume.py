@@ -7,7 +7,7 @@ A recording's outputs are complete when ``DIR/<motor>/<recording>/`` holds
 it names the same options and the same input: the same file sizes and modification times,
 or, when those moved (a copy, a touch), the same content hash. The stat check costs a
 ``stat`` per file, so a rerun with nothing to do reads no data; the hash is only computed
-where the stat differs.
+where the stat differs, once: :class:`HashCache` keeps it by the new stat for the next run.
 """
 
 from __future__ import annotations
@@ -81,6 +81,47 @@ def content_of(path: str | Path) -> str:
     return digest.hexdigest()
 
 
+HASHES = '.fleet-hashes.json'
+"""The fleet's cache of its recordings' content hashes, in DIR."""
+
+
+class HashCache:
+    """
+    The content hash of each recording by its files' (size, mtime), kept in DIR.
+
+    A recording touched since its marker (same content, another mtime) is hashed once, by
+    the first run that sees it; the runs after find its hash here by its stat and read no
+    data. The file keeps the hashes a run asked for (a recording gone is dropped).
+    """
+
+    def __init__(self, directory: str | Path) -> None:
+        self.path = Path(directory) / HASHES
+        found = read_marker(self.path) or {}
+        self._held = found.get('recordings') if isinstance(found.get('recordings'), dict) \
+            else {}
+        self._asked: dict[str, Any] = {}
+
+    def content(self, path: str | Path) -> str:
+        """Return :func:`content_of` a recording, hashed only when its stat is not known."""
+        stat = stat_of(path)
+        key = str(path)
+        entry = self._held.get(key)
+        if not (isinstance(entry, dict) and entry.get('stat') == stat
+                and isinstance(entry.get('content'), str)):
+            entry = {'stat': stat, 'content': content_of(path)}
+        self._asked[key] = entry
+        return str(entry['content'])
+
+    def save(self) -> None:
+        """Write the hashes asked for, whole (a temporary name renamed into place)."""
+        if self._asked == self._held or not self.path.parent.is_dir():
+            return
+        temporary = self.path.with_name(f'{HASHES}.partial-{os.getpid()}')
+        temporary.write_text(json.dumps({'recordings': self._asked}, sort_keys=True) + '\n',
+                             encoding='utf-8')
+        os.replace(temporary, self.path)
+
+
 def options_key(options: dict[str, Any]) -> str:
     """Hash the options a recording's outputs depend on (JSON with sorted keys)."""
     text = json.dumps(options, sort_keys=True, default=str)
@@ -101,7 +142,8 @@ def read_done(directory: Path) -> dict[str, Any] | None:
     return read_marker(directory / DONE)
 
 
-def is_done(directory: Path, path: str | Path, options: str) -> dict[str, Any] | None:
+def is_done(directory: Path, path: str | Path, options: str,
+            hashes: HashCache | None = None) -> dict[str, Any] | None:
     """
     Return the done-marker when the outputs are complete for this input and options.
 
@@ -113,6 +155,8 @@ def is_done(directory: Path, path: str | Path, options: str) -> dict[str, Any] |
         The recording, [-]
     options : str
         :func:`options_key` of the options asked now, [-]
+    hashes : HashCache, optional
+        The fleet's known hashes (a touched recording is not hashed again), [-]
 
     Returns
     -------
@@ -130,7 +174,8 @@ def is_done(directory: Path, path: str | Path, options: str) -> dict[str, Any] |
     try:
         if marker.get('stat') == stat_of(path):
             return marker
-        return marker if marker.get('content') == content_of(path) else None
+        content = hashes.content(path) if hashes is not None else content_of(path)
+        return marker if marker.get('content') == content else None
     except OSError:
         return None
 
@@ -154,5 +199,5 @@ def write_done(directory: Path, marker: dict[str, Any], only: tuple[str, ...] | 
     os.replace(temporary, directory / DONE)
 
 
-__all__ = ['DONE', 'content_of', 'is_done', 'options_key', 'read_done', 'read_marker', 'stat_of',
+__all__ = ['DONE', 'HASHES', 'HashCache', 'content_of', 'is_done', 'options_key', 'read_done', 'read_marker', 'stat_of',
            'write_done']

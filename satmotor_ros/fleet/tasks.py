@@ -15,6 +15,7 @@ import json
 import os
 from pathlib import Path
 import socket
+import time
 from typing import Any
 
 from satmotor_ros.fleet.config import MotorRule
@@ -263,10 +264,36 @@ def rule_identity(rule: MotorRule) -> list[Any]:
     A column mapping or motor file edited in place changes every result read through it, so
     the content of each file the entry names is part of it, not only the path.
     """
-    files = [content_of(name) if name and Path(name).is_file() else ''
-             for name in (rule.motor_file, rule.columns)]
+    files = [file_digest(name) for name in (rule.motor_file, rule.columns)]
     return [rule.pattern, rule.motor, rule.liquid, rule.family, rule.displacement,
             rule.motor_file, rule.columns, rule.columns_inline, *files]
+
+
+_DIGESTS: dict[tuple[str, int, int], str] = {}
+_SETTLED_NS = 2_000_000_000  # a file's digest is kept once its mtime is this old [ns]
+
+
+def file_digest(name: str) -> str:
+    """
+    Return :func:`content_of` a motor file or column mapping; '' for none (or a packaged name).
+
+    Hashed once per (path, size, mtime) in a process: a run's keys, one per recording, hash
+    each motor's files once, not once per recording (a file written in the last 2 s is
+    hashed every time: an edit within the clock's tick keeps the mtime).
+    """
+    try:
+        st = os.stat(name) if name else None
+    except OSError:
+        st = None
+    if st is None or not Path(name).is_file():
+        return ''
+    key = (name, st.st_size, st.st_mtime_ns)
+    if key in _DIGESTS:
+        return _DIGESTS[key]
+    digest = content_of(name)
+    if time.time_ns() - st.st_mtime_ns > _SETTLED_NS:  # an edit within its mtime's tick: hashed
+        _DIGESTS[key] = digest
+    return digest
 
 
 def baseline_rule_key(rule: MotorRule, run: RunOptions) -> str:
@@ -277,10 +304,10 @@ def baseline_rule_key(rule: MotorRule, run: RunOptions) -> str:
 
 def given_baseline(motor: Motor, run: RunOptions) -> dict[str, Any]:
     """Return the baseline of a motor whose fleet.yaml entry gives its motor file."""
-    from satmotor_ros.fleet.resume import content_of as digest
     found: dict[str, Any] = {'recording': None, 'coefficients': motor.rule.motor_file,
                              'liquid': motor.rule.liquid or run.liquid,
-                             'content': digest(motor.rule.motor_file), 'refused_before': []}
+                             'content': file_digest(motor.rule.motor_file),
+                             'refused_before': []}
     found['key'] = options_key(found)
     return found
 
@@ -391,6 +418,6 @@ def _line(err: BaseException) -> str:
 
 __all__ = ['BASELINE', 'CALIBRATE_DIR', 'MONITOR_DIR', 'MotorRefused', 'NO_LIQUID', 'RunOptions',
            'OUTPUTS', 'Refused', 'STATE', 'STEP', 'VALIDATE_DIR', 'ZERO_PRESSURE',
-           'baseline_rule_key', 'drop_stale',
+           'baseline_rule_key', 'drop_stale', 'file_digest',
            'calibrate_baseline', 'columns_of', 'given_baseline', 'input_of', 'load_screened',
            'motor_options', 'no_baseline', 'process_recording', 'recording_options']
