@@ -304,6 +304,21 @@ def test_a_slope_three_recordings_cannot_tell_from_noise_gives_no_date():
     assert view['days_to_limit'] is None
 
 
+def test_the_doc_gives_the_student_bound_the_days_to_the_limit_need():
+    """doc/fleet.md says the t-bound ``summary._trend`` uses (it said 2 standard errors)."""
+    from pathlib import Path
+    from scipy.stats import t as student
+    text = ' '.join((Path(__file__).resolve().parents[1] / 'doc' / 'fleet.md').read_text(
+        encoding='utf-8').split())
+    assert 'by two standard errors' not in text
+    assert (f'{student.ppf(0.975, 1):.1f} of them with three recordings, '
+            f'{student.ppf(0.975, 8):.1f} with ten') in text
+    rng = np.random.default_rng(9)  # ten recordings, slope 2.19 standard errors: below 2.31
+    values = 1.0 + 0.0004 * np.arange(10) + rng.normal(0, 0.002, 10)
+    view = motor_view('t', 'water', _markers(values), None, limit=2.0)
+    assert view['trend_per_day'] > 0 and view['days_to_limit'] is None
+
+
 def test_a_step_is_one_change_alarm_and_the_trend_restarts_after_it():
     rng = np.random.default_rng(2)
     values = np.r_[np.ones(5), 1.5 * np.ones(5)] + rng.normal(0, 0.002, 10)

@@ -297,13 +297,17 @@ def rank(motors: list[dict[str, Any]]) -> list[dict[str, Any]]:
         if last >= limit or days == 0.0:
             return (0, -last, m['motor'])
         if days is not None:
-            since = (now - m['last_time']) / DAY if now is not None and m.get(
-                'last_time') is not None else 0.0
-            return (1, days - since, m['motor'])
+            return (1, days - _days_since(m, now), m['motor'])
         if last >= limit - NEAR * (limit - 1.0):
             return (1, 0.0, m['motor'])
         return (2, -last, m['motor'])
     return sorted(motors, key=key)
+
+
+def _days_since(motor: dict[str, Any], now: float | None) -> float:
+    """Return the days from a motor's latest recording to the fleet's latest (0 if unknown)."""
+    last = motor.get('last_time')
+    return 0.0 if now is None or last is None else (now - float(last)) / DAY
 
 
 def iso_now() -> str:
