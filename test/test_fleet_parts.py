@@ -219,8 +219,8 @@ def test_a_report_drops_the_plots_of_motors_it_no_longer_has(tmp_path):
                                                                       'fleet.png']
 
 
-def test_a_touched_recording_is_hashed_once_and_a_motor_file_once_per_run(tmp_path,
-                                                                         monkeypatch):
+def test_a_touched_recording_is_hashed_once_and_a_motor_file_once_per_run(
+        tmp_path, monkeypatch):
     """
     F9: a touched recording (same content) is hashed by the first rerun only.
 

@@ -97,8 +97,8 @@ class HashCache:
     def __init__(self, directory: str | Path) -> None:
         self.path = Path(directory) / HASHES
         found = read_marker(self.path) or {}
-        self._held = found.get('recordings') if isinstance(found.get('recordings'), dict) \
-            else {}
+        held = found.get('recordings')
+        self._held: dict[str, Any] = held if isinstance(held, dict) else {}
         self._asked: dict[str, Any] = {}
 
     def content(self, path: str | Path) -> str:
@@ -199,5 +199,5 @@ def write_done(directory: Path, marker: dict[str, Any], only: tuple[str, ...] | 
     os.replace(temporary, directory / DONE)
 
 
-__all__ = ['DONE', 'HASHES', 'HashCache', 'content_of', 'is_done', 'options_key', 'read_done', 'read_marker', 'stat_of',
-           'write_done']
+__all__ = ['DONE', 'HASHES', 'HashCache', 'content_of', 'is_done', 'options_key', 'read_done',
+           'read_marker', 'stat_of', 'write_done']
