@@ -13,7 +13,12 @@ from satmotor_ros.identify.effects import CalibratedModel
 from satmotor_ros.identify.health import Baseline, HealthMonitor, HealthSamples, HealthSettings
 from satmotor_ros.identify.synthetic import base_model, generate_series, Injection, Plan
 from satmotor_ros.model import MotorModel
+from satmotor_ros.model.effects import Effect
+from satmotor_ros.model.effects.viscosity_temperature import KIND as VISCOSITY, law_of
 from satmotor_ros.model.units import MPA
+from satmotor_ros.model.viscosity import standard_law
+from satmotor_ros.options import MotorOptions
+from satmotor_ros.plant.params import ThermalParams
 
 QUIET = HealthSettings(explain=False)
 FAMILIES = ('sliwinski2017', 'balawender', 'paszota')
@@ -113,3 +118,34 @@ def test_a_thirty_kelvin_swing_is_no_change_and_the_factor_stays_one(family: str
         assert alarms == []
         assert abs(k.value - 1.0) < 0.012
         assert k.low <= 1.0 <= k.high
+
+
+@pytest.mark.parametrize(('liquid', 'at_40'), [('oil', 46.0 / 40.0), ('water', 0.654 / 0.853)])
+def test_the_plant_pinned_where_the_baseline_is_runs_the_baseline_s_oil(
+        liquid: str, at_40: float) -> None:
+    """
+    One home for where the model's viscosity holds: the liquid's standard law.
+
+    The baseline refers the oil to that law's reference (43.1 degC oil, 27.1 degC water); the
+    plant's ``thermal.reference`` (DESIGN.md: 40 degC) pins the same law at the model's
+    viscosity there instead: at 40 degC the law's viscosity is ``at_40`` times the plant's
+    (doc/health.md). Given the baseline's reference the plant's oil is the baseline's.
+    """
+    model = MotorOptions(liquid=liquid).build_model()
+    baseline = Baseline(model)
+    law = standard_law(model.liquid, model.coefficient_set.name)
+    assert baseline.reference_temperature == law.reference_temperature
+    temperatures = np.linspace(20.0, 70.0, 11)
+
+    def plant_oil(reference: float) -> np.ndarray:
+        effect = VISCOSITY.bind(Effect('viscosity_temperature', law.standard_slope,
+                                       'temperature'), law, reference)
+        return law_of(effect).viscosity(temperatures, law.standard_slope)
+
+    same = plant_oil(baseline.reference_temperature)
+    np.testing.assert_allclose(same, law.viscosity(temperatures, law.standard_slope),
+                               rtol=1e-12)
+    assert ThermalParams().reference == 40.0
+    default = plant_oil(ThermalParams().reference)
+    assert law.viscosity(40.0, law.standard_slope) / default[temperatures == 40.0][0] == \
+        pytest.approx(at_40, rel=2e-3)
