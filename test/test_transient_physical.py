@@ -25,5 +25,6 @@ def test_a_negative_compliance_is_flagged_impossible_in_json_and_report():
 
 def test_positive_terms_are_physical_and_carry_no_flag():
     _, found = _dynamics(Dynamics(line_compliance=5e-13, speed_lag=0.02, flow_lag=0.05), 12)
+    assert 'left_out' in found.pop('line_compliance_b')  # no volume on port B's line
     for d in found.values():
         assert d['physical'] is True and 'impossible' not in d, d

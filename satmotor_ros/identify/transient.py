@@ -382,6 +382,38 @@ def _screen(regressors: dict[str, FloatArray],
     return kept, left_out
 
 
+LINE_VOLUMES = ('line_compliance', 'line_compliance_b')
+"""The two line volumes of (T1): a rig metered on one line has only one of them."""
+
+VOLUME_T = 2.0
+"""Least |t| of a line volume in a least-squares fit of the loss on the base and every
+dynamic term (its variance inflated for the residuals' correlation) to keep it, [-]."""
+
+
+def _line_volumes(kept: dict[str, FloatArray], left_out: list[tuple[str, str]],
+                  parts: LossParts) -> tuple[dict[str, FloatArray], list[tuple[str, str]]]:
+    """
+    Leave out a line volume the loss does not show (|t| < :data:`VOLUME_T`), saying so.
+
+    A free coefficient on a line no flowmeter meets costs every later test power and can
+    soak up part of an effect; the screen is the same for both ports, so a recording and
+    its mirror keep the same volumes.
+    """
+    names = list(kept)
+    x = np.column_stack([_base(parts), *kept.values()])
+    coef, *_ = np.linalg.lstsq(x, parts.loss, rcond=None)
+    residual = parts.loss - x @ coef
+    dof = max(residual.size - x.shape[1], 1)
+    variance = float(residual @ residual) / dof * variance_inflation(residual)
+    scale = np.sqrt(variance * np.diag(np.linalg.pinv(x.T @ x)))
+    t = dict(zip(names, np.abs(coef[-len(names):]) / scale[-len(names):])) if names else {}
+    weak = [name for name in LINE_VOLUMES if name in t and not t[name] >= VOLUME_T]
+    return ({k: v for k, v in kept.items() if k not in weak},
+            left_out + [(name, f'the loss does not show it (|t| = {t[name]:.2f} < '
+                               f'{VOLUME_T:g} in a least-squares fit with every term)')
+                        for name in weak])
+
+
 REST_BAND = 5.0
 """A sample whose speed reads 0 is usable unless its flow runs against the drop by more than
 this many robust spreads of those samples' flow readings, [-]."""
@@ -501,6 +533,7 @@ def transient_samples(model: MotorModel, table: BenchTable,
     regressors = dynamic_regressors(dp_a, dp_b, dn, dq,
                                     flow_per_speed(parts, model.geometry.displacement))
     nuisance, left_out = _screen(regressors, parts)
+    nuisance, left_out = _line_volumes(nuisance, left_out, parts)
     parts = parts.with_nuisance(nuisance)
     rows = BenchTable(mean(table.speed), mean(table.flow), mean(table.p_in), mean(table.p_out),
                       {k: _channel_means(time, v, a, b) for k, v in table.channels.items()},
