@@ -20,6 +20,7 @@ from satmotor_ros.identify.synthetic import (Dynamics, first_order, generate_ser
 from satmotor_ros.identify.table import write_csv
 from satmotor_ros.identify.transient import (bin_means, bins, segments, transient_samples,
                                              variance_inflation)
+from satmotor_ros.identify.validate import validate
 from satmotor_ros.model import MotorModel
 from satmotor_ros.model.units import LPM, MPA
 from satmotor_ros.model.viscosity import standard_law
@@ -169,6 +170,13 @@ def test_a_line_volume_on_each_port_is_recovered_beside_the_lags():
                                 options=Options(mode='transient')))
     for term in ('line_compliance', 'line_compliance_b', 'speed_lag', 'flow_lag'):
         assert _covers(found[term], getattr(dynamics, term)) and found[term]['nonzero'], term
+
+
+def test_validate_applies_a_calibrated_line_volume_the_data_do_not_show():
+    table = _recording('oil', dynamics=REALISTIC_DYNAMICS, seed=7)  # port A's volume only
+    volumes = {'line_compliance': 5e-13, 'line_compliance_b': 3e-13}
+    checked = validate(table, MotorModel.default('oil'), 'oil', 'transient', dynamics=volumes)
+    assert checked.transient['applied'] == volumes
 
 
 @pytest.mark.parametrize('seed', [4, 5, 6])

@@ -111,6 +111,8 @@ class TransientOptions:
     gap: float = 3.0  # a time step over gap x the median step cuts the series [-]
     min_steady: int = 20  # 'auto' takes steady windows only when they give this many points [-]
     max_rows: int = MAX_ROWS  # rows a fit takes at most [-]
+    screen_volumes: bool = True  # leave out a line volume the loss does not show (validate
+    # applies a calibration's volumes to data that may not show them, so it keeps both) [-]
 
     def __post_init__(self) -> None:
         """Reject a bin <= 0, a gap <= 1 and counts < 1."""
@@ -401,12 +403,14 @@ def _line_volumes(kept: dict[str, FloatArray], left_out: list[tuple[str, str]],
     """
     names = list(kept)
     x = np.column_stack([_base(parts), *kept.values()])
+    x = x / np.where(np.any(x, axis=0), np.linalg.norm(x, axis=0), 1.0)  # t is scale-free
     coef, *_ = np.linalg.lstsq(x, parts.loss, rcond=None)
     residual = parts.loss - x @ coef
     dof = max(residual.size - x.shape[1], 1)
     variance = float(residual @ residual) / dof * variance_inflation(residual)
-    scale = np.sqrt(variance * np.diag(np.linalg.pinv(x.T @ x)))
-    t = dict(zip(names, np.abs(coef[-len(names):]) / scale[-len(names):])) if names else {}
+    scale = np.sqrt(variance * np.abs(np.diag(np.linalg.pinv(x.T @ x))))
+    with np.errstate(divide='ignore', invalid='ignore'):
+        t = dict(zip(names, np.abs(coef[-len(names):]) / scale[-len(names):])) if names else {}
     weak = [name for name in LINE_VOLUMES if name in t and not t[name] >= VOLUME_T]
     return ({k: v for k, v in kept.items() if k not in weak},
             left_out + [(name, f'the loss does not show it (|t| = {t[name]:.2f} < '
@@ -533,7 +537,8 @@ def transient_samples(model: MotorModel, table: BenchTable,
     regressors = dynamic_regressors(dp_a, dp_b, dn, dq,
                                     flow_per_speed(parts, model.geometry.displacement))
     nuisance, left_out = _screen(regressors, parts)
-    nuisance, left_out = _line_volumes(nuisance, left_out, parts)
+    if options.screen_volumes:
+        nuisance, left_out = _line_volumes(nuisance, left_out, parts)
     parts = parts.with_nuisance(nuisance)
     rows = BenchTable(mean(table.speed), mean(table.flow), mean(table.p_in), mean(table.p_out),
                       {k: _channel_means(time, v, a, b) for k, v in table.channels.items()},

@@ -37,7 +37,7 @@ from satmotor_ros.identify.pipeline import Mode, Options, read_rows
 from satmotor_ros.identify.selection import Errors
 from satmotor_ros.identify.steady import SteadyTolerance
 from satmotor_ros.identify.table import BenchTable
-from satmotor_ros.identify.transient import averaged, parts_at, Samples
+from satmotor_ros.identify.transient import averaged, parts_at, Samples, TransientOptions
 from satmotor_ros.model import MotorModel
 from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.effects import Effect, flow_reading, kind_of
@@ -155,8 +155,9 @@ def validate(table: BenchTable, model: MotorModel, liquid: str, mode: Mode = 'au
         If the model's effects need a channel the data lack (the message names it).
 
     """
-    read = read_rows(_bare(model), table, Options(mode=mode, steady=tol or SteadyTolerance()),
-                     check=False)
+    options = Options(mode=mode, steady=tol or SteadyTolerance(),
+                      transient=TransientOptions(screen_volumes=False))
+    read = read_rows(_bare(model), table, options, check=False)
     beyond = _outside(calibrated, table)
     if read.samples is not None:
         return replace(_validate_samples(read.samples, model, liquid, dynamics),
