@@ -202,7 +202,7 @@ def _names(result):
 
 def _lags(result):
     """Return the fitted flow lag and its excess over the speed lag (what the data fix), [s]."""
-    lags = {d['term']: d['coefficient'] if d['nonzero'] else 0.0
+    lags = {d['term']: d['coefficient'] if d.get('nonzero') else 0.0
             for d in result.get('dynamics', [])}
     return lags.get('flow_lag', 0.0), lags.get('flow_lag', 0.0) - lags.get('speed_lag', 0.0)
 
