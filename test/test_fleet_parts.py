@@ -468,6 +468,13 @@ def test_without_a_baseline_the_damaged_keep_their_reason_and_the_sound_say_why(
     assert reasons.pop('tug_d/d04.csv') == ZERO_PRESSURE
     assert 'UTF-8' in reasons.pop('tug_d/d99_garbage.csv')
     assert set(reasons.values()) == {baseline['reason']}
+    from satmotor_ros.fleet.engine import plan
+    work = plan([motor], run)  # a rerun: the no-baseline is kept, nothing of it redone
+    assert work.baselines[motor.motor]['reason'] == baseline['reason'] and work.todo == []
+    assert plan([motor], RunOptions(str(tmp_path / 'out'), liquid='water')).todo  # new options
+    with open(motor.recordings[-1].path, 'a') as file:
+        file.write('1\n')
+    assert plan([motor], run).baselines == {}  # a recording changed: the baseline tried again
 
 
 @pytest.mark.parametrize(('text', 'said'), [

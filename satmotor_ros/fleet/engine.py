@@ -125,8 +125,10 @@ def _valid_baseline(motor: Motor, run: RunOptions,
     if not isinstance(found, dict) or found.get('rule') != baseline_rule_key(motor.rule, run):
         return None
     before = [entry.get('recording') for entry in found.get('refused_before', [])]
-    names = [rec.relative for rec in motor.recordings[:len(before) + 1]]
-    if names != [*before, found.get('recording')]:
+    calibrated = found.get('recording') is not None  # else every recording was refused
+    names = [rec.relative for rec in motor.recordings[:len(before) + calibrated]]
+    if names != [*before, found.get('recording')][:len(before) + calibrated] \
+            or not calibrated and len(motor.recordings) != len(before):
         return None  # an earlier recording appeared, or one went away
     contents = [e.get('content') for e in found['refused_before']] + [found.get('content')]
     stats = found.get('stats', {})
@@ -137,7 +139,7 @@ def _valid_baseline(motor: Motor, run: RunOptions,
                 return None
         except OSError:
             return None
-    return found if Path(found.get('coefficients', '')).is_file() else None
+    return found if not calibrated or Path(found.get('coefficients', '')).is_file() else None
 
 
 def machine_workers() -> int:

@@ -210,7 +210,8 @@ def calibrate_baseline(motor: Motor, run: RunOptions) -> dict[str, Any]:
     dict
         :data:`BASELINE`'s content: ``recording``, ``coefficients``, ``liquid``, ``key``
         (what a recording's health depends on) and ``refused_before``; ``recording``
-        None and ``reason`` when no recording calibrates.
+        None and ``reason`` when no recording calibrates (written too, so a rerun on the
+        same recordings and options finds it).
 
     """
     from satmotor_ros.cli.calibrate import calibrate_into
@@ -247,7 +248,12 @@ def calibrate_baseline(motor: Motor, run: RunOptions) -> dict[str, Any]:
     tried = next((r for r in refused if r['sound']), None)
     reason = (f"no baseline: {tried['recording']} was tried first and {tried['reason']}"
               if tried else 'no baseline: no recording of the motor is sound')
-    return {'recording': None, 'reason': reason, 'refused_before': refused, 'key': ''}
+    none: dict[str, Any] = {'recording': None, 'reason': reason, 'refused_before': refused,
+                            'rule': baseline_rule_key(motor.rule, run)}
+    none['key'] = options_key(none)
+    none['stats'] = stats  # kept too: a rerun with the same recordings and options redoes none
+    _write_baseline(Path(run.out) / motor.motor, none)
+    return none
 
 
 def no_baseline(baseline: dict[str, Any], rec: Recording) -> Refused:
