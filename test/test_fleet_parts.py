@@ -257,6 +257,11 @@ def test_a_touched_recording_is_hashed_once_and_a_motor_file_once_per_run(
     os.utime(motors[0].recordings[0].path, (EPOCH, EPOCH))  # touched: same content
     assert hashed() == [motors[0].recordings[0].path]
     assert hashed() == []
+    cache = resume.HashCache(tmp_path / 'out')  # a baseline, a step, a marker check one file
+    os.utime(motors[0].recordings[1].path, (EPOCH, EPOCH))
+    calls.clear()
+    assert cache.content(motors[0].recordings[1].path) == cache.content(
+        motors[0].recordings[1].path) and calls == [motors[0].recordings[1].path]
 
 
 def _markers(values, start=EPOCH, half=0.003):

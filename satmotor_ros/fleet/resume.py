@@ -105,7 +105,7 @@ class HashCache:
         """Return :func:`content_of` a recording, hashed only when its stat is not known."""
         stat = stat_of(path)
         key = str(path)
-        entry = self._held.get(key)
+        entry = self._asked.get(key) or self._held.get(key)  # once a run, then once a stat
         if not (isinstance(entry, dict) and entry.get('stat') == stat
                 and isinstance(entry.get('content'), str)):
             entry = {'stat': stat, 'content': content_of(path)}
