@@ -56,6 +56,17 @@ def test_one_bad_cell_is_named_and_the_leak_still_found(tmp_path, capsys, leak_c
     assert f'- bad cells: {note}' in report
 
 
+def test_a_pressure_beyond_any_hydraulics_is_dropped_and_a_high_one_is_kept(tmp_path,
+                                                                           leak_csv):
+    absurd = read_csv(_with_cell(tmp_path, leak_csv, 'p_in', 5, '2000'))  # MPa: 2 GPa
+    assert len(absurd) == 99
+    assert [n for n in absurd.notes if "'p_in'" in n] == [
+        "bad cells: column 'p_in': dropped the rows of 1 absurd values (up to 2e+09 in SI) at "
+        'data rows 5']
+    high = read_csv(_with_cell(tmp_path, leak_csv, 'p_in', 5, '600'))  # an intensifier's
+    assert len(high) == 100 and high.p_in.max() == pytest.approx(600e6)
+
+
 def test_a_mostly_missing_channel_drops_no_row(tmp_path, leak_csv):
     lines = [line + (',aux2 [V]' if i == 0 else f',{i if i % 2 else ""}')
              for i, line in enumerate(leak_csv)]

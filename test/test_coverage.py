@@ -8,17 +8,22 @@ import numpy as np
 import pytest
 
 from satmotor_ros.cli import validate as validate_cli
+from satmotor_ros.cli.calibrate import _errors
 from satmotor_ros.identify import calibrate, write_csv
 from satmotor_ros.identify.calibrated import Calibrated
+from satmotor_ros.identify.candidates import build_library
 from satmotor_ros.identify.columns import load_mapping, read_log
 from satmotor_ros.identify.coverage import envelope, envelope_share, outside
 from satmotor_ros.identify.errors import DataError
 from satmotor_ros.identify.output import write_yaml
+from satmotor_ros.identify.parts import loss_parts
 from satmotor_ros.identify.synthetic import (generate, generate_transient, Injection, Plan,
                                              REALISTIC_DYNAMICS)
-from satmotor_ros.identify.transient import segments, spikes, transient_samples
+from satmotor_ros.identify.transient import (reading_spikes, segments, spikes,
+                                             transient_samples)
 from satmotor_ros.model import MotorModel
 from satmotor_ros.model.units import LPM, MPA, RPM
+from satmotor_ros.model.viscosity import standard_law
 from satmotor_ros.options import MotorOptions
 from vendored_data import data_path
 import yaml
@@ -139,8 +144,63 @@ def test_a_spike_is_listed_among_the_outliers_by_its_time():
     assert listed[0]['residual_lpm'] == pytest.approx(-2.0, rel=0.1)
 
 
+def _glitched(table, at):
+    speed, p_in = table.speed.copy(), table.p_in.copy()
+    speed[at] = 1.0e5 * RPM  # a speed no motor reaches, a pressure far off its course
+    p_in[at + 40] += 0.5 * np.ptp(p_in)
+    return replace(table, speed=speed, p_in=p_in)
+
+
+def test_a_spike_of_the_speed_or_a_pressure_is_named_and_mended_to_the_clean_rows():
+    table, at = _spiked(20.0)
+    model = MotorModel.default('oil')
+    clean, samples = (transient_samples(model, t) for t in (table, _glitched(table, at)))
+    assert list(zip(samples.spikes, samples.spike_channel)) == [(at, 'speed'), (at + 40, 'p_in')]
+    assert samples.spike_size[0] == pytest.approx(1.0e5 * RPM - table.speed[at], rel=0.01)
+    assert samples.spike_size[1] == pytest.approx(0.5 * np.ptp(table.p_in), rel=0.1)
+    assert 'mended: isolated spikes of 1 speed, 1 p_in reading(s)' in samples.table.notes[-1]
+    # each replaced by its neighbours' fit: the same rows, regressors and revolutions
+    assert samples.usable.sum() == clean.usable.sum() and len(samples.parts) == len(clean.parts)
+    for name in ('speed', 'flow', 'p_in', 'p_out'):
+        assert getattr(samples.table, name) == pytest.approx(getattr(clean.table, name),
+                                                              rel=1e-3, abs=1e-3), name
+    for name, x in samples.parts.nuisance.items():
+        assert np.abs(x - clean.parts.nuisance[name]).max() <= 0.05 * np.abs(x).max(), name
+    assert samples.table.channels['revolutions'] == pytest.approx(
+        clean.table.channels['revolutions'], rel=1e-3)
+
+
+def test_a_spiked_speed_and_pressure_give_the_clean_figures_and_are_listed(tmp_path):
+    table, at = _spiked(30.0, seed=5)
+    clean, cal = (calibrate(t, 'oil').summary() for t in (table, _glitched(table, at)))
+    for key in ('error_before', 'error_after'):
+        assert cal[key]['rmse_lpm'] == pytest.approx(clean[key]['rmse_lpm'], rel=0.02)
+    listed = [(o['sample'], o['reading']) for o in cal['outliers'] if 'sample' in o]
+    assert listed == [(at, 'speed'), (at + 40, 'p_in')]
+    # the summary line counts rows: a spike is of a sample, no row of this table is out
+    assert f'over {cal["n_points"]} rows of' in _errors(cal, True)
+    assert 'isolated outlier' not in _errors(cal, True)
+
+
 @pytest.mark.parametrize('name', MBARI)
 def test_the_real_logs_fast_transients_are_not_spikes(name):
     table = read_log(data_path('real', 'mbari_pto', name), load_mapping('mbari_pto'))
     first, _ = segments(table.channels['time'], 3.0)
     assert spikes(table.flow, first)[0].sum() <= 2  # of some 20 000 samples
+    # the pressures' ringing and the speed's jitter in the fast moves are not spikes
+    found = reading_spikes(table, first)
+    assert set(found.channel) <= {'flow'} and found.at.size <= 2
+
+
+def test_a_wear_over_an_epoch_clock_is_offered_as_over_a_clock_from_zero():
+    table = generate_transient(Plan(liquid='oil'), Injection(), REALISTIC_DYNAMICS, seed=3,
+                               duration_s=20.0)
+    parts, _ = loss_parts(MotorModel.default('oil'), table)
+    law = standard_law(MotorModel.default('oil').liquid, 'oil')
+    time = np.linspace(0.0, 20.0, len(parts))
+    offered = {}
+    for start in (0.0, 1.6e9):  # a time column read as seconds since 1970
+        candidates, skipped = build_library(parts, {'time': time + start}, law)
+        assert not [s for s in skipped if 'wear(time)' in s], skipped
+        offered[start] = [c for c in candidates if c.regressor == 'time']
+    assert [c.effect for c in offered[1.6e9]] == [c.effect for c in offered[0.0]] != []

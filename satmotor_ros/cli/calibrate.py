@@ -124,7 +124,8 @@ def calibrate_into(data: str, out: str, mode: Mode, alpha: float, folds: int,
 def _errors(summary: dict[str, Any], series: bool) -> str:
     """Say the errors before and after and the rows they are over, outliers named apart."""
     before, after = summary['error_before']['rmse_lpm'], summary['error_after']['rmse_lpm']
-    n, left_out = summary['n_points'], len(summary['outliers'])
+    n = summary['n_points']  # a spike of a reading is a sample left out before the rows
+    left_out = sum(1 for o in summary['outliers'] if 'sample' not in o)
     unit = 'rows' if series else 'points'
     rows = f'{n - left_out} of {n} {unit}' if left_out else f'{n} {unit}'
     if series:

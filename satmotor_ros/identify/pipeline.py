@@ -187,14 +187,17 @@ class Calibration:
 
     def spike_rows(self) -> list[dict[str, Any]]:
         """
-        Return each sample left out as a spike of the flow reading (a time series' only).
+        Return each spike of a reading (a time series' only): a flow's sample left out, a
+        speed's or pressure's reading replaced by its neighbours' fit.
 
         Returns
         -------
         list of dict
-            time, sample (its index in the time-ordered data), flow_lpm, residual_lpm (its
-            departure from its neighbours' local fit) and noise_sd (that departure in
-            robust standard deviations of all departures).
+            time, sample (its index in the time-ordered data), flow_lpm, reading (the
+            reading that spiked: flow, speed, p_in or p_out), departure (its departure from
+            its neighbours' local fit, in SI: m^3/s, rad/s or Pa), residual_lpm (that
+            departure of a flow reading) and noise_sd (the departure in robust standard
+            deviations of all that reading's departures), one per spiked reading.
 
         """
         s = self.samples
@@ -202,8 +205,11 @@ class Calibration:
             return []
         time, flow = s.samples.channels['time'], s.samples.flow
         return [{'time': written(time[j]), 'sample': int(j), 'flow_lpm': written(flow[j] / LPM),
-                 'residual_lpm': written(d / LPM), 'noise_sd': written(abs(d) / s.spike_scale)}
-                for j, d in zip(s.spikes, s.spike_size)]
+                 'reading': name, 'departure': written(d),
+                 'residual_lpm': written(d / LPM) if name == 'flow' else None,
+                 'noise_sd': written(abs(d) / sd)}
+                for j, name, d, sd in zip(s.spikes, s.spike_channel, s.spike_size,
+                                          s.spike_scale)]
 
     def missed_regions(self) -> list[dict[str, Any]]:
         """

@@ -381,8 +381,9 @@ def _outliers(cal: Calibration, summary: dict[str, Any]) -> list[str]:
              'their neighbours stay in (see the regions above).', '']
     if not rows:
         return lines + ['No outlier.', '']
-    keys = list(rows[0])
-    return lines + [_table([[str(r[k]) for k in keys] for r in rows], keys), '',
+    keys = list(dict.fromkeys(k for r in rows for k in r))  # a spike's keys after the rest
+    cells = [['' if r.get(k) is None else str(r[k]) for k in keys] for r in rows]
+    return lines + [_table(cells, keys), '',
                     'These points decide nothing: they are left out of the fits and of the '
                     'first error figures (the second pair includes them).', '']
 

@@ -53,10 +53,12 @@ _RESTART_GAP = 1000.0
 """A restarted recording is moved to begin this many median time steps after the one before:
 far beyond any gap that cuts a steady window or a transient stretch."""
 
-_CEILINGS = {'pressure': 1.0e10, 'temperature': 1.0e4, 'speed': 1.0e5, 'flow': 10.0,
+_CEILINGS = {'pressure': 1.0e9, 'temperature': 1.0e4, 'speed': 1.0e5, 'flow': 10.0,
              'torque': 1.0e7}
-"""Kind -> magnitude in SI no bench reaches (10 GPa, 10^4 degC, about 10^6 rpm, 10 m^3/s,
-10^7 N m): a cell beyond it is a broken cell or a wrong unit, not a measurement."""
+"""Kind -> magnitude in SI no bench reaches (1 GPa, 10^4 degC, about 10^6 rpm, 10 m^3/s,
+10^7 N m): a cell beyond it is a broken cell or a wrong unit, not a measurement. 1 GPa is
+beyond every hydraulic pressure: displacement motors are rated to some 70 MPa, intensifiers
+reach 600 MPa, and the pressure transducers of the highest range end near 1 GPa."""
 
 _ABSURD_RATIO = 1.0e6
 """A cell this many times larger in magnitude than 90 % of its column's cells is absurd."""

@@ -140,10 +140,13 @@ class Samples:
     bounds: tuple[np.ndarray, np.ndarray]  # first and last sample of each row [-]
     in_bins: np.ndarray  # which of the raw samples a row holds [-]
     spikes: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))  # samples
-    # left out as isolated spikes of the flow reading (:func:`spikes`) [-]
+    # with an isolated spike of a reading (:func:`reading_spikes`: a flow's left out, a
+    # speed's or pressure's mended), one per spiked reading [-]
     spike_size: np.ndarray = field(default_factory=lambda: np.zeros(0))  # their departure
-    # from the neighbours' local fit [m^3/s]
-    spike_scale: float = 0.0  # the robust scale of those departures [m^3/s]
+    # from the neighbours' local fit [SI unit of the reading]
+    spike_scale: np.ndarray = field(default_factory=lambda: np.zeros(0))  # the robust
+    # scale of that reading's departures [SI unit of the reading]
+    spike_channel: tuple[str, ...] = ()  # the reading of each: 'flow', 'speed', 'p_in', 'p_out'
 
     guard = 1
     """Rows a test fold keeps out of training on each side: neighbours share a sample."""
@@ -489,6 +492,8 @@ def transient_samples(model: MotorModel, table: BenchTable,
         table = table.select(order)
     time = table.channels['time']
     first, step = segments(time, options.gap)
+    found = reading_spikes(table, first)
+    table = found.mended(table)  # a spiked speed or pressure: its neighbours' fit
     channels = dict(table.channels)
     if 'revolutions' not in channels:
         channels['revolutions'] = sampled_revolutions(table.speed, time)
@@ -499,7 +504,8 @@ def transient_samples(model: MotorModel, table: BenchTable,
     moving[still] = ~at_rest(all_parts.flow[still])
     rest = np.zeros(time.size, dtype=bool)  # speed reads 0, the flow against the drop
     rest[usable] = moving
-    spike, departure, scale = spikes(table.flow, first)
+    spike = np.zeros(time.size, dtype=bool)
+    spike[found.left_out()] = True  # a spiked flow: the sample is left out
     if ((spike | rest) & usable).any():  # a bad sample decides nothing: left out like an
         all_parts = parts_at(all_parts, ~(spike | rest)[usable])  # unusable one
         usable = usable & ~spike & ~rest
@@ -554,13 +560,13 @@ def transient_samples(model: MotorModel, table: BenchTable,
             f'in {n_segments} stretch(es) without a gap, step {step:.4g} s, averaged over '
             f'bins of {size} steps ({size * step:.3g} s, {a.size} rows)'
             + left_out_samples(model, table, usable | spike | rest, held, int(spike.sum()),
-                               int(rest.sum())))
+                               int(rest.sum())) + found.mended_note())
     rows = replace(rows, notes=rows.notes + (note,))
     lags = [nuisance[name] for name in RATE_TERMS if name in nuisance]
     correlation = float(np.corrcoef(lags[0], lags[1])[0, 1]) if len(lags) == 2 else np.nan
     return Samples(rows, parts, n_samples, size, step, n_segments, tuple(left_out),
-                   correlation, table, usable, (a, b), held, np.flatnonzero(spike),
-                   departure[spike], scale)
+                   correlation, table, usable, (a, b), held, found.at, found.size,
+                   found.scale, found.channel)
 
 
 SPIKE_HALF = 3
@@ -655,6 +661,99 @@ def spikes(x: FloatArray, first: np.ndarray) -> tuple[np.ndarray, FloatArray, fl
     return flagged, departure, scale
 
 
+SPIKE_SPAN = 0.05
+"""Least departure of a spike of a reading the model is evaluated at (the speed, the port
+pressures), as a share of that reading's span (1st to 99th percentile of the series), [-]."""
+
+SPIKE_READINGS = (('flow', 0.0), ('speed', SPIKE_SPAN), ('p_in', SPIKE_SPAN),
+                  ('p_out', SPIKE_SPAN))
+"""The readings searched for spikes, each with the least share of its span a spike departs by."""
+
+
+@dataclass(frozen=True)
+class ReadingSpikes:
+    """The isolated spikes of a time series' readings: one entry per spiked reading."""
+
+    at: np.ndarray  # the sample of each, in time order [-]
+    channel: tuple[str, ...]  # its reading: 'flow', 'speed', 'p_in' or 'p_out'
+    size: np.ndarray  # its departure from the neighbours' fit [SI unit of the reading]
+    scale: np.ndarray  # the robust scale of that reading's departures [SI unit of the reading]
+
+    def left_out(self) -> np.ndarray:
+        """Return the samples whose flow reading spiked: they are left out."""
+        return self.at[[c == 'flow' for c in self.channel]].astype(int)
+
+    def mended(self, table: BenchTable) -> BenchTable:
+        """
+        Return the table with each spiked speed or pressure replaced by its neighbours' fit.
+
+        Parameters
+        ----------
+        table : BenchTable
+            The samples the spikes were found in, in time order, [-]
+
+        Returns
+        -------
+        BenchTable
+            The same samples; a spiked flow reading stays (its sample is left out).
+
+        """
+        out = {name: getattr(table, name).copy() for name in set(self.channel) - {'flow'}}
+        for i, name, d in zip(self.at, self.channel, self.size):
+            if name != 'flow':
+                out[name][i] -= d
+        return replace(table, **out) if out else table
+
+    def mended_note(self) -> str:
+        """Say which readings of the speed and pressures were mended, or ''."""
+        counts = [(n, self.channel.count(n)) for n, _ in SPIKE_READINGS[1:] if n in self.channel]
+        if not counts:
+            return ''
+        return ('; mended: isolated spikes of ' + ', '.join(f'{k} {n}' for n, k in counts)
+                + " reading(s), each replaced by its neighbours' fit (listed as outliers)")
+
+
+def reading_spikes(table: BenchTable, first: np.ndarray) -> ReadingSpikes:
+    """
+    Find the isolated spikes of the flow, the speed and both port pressures (:func:`spikes`).
+
+    The flow is the reading the fit explains: a spike beyond its noise would pull the fit,
+    and a value made up for it would be data the error is judged on, so its sample is left
+    out. The speed and the pressures are where the model is evaluated: a spike of theirs is
+    replaced by its neighbours' fit (:meth:`ReadingSpikes.mended`), so the sample's flow
+    still counts and the rows are those of the recording without the glitch. Their
+    one-sample departures of a few tenths of an MPa or a few rad/s (a pressure ringing
+    sampled at 50 Hz, a speed computed from an encoder's counts) are errors in the
+    variables every sample carries, not bad readings: a spike of theirs must also depart by
+    :data:`SPIKE_SPAN` of the reading's span.
+
+    Parameters
+    ----------
+    table : BenchTable
+        The samples in time order, [-]
+    first : ndarray of bool
+        First sample of each stretch without a gap, [-]
+
+    Returns
+    -------
+    ReadingSpikes
+        Each spiked reading of a sample, in time order.
+
+    """
+    found = []
+    for name, share in SPIKE_READINGS:
+        x = getattr(table, name)
+        flagged, departure, scale = spikes(x, first)
+        if share > 0.0 and flagged.any():
+            lo, hi = np.percentile(x[np.isfinite(x)], [1.0, 99.0])
+            flagged &= np.abs(departure) > share * (hi - lo)
+        found += [(int(i), name, float(departure[i]), scale) for i in np.flatnonzero(flagged)]
+    found.sort(key=lambda f: f[0])
+    return ReadingSpikes(np.array([f[0] for f in found], dtype=int),
+                         tuple(f[1] for f in found), np.array([f[2] for f in found]),
+                         np.array([f[3] for f in found]))
+
+
 def left_out_samples(model: MotorModel, table: BenchTable, usable: np.ndarray,
                      held: np.ndarray, n_spikes: int = 0, n_rest: int = 0) -> str:
     """
@@ -672,7 +771,7 @@ def left_out_samples(model: MotorModel, table: BenchTable, usable: np.ndarray,
     held : ndarray of bool
         Which a row holds, [-]
     n_spikes : int
-        Samples left out as spikes (:func:`spikes`), [-]
+        Samples left out as spikes of the flow reading (:func:`reading_spikes`), [-]
     n_rest : int
         Samples of a shaft reading no speed left out by :func:`at_rest`, [-]
 

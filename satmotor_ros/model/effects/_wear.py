@@ -45,10 +45,11 @@ class Wear(EffectKind):
         out, skipped = [], []
         for name in self.regressors:
             exposure = data.channels.get(name)
-            if exposure is None or not varies(exposure):
+            # the exposure counts from its start: a clock's epoch (1.6e9 s) is no spread
+            start = float(np.min(exposure)) if exposure is not None and exposure.size else 0.0
+            if exposure is None or not varies(exposure - start):
                 skipped.append(f'{self.name}({name}): {why_not(exposure)}')
                 continue
-            start = float(np.min(exposure))
             x = exposure - start
             typical = self.typical(data.parts, max(float(np.max(x)), 1e-300))
             unit = f'{self.per}/s' if name == 'time' else f'{self.per}/rev'
