@@ -56,8 +56,8 @@ def test_one_bad_cell_is_named_and_the_leak_still_found(tmp_path, capsys, leak_c
     assert f'- bad cells: {note}' in report
 
 
-def test_a_pressure_beyond_any_hydraulics_is_dropped_and_a_high_one_is_kept(tmp_path,
-                                                                           leak_csv):
+def test_a_pressure_beyond_any_hydraulics_is_dropped_and_a_high_one_is_kept(
+        tmp_path, leak_csv):
     absurd = read_csv(_with_cell(tmp_path, leak_csv, 'p_in', 5, '2000'))  # MPa: 2 GPa
     assert len(absurd) == 99
     assert [n for n in absurd.notes if "'p_in'" in n] == [

@@ -162,8 +162,8 @@ def test_a_spike_of_the_speed_or_a_pressure_is_named_and_mended_to_the_clean_row
     # each replaced by its neighbours' fit: the same rows, regressors and revolutions
     assert samples.usable.sum() == clean.usable.sum() and len(samples.parts) == len(clean.parts)
     for name in ('speed', 'flow', 'p_in', 'p_out'):
-        assert getattr(samples.table, name) == pytest.approx(getattr(clean.table, name),
-                                                              rel=1e-3, abs=1e-3), name
+        assert getattr(samples.table, name) == pytest.approx(
+            getattr(clean.table, name), rel=1e-3, abs=1e-3), name
     for name, x in samples.parts.nuisance.items():
         assert np.abs(x - clean.parts.nuisance[name]).max() <= 0.05 * np.abs(x).max(), name
     assert samples.table.channels['revolutions'] == pytest.approx(

@@ -187,8 +187,10 @@ class Calibration:
 
     def spike_rows(self) -> list[dict[str, Any]]:
         """
-        Return each spike of a reading (a time series' only): a flow's sample left out, a
-        speed's or pressure's reading replaced by its neighbours' fit.
+        Return each spike of a reading (a time series' only).
+
+        A flow's spike is a sample left out; a speed's or pressure's is a reading replaced
+        by its neighbours' fit.
 
         Returns
         -------
