@@ -177,10 +177,11 @@ def test_times_from_file_names_give_the_trend_per_calendar_day(edge_fleet):
     assert view['days_to_limit'] == pytest.approx((2.0 - last) / 0.03, rel=0.15)
 
 
-@pytest.mark.slow  # the client's connect timeout, 20 s
-def test_an_unreachable_scheduler_is_one_line_and_exit_1(tmp_path, capsys):
+def test_an_unreachable_scheduler_is_one_line_and_exit_1(tmp_path, capsys, monkeypatch):
     import socket
     from satmotor_ros.cli.main import main
+    from satmotor_ros.fleet import engine
+    monkeypatch.setattr(engine, 'CONNECT_WAIT', 2.0)  # the client retries until then (20 s)
     _csv(tmp_path / 'root' / 'm1' / 'a.csv')
     with socket.socket() as free:  # a port nothing listens on once closed
         free.bind(('127.0.0.1', 0))

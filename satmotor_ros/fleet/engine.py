@@ -39,6 +39,9 @@ MEMORY_CAP = 4 << 30
 WORKER_WAIT = 60.0
 """How long a run on --scheduler waits for the cluster's first worker, [s]."""
 
+CONNECT_WAIT = 20.0
+"""How long a run on --scheduler tries to reach the scheduler before it gives up, [s]."""
+
 
 @dataclass
 class Plan:
@@ -238,7 +241,7 @@ def connect(workers: int = 0, scheduler: str = '') -> Iterator[tuple[Any, Cluste
         cluster = None
         try:
             if scheduler:
-                client = Client(scheduler, timeout='20s')
+                client = Client(scheduler, timeout=CONNECT_WAIT)
                 _wait_for_a_worker(client, scheduler)
             else:
                 n = workers or machine_workers()
