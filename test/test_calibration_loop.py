@@ -6,9 +6,10 @@ import json
 
 import numpy as np
 import pytest
-from satmotor_ros.cli.demo import command
+from satmotor_ros.cli.demo import parse_effects
 from satmotor_ros.cli.main import main
 from satmotor_ros.model import load_motor, MotorModel
+from satmotor_ros.plant.scenario import default_cycle
 import yaml
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
@@ -27,15 +28,18 @@ def test_demo_bag_with_wear_is_calibrated_and_the_new_yaml_shrinks_the_speed_res
     """
     The virtual motor wears its clearances; nobody tells the calibration.
 
-    The demo records the virtual motor, controller and motor_model over ROS. Calibrating
-    the bag must name the wear, write it as data, and the motor_model prediction
-    (``satmotor replay`` runs the node's own code; test_replay_live holds them equal)
-    with the new file must track the measured speed better than with the packaged one.
+    The demo's run with the model's feed-forward (``satmotor demo --duration 96`` makes it
+    and the PI-alone run, which is not needed here) records the virtual motor, controller
+    and motor_model over ROS. Calibrating the bag must name the wear, write it as data, and
+    the motor_model prediction (``satmotor replay`` runs the node's own code; test_replay_live
+    holds them equal) with the new file must track the measured speed better than with the
+    packaged one. 96 s: at 48 s (6e-9) or 24 s (3e-9) the tracking cycle's steps are too
+    short for the calibration to name the wear.
     """
-    out = tmp_path / 'demo'
-    assert command(liquid='water', duration='96', effect=[f'clearance_wear={WEAR}'],
-                   out=str(out), quiet=True, no_loop=True) == 0  # the demo's own loop: test_demo
-    bag = out / 'bags' / 'water_model'
+    from satmotor_ros.cli._demo_ros import run_cycle  # imports rclpy
+    bag = tmp_path / 'water_model'
+    run_cycle('water', 'model', default_cycle().scaled(96.0),
+              parse_effects([f'clearance_wear={WEAR}']), bag, None)
     cal = tmp_path / 'cal'
     assert main(['calibrate', str(bag), '--liquid', 'water', '--out', str(cal)]) == 0
     result = json.loads((cal / 'calibration.json').read_text())
