@@ -20,9 +20,14 @@ PNG = b'\x89PNG\r\n\x1a\n'
 
 @pytest.fixture(scope='module')
 def demo_run(tmp_path_factory):
-    """Run the demo on water for 6 s of simulated time, with an injected effect."""
+    """
+    Run the demo on water for its default 24 s of simulated time, with an injected effect.
+
+    One run serves the report, the bags and the closing of the loop: the loop run's own
+    leak (2e-11) replaces the injected 2e-12, so its calibration is the default demo's.
+    """
     out = tmp_path_factory.mktemp('demo') / 'out'
-    code = command(liquid='water', duration='6', effect=['external_leakage=2e-12'],
+    code = command(liquid='water', duration='24', effect=['external_leakage=2e-12'],
                    out=str(out), quiet=True)
     return code, out
 
@@ -35,8 +40,8 @@ def test_demo_writes_a_report_with_its_plots(demo_run):
     assert 'external_leakage = 2e-12' in report
     assert '| water | model |' in report and '| water | none (PI alone) |' in report
     assert 'Prediction from the motor_model node' in report
-    assert '## Closing the loop' in report  # 6 s may be too short to calibrate: it says so
-    assert 'points held 1 s each' in report  # 1.5 x 6 s over nine points, as it ran
+    assert '## Closing the loop' in report
+    assert 'points held 4 s each' in report  # 1.5 x 24 s over nine points, as it ran
     # the injected leakage takes k p_case / q_t = 0.55 rpm the model does not know about
     bias = float(re.search(r'has a median of (-?[0-9.]+) rpm', report).group(1))
     assert -1.0 < bias < -0.3
@@ -59,7 +64,7 @@ def test_demo_bags_hold_every_topic_at_its_rate(demo_run, run):
                       '/speed_setpoint', '/diagnostics', '/clock', '/predicted_joint_state',
                       '/speed_residual', '/losses/total', '/losses/flat_clearance'):
             assert counts.get(topic, 0) > 0, topic
-        assert counts['/joint_states'] == pytest.approx(600, abs=20)
+        assert counts['/joint_states'] == pytest.approx(2400, abs=20)
         joints = [c for c in reader.connections if c.topic == '/joint_states']
         last = None
         for connection, _, raw in reader.messages(connections=joints):
@@ -81,10 +86,10 @@ def test_demo_refuses_bad_options_in_one_line(tmp_path, capsys):
     assert not Path(tmp_path / 'a').exists()
 
 
-def test_demo_closes_the_loop_on_its_own_recording(tmp_path):
+def test_demo_closes_the_loop_on_its_own_recording(demo_run):
     """The default demo also calibrates a run with a leak the model lacks, and names it."""
-    out = tmp_path / 'out'
-    assert command(liquid='water', duration='24', effect=[], out=str(out), quiet=True) == 0
+    code, out = demo_run
+    assert code == 0
     report = (out / 'report.md').read_text()
     section = report[report.index('## Closing the loop'):]
     assert '`external_leakage = 2e-11`' in section and 'points held 4 s each' in section
