@@ -73,3 +73,50 @@ def test_alternating_residuals_give_no_negative_phi_and_few_points_no_line() -> 
     few = _trend(x[:MIN_POINTS - 1], x[:MIN_POINTS - 1], 1e9)
     assert all(math.isnan(v) for v in few.estimate(1.0))
     assert all(math.isnan(v) for v in _trend(np.full(6, 2.0), x[:6], 1e9).estimate(2.0))
+
+
+def _one_step_phi(x: np.ndarray, y: np.ndarray, tau: float) -> float:
+    """Phi by hand: each point's residual against the weighted line before it, forgotten."""
+    rho = r2 = 0.0
+    last = math.nan
+    for k in range(MIN_POINTS, len(x)):
+        w = np.exp(-(x[k - 1] - x[:k]) / tau)
+        b, a = np.polyfit(x[:k], y[:k], 1, w=np.sqrt(w))
+        r = y[k] - (a + b * x[k])
+        if math.isfinite(last):
+            forget = math.exp(-(x[k] - x[k - 1]) / tau)
+            rho, r2 = rho * forget + r * last, r2 * forget + r * r
+        last = r
+    return min(max(rho / r2, 0.0), 0.95)
+
+
+@pytest.mark.parametrize('tau', [1e12, 3.0])
+def test_phi_forgets_as_the_line_does_far_from_hour_zero(tau: float) -> None:
+    """From 500 h on, with and without forgetting: phi as by hand."""
+    x = 500.0 + 0.4 * np.arange(16)
+    y = 1.0 + 0.1 * x + 0.05 * np.sin(x / 1.3)
+    assert _trend(x, y, tau).estimate(x[-1])[4] == pytest.approx(_one_step_phi(x, y, tau),
+                                                                 rel=1e-6)
+
+
+def test_a_curve_gives_phi_at_its_cap_and_minutes_apart_still_a_slope() -> None:
+    """Residuals of one sign: phi capped at 0.95; points a minute apart: the slope is fitted."""
+    x = np.arange(30, dtype=float)
+    curve = _trend(x, 1.0 + 0.1 * np.sqrt(x), 1e9)
+    assert curve.rho_sum / curve.r2_sum > 0.99 and curve.estimate(29.0)[4] == 0.95
+    x = np.arange(12, dtype=float)
+    minutes = x / 60.0
+    level, _, slope, _, _ = _trend(minutes, 1.0 + 0.3 * minutes, 1e9).estimate(minutes[-1])
+    assert slope == pytest.approx(0.3) and level == pytest.approx(1.0 + 0.3 * minutes[-1])
+
+
+def test_the_fewest_points_and_the_least_weight_still_give_a_line() -> None:
+    """Exactly MIN_POINTS points (no residual pair yet), and forgetting that leaves sw < 3."""
+    x = np.arange(MIN_POINTS, dtype=float)
+    level, level_hw, slope, slope_hw, phi = _trend(x, 2.0 + 0.1 * x + 0.01 * (-1.0) ** x,
+                                                   1e9).estimate(3.0)
+    assert slope == pytest.approx(0.1, abs=0.02) and phi == 0.0 and slope_hw > 0.0
+    x = np.arange(8, dtype=float)
+    trend = _trend(x, 1.0 + 0.05 * x + 0.01 * np.cos(x), 2.0)
+    assert 2.0 < trend.sw < 3.0
+    assert all(math.isfinite(v) for v in trend.estimate(x[-1]))
