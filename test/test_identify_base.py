@@ -2,12 +2,13 @@
 """The base fits the channel drop the data pin, keeps what they cannot, and says which."""
 
 import json
+from dataclasses import replace
 
 import numpy as np
 import pytest
-from satmotor_ros.identify.base import _with_factor, fit_base
+from satmotor_ros.identify.base import _with_factor, EMPTIED, emptied, fit_base
 from satmotor_ros.identify.output import write_json, write_yaml
-from satmotor_ros.identify.pipeline import calibrate
+from satmotor_ros.identify.pipeline import calibrate, Options
 from satmotor_ros.identify.table import BenchTable
 from satmotor_ros.model import load_motor, MotorModel
 from satmotor_ros.model.families import FAMILY_NAMES
@@ -72,9 +73,14 @@ def test_the_motor_s_own_coefficients_are_kept_not_refitted():
 def test_the_guess_refuted_by_the_port_drop_is_not_kept_beyond_physics():
     spec, truth = _truth('sliwinski2017', 0.02)
     base = fit_base(spec, 'oil', _points(truth, 0.02))
-    assert base.channel_drop['packaged_mpa'] > 5.0  # the similarity guess
-    assert base.channel_drop['used_mpa'] < 1.0  # what the data support
-    assert base.fitted[0]['bounds'][1] < MotorModel.from_spec(spec, 'oil').coef.c_t
+    drop = base.channel_drop
+    assert drop['packaged_mpa'] > 5.0  # the similarity guess
+    # the rows below the guessed drop refute it; the profile is least at no drop, a bound:
+    # the largest drop the data accept is kept, which holds the true one
+    true = truth.equations.channel_drop(drop['flow_lpm'] * LPM) / MPA
+    assert true < drop['used_mpa'] < 1.5, base.note
+    kept = {k['coefficient']: k['why'] for k in base.kept}
+    assert not base.fitted and 'refute' in kept['c_t'] and 'largest' in kept['c_t']
 
 
 def test_the_calibration_writes_what_the_base_fitted_and_the_yaml_loads_it(tmp_path):
@@ -89,3 +95,49 @@ def test_the_calibration_writes_what_the_base_fitted_and_the_yaml_loads_it(tmp_p
     loaded = MotorModel.from_spec(load_motor(tmp_path / 'coefficients.yaml'), 'oil')
     assert loaded.coef.c_t == pytest.approx(fitted['c_t'], rel=1e-12)
     assert loaded.coef.c_t < 0.6 * MotorModel.from_spec(spec, 'oil').coef.c_t
+
+
+def _both_ways(truth, dp_mpa, seed=3, count=240):
+    """Steady points at port drops `dp_mpa` (lo, hi), half turning each way, with noise."""
+    rng = np.random.default_rng(seed)
+    speed = rng.uniform(1000.0, 5000.0, count) * RPM
+    dp = rng.uniform(*dp_mpa, count) * MPA
+    flow = truth.absorbency(speed, dp, errors='mask').flow + rng.normal(0.0, 0.02 * LPM, count)
+    ok = np.isfinite(flow)
+    way = np.where(np.arange(count) % 2 == 0, 1.0, -1.0)[ok]
+    low, high = np.full(int(ok.sum()), 0.5 * MPA), dp[ok] + 0.5 * MPA
+    return BenchTable(way * speed[ok], way * flow[ok], np.where(way > 0, high, low),
+                      np.where(way > 0, low, high))
+
+
+def test_rows_below_the_packaged_drop_pin_a_small_drop_and_are_kept():
+    spec, truth = _truth('sliwinski2017', 0.03)
+    packaged = MotorModel.from_spec(spec, 'oil')
+    table = _both_ways(truth, (1.0, 6.0))
+    drops = packaged.equations.channel_drop(np.abs(table.flow))
+    assert np.mean(np.abs(table.dp) < drops) > 0.5  # most rows: below the guessed drop
+    cal = calibrate(table, 'oil', spec=spec)
+    assert cal.base.fitted, cal.base.note
+    drop = cal.base.channel_drop
+    assert drop['packaged_mpa'] > 5.0 and drop['used_mpa'] < 0.5, cal.base.note
+    low, high = cal.base.fitted[0]['ci95']
+    assert low <= truth.coef.c_t <= high, cal.base.note
+    envelope = cal.coverage['envelope']
+    assert envelope['positive']['samples'] + envelope['negative']['samples'] == len(table)
+    assert not cal.warnings()
+
+
+def test_a_drop_that_empties_a_direction_is_warned_of():
+    spec, truth = _truth('sliwinski2017', 0.03)
+    table = _both_ways(truth, (1.0, 6.0))
+    # a motor file's own drop (not a guess): kept, and most motor-mode samples are below it
+    own = replace(spec, name='F11-5 (measured)')
+    packaged = MotorModel.from_spec(own, 'oil')
+    below = packaged.chamber_drop(table.dp, table.flow) * np.sign(table.dp) < 0.0
+    positive, lost = int((table.dp > 0.0).sum()), int((below & (table.dp > 0.0)).sum())
+    assert lost > positive / 2
+    cal = calibrate(table, 'oil', spec=own, options=Options(compare_families=False))
+    assert not cal.base.changed
+    warned = [w for w in cal.warnings()['warnings'] if w.startswith(EMPTIED)]
+    assert len(warned) == 1 and f'{lost} of {positive} samples with a positive drop' in warned[0]
+    assert emptied(truth, table, cal.base) is None  # the true drop leaves them in

@@ -13,6 +13,7 @@ from satmotor_ros.cli._bench import (add_data_arguments, open_bench, run_bench_c
 from satmotor_ros.cli._common import add_motor_options, number_option
 from satmotor_ros.cli._output import output_dir
 from satmotor_ros.identify import BenchTable, calibrate, Options
+from satmotor_ros.identify.base import EMPTIED
 from satmotor_ros.identify.output import write_json, write_yaml
 from satmotor_ros.identify.pipeline import AT_BOUND, IMPLAUSIBLE, Mode, MODES
 from satmotor_ros.identify.report import write_report
@@ -99,7 +100,7 @@ def calibrate_into(data: str, out: str, mode: Mode, alpha: float, folds: int,
         write_report(cal, tmp, summary)
     target = Path(out)
     effect = summary['effect']
-    kinds = [k for k in (IMPLAUSIBLE, AT_BOUND) if any(w.startswith(k) for w in warnings)]
+    kinds = [k for k in (IMPLAUSIBLE, EMPTIED, AT_BOUND) if any(w.startswith(k) for w in warnings)]
     line = (f'WARNING {" and ".join(kinds)} (see report.md); ' if kinds else '') + \
         (f'WARNING: {settled.warning}; ' if settled.warning else '') + \
         f'effect: {effect}'

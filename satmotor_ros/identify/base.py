@@ -10,19 +10,31 @@ or a sensor gain absorb the mismatch, and the calibration names it as an effect.
 
 So the base fits one factor f >= 0 on the coefficients the family's channel drop is
 linear in (:attr:`Family.channel`: C_t and C_l of eq. (35), C_ich of eq. (27)), with
-the factors of the linear parts refitted at every f (a profile), on the rows usable over
-the whole range of f. The range is physical: in motor mode the chambers must still see
-a drop, so the channel drop may not exceed the port drop (at the
+the factors of the linear parts refitted at every f (a profile), on the rows usable at
+f = 0 (and, for the rows whose chambers see more than the port drop, at the range's top).
+A motor-mode row whose port drop is below the channel drop at a factor stays in the
+profile at that factor, with the chamber drop 0 as the engine runs it (channel-limited,
+eq. (34) clamped): its loss, which the model then gives as (almost) none, counts against
+the factor. Leaving such rows out would leave out exactly the rows that speak against a
+large channel drop. The range is 0 to the larger of the packaged factor 1 and the
+physical bound: the channel drop may not exceed the port drop (at the
 :data:`PHYSICAL_QUANTILE` of the motor-mode rows, against noise). The factor is
 *fitted* only where the data pin it: the profile's Huber objective at f (each row
 standardised by its noise, :func:`~satmotor_ros.identify.noise.noise_model` of the residuals
 at the kept value: a recording's fast moves, the noisiest rows, do not decide) must beat the
 kept value's by chi2(1) at :data:`ALPHA` (its variance inflated by the correlation of
-neighbouring samples of a time series) and its 95 % profile interval must not span the
-whole range. Otherwise it is *kept*: the packaged value, or the physical bound where the
-packaged value is beyond it. Every other nonlinear coefficient of the family (the
-exponents of Table 1, the clearance law) is kept, as the data cannot separate it from
-the linear factors (:mod:`.fit`).
+neighbouring samples of a time series), its 95 % profile interval must not span the
+whole range, and its least must lie inside the range (at the range's top the data ask
+for a drop at least that large, which is no estimate). Otherwise it is *kept*: the
+packaged value (the bound only widens the range: a drop above the port drop is a
+channel-limited point the engine runs, so capping the guess there is not the data's
+call; when the kept drop leaves out most of a direction, :func:`emptied` says so); where the
+data refute the packaged value but are least at no drop (a bound, not an estimate
+either), the largest drop they accept (the top of the 95 % interval). The rows are read
+without the channel drop (:func:`open_channels`), so the samples below the guessed drop
+reach the profile. Every other nonlinear coefficient of the family (the exponents of
+Table 1, the clearance law) is kept, as the data cannot separate it from the linear
+factors (:mod:`.fit`).
 """
 
 from __future__ import annotations
@@ -33,6 +45,7 @@ import math
 from typing import Any
 
 import numpy as np
+from satmotor_ros.identify.coverage import DIRECTIONS
 from satmotor_ros.identify.errors import IdentificationError
 from satmotor_ros.identify.fit import HUBER, huber_rho
 from satmotor_ros.identify.noise import noise_model, rates_of
@@ -56,6 +69,15 @@ GRID = 8
 
 MIN_ROWS = 12
 """Fewest rows usable over the whole range of the factor for it to be fitted, [-]."""
+
+EDGE = 1e-3
+"""Share of the range within which a factor counts as at the range's end, [-]."""
+
+EMPTIED = 'a direction emptied'
+"""How the warning begins that the channel drop left out most of a direction's samples."""
+
+EMPTIED_SHARE = 0.5
+"""Share of a direction's samples whose loss to the channel drop is warned of, [-]."""
 
 IRLS_STEPS = 6
 """Reweighted least-squares steps of the Huber fit of the linear factors at each factor, [-]."""
@@ -85,6 +107,61 @@ class BaseFit:
 def guessed(spec: MotorSpec) -> bool:
     """Return whether the coefficients are a family's defaults scaled by similarity to a size."""
     return spec.name.endswith(DEFAULTS_NOTE)
+
+
+def open_channels(spec: MotorSpec, liquid: str) -> MotorSpec:
+    """
+    Return the motor without its channel drop when the base is to fit it (else as given).
+
+    The rows the base profiles are read at the smallest factor, 0: read at the packaged
+    drop, the samples whose port drop is below it, which speak against it, would be gone.
+    """
+    if not guessed(spec) or liquid not in spec.sets:
+        return spec
+    model = MotorModel.from_spec(spec, liquid)
+    names = tuple(n for n in model.family.channel if getattr(model.coef, n) > 0.0)
+    return _with_factor(spec, liquid, names, 0.0) if names else spec
+
+
+def emptied(model: MotorModel, table: BenchTable, base: BaseFit) -> str | None:
+    """
+    Say when the model's channel drop leaves out most of a direction's samples.
+
+    A sample is left out where the channels take more than its port drop (the chamber drop
+    of eq. (34) below 0 at its flow).
+
+    Parameters
+    ----------
+    model : MotorModel
+        The model the calibration goes on with (its channel drop fitted or kept), [-]
+    table : BenchTable
+        The data as read, every sample, [-]
+    base : BaseFit
+        What the base fitted or kept, [-]
+
+    Returns
+    -------
+    str or None
+        The warning (beginning :data:`EMPTIED`), naming the count and the reason.
+
+    """
+    dp, flow = table.dp, table.flow
+    with np.errstate(invalid='ignore'):
+        finite = np.isfinite(dp) & np.isfinite(flow) & np.isfinite(table.speed)
+        below = finite & (np.sign(dp) * model.chamber_drop(dp, flow) < 0.0)
+    lost = []
+    for name, sign in DIRECTIONS:
+        way = finite & (np.sign(dp) == sign)
+        count = int((below & way).sum())
+        if way.any() and count > EMPTIED_SHARE * int(way.sum()):
+            lost.append(f'{count} of {int(way.sum())} samples with a {name} drop')
+    if not lost:
+        return None
+    drop = base.channel_drop
+    at = (f' ({drop["used_mpa"]:.3g} MPa at {drop["flow_lpm"]:.3g} l/min)'
+          if 'used_mpa' in drop else '')
+    return (f'{EMPTIED}: {" and ".join(lost)} left out, their port drop below the channel '
+            f'drop{at} ({base.note}): the fit does not speak for them')
 
 
 def _with_factor(spec: MotorSpec, liquid: str, names: tuple[str, ...],
@@ -128,7 +205,7 @@ class _Profile:
         """Return the base's residual at `factor`: the linear factors by Huber IRLS, [m^3/s]."""
         model = MotorModel.from_spec(_with_factor(self.spec, self.liquid, self.names, factor),
                                      self.liquid)
-        parts, usable = loss_parts(model, self.points)
+        parts, usable = loss_parts(model, self.points, clamp=True)
         if not usable.all():
             raise IdentificationError('a row left the usable range inside the profile')
         columns = [c.flow(NO_EFFECT) for c in parts.components]
@@ -206,14 +283,16 @@ def fit_base(spec: MotorSpec, liquid: str, points: BenchTable,
                  'why': 'no channel drop to fit'} for n in model.family.channel]
         return result(1.0, [], kept, 'the channel drop is kept: the model has none to fit')
     bound = _physical_bound(model, points)
-    kept_factor = min(1.0, bound)
-    why_kept = ('the packaged value' if kept_factor == 1.0 else
-                'the physical bound: the packaged drop exceeds the port drop of '
-                f'{100 * (1 - PHYSICAL_QUANTILE):.0f} % of the motor-mode rows')
-    rows = _rows(model, spec, liquid, names, points, bound)
+    # not pinned, the guess stands: the rows below its drop were weighed in the profile (a
+    # drop above the port drop is a channel-limited point the engine runs, not beyond physics)
+    kept_factor, why_kept = 1.0, 'the packaged value'
+    if not math.isfinite(bound):
+        return _kept(result, names, model, kept_factor, 'no motor-mode row bounds it')
+    top_factor = max(1.0, bound)
+    rows = _rows(spec, liquid, names, points, top_factor)
     profile = _Profile(spec, liquid, names, points.select(rows) if not rows.all() else points,
                        {k: np.asarray(v)[rows] for k, v in (nuisance or {}).items()})
-    if int(rows.sum()) < MIN_ROWS or not math.isfinite(bound):
+    if int(rows.sum()) < MIN_ROWS:
         return _kept(result, names, model, kept_factor, 'too few rows usable over the range')
     try:
         residual = profile.residual(kept_factor)
@@ -222,28 +301,38 @@ def fit_base(spec: MotorSpec, liquid: str, points: BenchTable,
     # each row weighed by its noise (:mod:`.noise`): a recording's fast moves do not decide
     profile.scale = noise_model(residual, points.flow[rows], 1 + len(profile.nuisance),
                                 1e-6 * LPM, rates_of(profile.nuisance))
-    best = _minimum(profile, bound, kept_factor)
+    best = _minimum(profile, top_factor, kept_factor)
     inflation = variance_inflation(profile.residual(best)) if points.time_series else 1.0
     gain = (profile(kept_factor) - profile(best)) / inflation
     limit = float(stats.chi2.ppf(1.0 - ALPHA, 1))
-    low, high = 0.0, bound
+    low, high = 0.0, top_factor
     if gain > limit:  # the interval only matters for a factor that may be fitted
-        low, high = _interval(profile, best, bound, profile(best)
+        low, high = _interval(profile, best, top_factor, profile(best)
                               + inflation * float(stats.chi2.ppf(0.95, 1)))
-    spans = low <= bound * 1e-3 and high >= bound * 0.999
-    if gain <= limit or spans:
+    spans = low <= top_factor * EDGE and high >= top_factor * (1.0 - EDGE)
+    at_top = best >= top_factor * (1.0 - EDGE)
+    if gain <= limit or spans or at_top:
         why = (f'the data do not pin it (profile: chi2 gain {gain:.3g} <= {limit:.3g}'
-               if gain <= limit else 'the 95 % profile interval spans the whole range (')
+               if gain <= limit else 'the 95 % profile interval spans the whole range ('
+               if spans else 'the profile is least at the top of the range (')
         return _kept(result, names, model, kept_factor,
-                     f'{why}, factor range 0-{bound:.3g}); kept at {why_kept}')
+                     f'{why}, factor range 0-{top_factor:.3g}); kept at {why_kept}')
+    if best <= top_factor * EDGE:  # least at no drop: a bound, not an estimate
+        return _kept(result, names, model, high,
+                     f'the data refute the packaged drop (profile: chi2 gain {gain:.3g} > '
+                     f'{limit:.3g}) and are least at no drop, a bound, not an estimate; kept at '
+                     f'the largest the data accept, the top of the 95 % profile interval '
+                     f'(factor 0-{high:.3g}, range 0-{top_factor:.3g})')
+    open_top = high >= top_factor * (1.0 - EDGE)
     fitted = [{'coefficient': n, 'value': float(getattr(model.coef, n)) * best,
                'packaged': float(getattr(model.coef, n)),
                'ci95': [float(getattr(model.coef, n)) * low, float(getattr(model.coef, n)) * high],
-               'factor': best, 'bounds': [0.0, float(getattr(model.coef, n)) * bound]}
+               'factor': best, 'bounds': [0.0, float(getattr(model.coef, n)) * top_factor]}
               for n in names]
     note = (f'channel drop fitted: {packaged_drop * best / MPA:.3g} MPa at {top / LPM:.3g} '
             f'l/min (packaged {packaged_drop / MPA:.3g} MPa; factor {best:.3g}, 95 % '
-            f'{low:.3g}-{high:.3g}, physical range 0-{bound:.3g})')
+            f'{low:.3g}-{high:.3g}{" (open: the top of the range)" if open_top else ""}, '
+            f'range 0-{top_factor:.3g}, physical bound {bound:.3g})')
     return result(best, fitted, [], note)
 
 
@@ -254,15 +343,20 @@ def _kept(result: Callable[[float, list[dict[str, Any]], list[dict[str, Any]], s
     return result(factor, [], kept, f'channel drop kept: {why}')
 
 
-def _rows(model: MotorModel, spec: MotorSpec, liquid: str, names: tuple[str, ...],
-          points: BenchTable, bound: float) -> np.ndarray:
-    """Return the rows usable at no channel drop and at the bound (so at every f between)."""
-    ends = [0.0, bound] if math.isfinite(bound) else [0.0]
+def _rows(spec: MotorSpec, liquid: str, names: tuple[str, ...], points: BenchTable,
+          top: float) -> np.ndarray:
+    """
+    Return the rows usable, the chamber drop clamped at 0, over the factor's range 0 to `top`.
+
+    A motor-mode row's chamber drop falls with the factor (clamped, it stays usable); a
+    row whose chambers see more than the port drop (a pump's) may leave the model's limit
+    at `top`: the rows usable at both ends are usable at every factor between.
+    """
     usable = np.ones(len(points), dtype=bool)
-    for factor in ends:
+    for factor in (0.0, top):
         at = MotorModel.from_spec(_with_factor(spec, liquid, names, factor), liquid)
         try:
-            usable &= loss_parts(at, points)[1]
+            usable &= loss_parts(at, points, clamp=True)[1]
         except IdentificationError:
             return np.zeros(len(points), dtype=bool)
     return usable
@@ -295,4 +389,4 @@ def _minimum(profile: _Profile, bound: float, kept: float) -> float:
     return float(grid[i])
 
 
-__all__ = ['ALPHA', 'BaseFit', 'fit_base', 'guessed']
+__all__ = ['ALPHA', 'BaseFit', 'EMPTIED', 'emptied', 'fit_base', 'guessed', 'open_channels']

@@ -154,7 +154,8 @@ def predict_flow(parts: LossParts, scales: FloatArray, mod: Modifier = NO_EFFECT
     return mod.flow_gain * inner + mod.offset * parts.sign
 
 
-def loss_parts(model: MotorModel, table: BenchTable) -> tuple[LossParts, np.ndarray]:
+def loss_parts(model: MotorModel, table: BenchTable,
+               clamp: bool = False) -> tuple[LossParts, np.ndarray]:
     """
     Evaluate the model's components at the table's points.
 
@@ -164,6 +165,11 @@ def loss_parts(model: MotorModel, table: BenchTable) -> tuple[LossParts, np.ndar
         The packaged (or user) model for the liquid, [-]
     table : BenchTable
         Steady operating points, [-]
+    clamp : bool
+        Keep a row whose channels take the whole port drop at the chamber drop 0, as the
+        engine runs it (flagged channel-limited), instead of leaving it out: the base's
+        profile of the channel drop (:mod:`.base`) so weighs the rows that speak against
+        a large drop, [-]
 
     Returns
     -------
@@ -189,6 +195,8 @@ def loss_parts(model: MotorModel, table: BenchTable) -> tuple[LossParts, np.ndar
                                                     -1.0, 1.0))
         flow, speed, dp = s * table.flow, s * table.speed, s * table.dp  # the loss runs forward
         dp_i = s * model.chamber_drop(table.dp, table.flow)
+        if clamp:
+            dp_i = np.where(np.isfinite(dp_i), np.maximum(dp_i, 0.0), dp_i)
         usable = (np.isfinite(flow) & np.isfinite(speed) & np.isfinite(dp)
                   & ((flow > 0.0) | (speed <= 0.0)) & (dp_i >= 0.0) & (dp_i < model.dp_limit))
     if not usable.any():

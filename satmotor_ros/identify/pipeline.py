@@ -14,7 +14,8 @@ from typing import Any, Literal
 
 import numpy as np
 
-from satmotor_ros.identify.base import BaseFit, fit_base
+from satmotor_ros.identify.base import (BaseFit, emptied, EMPTIED, fit_base, guessed,
+                                        open_channels)
 from satmotor_ros.identify.candidates import build_library, Candidate, Sampled
 from satmotor_ros.identify.coverage import (coverage, COVERED, envelope, envelope_share, MOST,
                                             TAIL)
@@ -296,13 +297,14 @@ class Calibration:
         Returns
         -------
         dict
-            The warnings: the data are implausible (beginning :data:`IMPLAUSIBLE`), a
+            The warnings: the data are implausible (beginning :data:`IMPLAUSIBLE`), the
+            channel drop left out most of a direction (:data:`~.base.EMPTIED`), a
             candidate that fitted better than the ones chosen from was refused because
             its fit ended on a bound, or a factor of the final fit ended on a bound (both
             beginning :data:`AT_BOUND`): a value on a bound is not an estimate.
 
         """
-        found = [note for note in self.table.notes if note.startswith(IMPLAUSIBLE)]
+        found = [note for note in self.table.notes if note.startswith((IMPLAUSIBLE, EMPTIED))]
         found += [f'{AT_BOUND}: step {i}: {at_bound(score)}: the data ask for a value beyond '
                   'its range, so the fit gives the bound, not an estimate; refused'
                   for i, step in enumerate(self.forward.steps, 1) for score in step.refused]
@@ -657,16 +659,29 @@ def calibrate(table: BenchTable, liquid: str = 'oil', spec: MotorSpec | None = N
 
 def _with_base(spec: MotorSpec, liquid: str, table: BenchTable, options: Options, read: Rows,
                choice: FamilyChoice | None) -> tuple[MotorSpec, MotorModel, Rows, BaseFit]:
-    """Fit the base's channel drop where the data pin it (:mod:`.base`); re-read the rows."""
+    """
+    Fit the base's channel drop where the data pin it (:mod:`.base`); re-read the rows.
+
+    The rows of a guessed motor were read without a channel drop (:func:`.open_channels`);
+    they are read again with the drop fitted or kept, and the report and stderr warn
+    when that leaves out most of one direction's samples.
+    """
     base = choice.bases.get(choice.chosen) if choice is not None else None
     if base is None:
         base = fit_base(spec, liquid, read.table, read.parts.nuisance)
     model = MotorModel.from_spec(base.spec, liquid)
-    if not base.changed:
-        return base.spec, model, read, base
-    again = read_rows(model, table, replace(options, mode=read.mode))
-    return base.spec, model, replace(again, reason=read.reason,
-                                     coverage={**read.coverage, **again.coverage}), base
+    if base.changed or guessed(spec):
+        again = read_rows(model, table, replace(options, mode=read.mode))
+        read = replace(again, reason=read.reason, coverage={**read.coverage, **again.coverage})
+    note = emptied(model, table, base)
+    if note:
+        read = replace(read, table=replace(read.table, notes=read.table.notes + (note,)))
+    return base.spec, model, read, base
+
+
+def _open(spec: MotorSpec, liquid: str) -> MotorModel:
+    """Return the model the rows are read with: a guessed channel drop left out (:mod:`.base`)."""
+    return MotorModel.from_spec(open_channels(spec, liquid), liquid)
 
 
 def _sampled(samples: Samples | None) -> Sampled | None:
@@ -704,10 +719,10 @@ def _family_and_rows(spec: MotorSpec, liquid: str, table: BenchTable,
     """Read the rows with the motor's family, compare the families there, re-read if another."""
     model = MotorModel.from_spec(spec, liquid)
     if not options.compare_families:
-        return spec, model, read_rows(model, table, options), None
+        return spec, model, read_rows(_open(spec, liquid), table, options), None
     read: Rows | None = None
     try:
-        read = read_rows(model, table, options)
+        read = read_rows(_open(spec, liquid), table, options)
         compared = read.table  # in transient mode the bins' means: the steady maps compared
     except IdentificationError as err:  # the motor's own family cannot use the data; another may
         steady: Mode = options.mode if options.mode != 'transient' else 'auto'
@@ -726,8 +741,8 @@ def _family_and_rows(spec: MotorSpec, liquid: str, table: BenchTable,
     spec = specs[choice.chosen]
     model = MotorModel.from_spec(spec, liquid)
     if read is None:
-        return spec, model, read_rows(model, table, options), choice
-    again = read_rows(model, table, replace(options, mode=read.mode))
+        return spec, model, read_rows(_open(spec, liquid), table, options), choice
+    again = read_rows(_open(spec, liquid), table, replace(options, mode=read.mode))
     # why the mode: as decided on the first reading
     return spec, model, replace(again, reason=read.reason,
                                 coverage={**read.coverage, **again.coverage}), choice
