@@ -1,8 +1,8 @@
 # SPDX-License-Identifier: Apache-2.0
 """The base fits the channel drop the data pin, keeps what they cannot, and says which."""
 
-import json
 from dataclasses import replace
+import json
 
 import numpy as np
 import pytest

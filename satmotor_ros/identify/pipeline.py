@@ -14,7 +14,7 @@ from typing import Any, Literal
 
 import numpy as np
 
-from satmotor_ros.identify.base import (BaseFit, emptied, EMPTIED, fit_base, guessed,
+from satmotor_ros.identify.base import (BaseFit, EMPTIED, emptied, fit_base, guessed,
                                         open_channels)
 from satmotor_ros.identify.candidates import build_library, Candidate, Sampled
 from satmotor_ros.identify.coverage import (coverage, COVERED, envelope, envelope_share, MOST,
