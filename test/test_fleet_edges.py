@@ -44,8 +44,8 @@ def test_a_monitor_on_a_restarting_clock_is_trended_on_the_recordings_calendar_t
     Ten-minute series, one every 2 days, each clock from 0: the monitor's clock spans 1 h.
 
     Its own trend (0.1 per recorded hour) would be 2.4 a day; the calendar's is 0.05. The
-    first recording leaves the monitor learning, its figure without an interval: not a point
-    (it stopped the report's plot).
+    first recording leaves the monitor learning, its figure without an interval: it gets its
+    ratio (the monitor's stopped the report's plot).
     """
     from satmotor_ros.fleet.report import write_report
     steps, markers = [], []
@@ -56,17 +56,19 @@ def test_a_monitor_on_a_restarting_clock_is_trended_on_the_recordings_calendar_t
         steps.append({'recording': f'm/run_2026-03-{3 + 2 * i:02d}.csv', 'status': 'done',
                       'result': {'leakage_factor': {'value': value, 'ci95': bounds},
                                  'trend_per_hour': 0.1 * 3600 / 610, 'hours_to_limit': 0.5,
-                                 'span_s': [start, start + 600.0], 'alarms': []}})
+                                 'span_s': [start, start + 600.0], 'alarms': [],
+                                 'n_samples': 3001, 'n_skipped': 0}})
         markers.append({'status': 'done', 'recording': steps[-1]['recording'],
                         'date': f'2026-03-{3 + 2 * i:02d}T00:00:00+00:00',
                         'time': EPOCH + (2 + 2 * i) * DAY, 'time_source': PATH_DATE,
                         'result': {'leakage_factor': value, 'ci95': [value, value]}})
     view = motor_view('m', 'water', markers, None, steps=steps)
-    assert view['estimator'] == 'monitor' and view['trend_clock'] == RECORDING_TIMES
+    assert view['estimator'] == 'monitor+ratio' and view['trend_clock'] == RECORDING_TIMES
     assert view['trend_per_day'] == pytest.approx(0.05)
     assert view['days_to_limit'] == pytest.approx((2.0 - 1.4) / 0.05)
     assert {p['time_source'] for p in view['leakage_factor']} == {PATH_DATE}
-    assert len(view['leakage_factor']) == 5
+    assert [p['estimator'] for p in view['leakage_factor']] == ['ratio'] + ['monitor'] * 5
+    assert 'learning' in view['leakage_factor'][0]['monitor_unused']
     write_report(tmp_path, [view], {'root': 'r', 'recordings': 6, 'refused': 0, 'ran': 6,
                                     'reused': 0, 'written': 'now', 'estimator': 'e',
                                     'limit': 2.0})
@@ -202,3 +204,62 @@ def test_a_tls_scheduler_without_a_tls_configuration_is_one_line_and_exit_1(tmp_
     err = capsys.readouterr().err
     assert err.count('\n') == 1 and "--scheduler 'tls://127.0.0.1:9': cannot connect" in err
     assert 'TLS' in err
+
+
+def _step(i, value, n, seconds, skipped=0, alarms=()):
+    """Return a monitor step on an epoch clock: r{i}.csv, `n` samples over `seconds`."""
+    start = EPOCH + i * DAY
+    return {'recording': f'r{i}.csv', 'status': 'done', 'result': {
+        'leakage_factor': {'value': value, 'ci95': [value - 0.01, value + 0.01]},
+        'learning': False, 'trend_per_hour': 0.01, 'hours_to_limit': 48.0,
+        'span_s': [start, start + seconds], 'n_samples': n, 'n_skipped': skipped,
+        'alarms': list(alarms)}}
+
+
+def _ratio(i, value):
+    return {'status': 'done', 'recording': f'r{i}.csv', 'date': f'2026-03-{1 + i:02d}',
+            'time': EPOCH + i * DAY, 'time_source': 'time column',
+            'result': {'leakage_factor': value, 'ci95': [value - 0.02, value + 0.02]}}
+
+
+def test_the_monitors_figure_is_taken_only_where_it_is_the_recordings_own():
+    """
+    Cold review F1 of issue 24: one valid step made every figure the monitor's.
+
+    A slow log (a point a minute) and a recording of few usable samples give the monitor a
+    figure with an interval that is not theirs (1.35, 1.30 here against ratios of 1.02): they
+    get their ratios, each point says which, and the monitor's alarm raised on the slow log is
+    not the fleet's. Its trend is then the line through the points, not the monitor's own.
+    """
+    raised = {'time_s': EPOCH + DAY + 60.0, 'kind': 'change', 'what': 'wear: leakage x1.35'}
+    later = {'time_s': EPOCH + 3 * DAY + 60.0, 'kind': 'change', 'what': 'wear: c x1.05'}
+    steps = [_step(0, 1.0, 3001, 600.0), _step(1, 1.35, 30, 1800.0, alarms=[raised]),
+             _step(2, 1.30, 3001, 600.0, skipped=2900, alarms=[raised]),
+             _step(3, 1.05, 3001, 600.0, alarms=[raised, later])]
+    markers = [_ratio(i, v) for i, v in enumerate((1.01, 1.02, 1.02, 1.04))]
+    view = motor_view('m', 'water', markers, None, steps=steps)
+    points = view['leakage_factor']
+    assert [p['value'] for p in points] == [1.0, 1.02, 1.02, 1.05]
+    assert [p['estimator'] for p in points] == ['monitor', 'ratio', 'ratio', 'monitor']
+    assert 'samples/s, below the 0.5' in points[1]['monitor_unused']
+    assert 'usable samples, fewer than 150' in points[2]['monitor_unused']
+    assert view['estimator'] == 'monitor+ratio' and view['trend_clock'] == RECORDING_TIMES
+    assert [a['recording'] for a in view['alarms'] if a.get('source') == 'monitor'] == \
+        ['r3.csv']
+    assert view['trend_per_day'] == pytest.approx(np.polyfit(np.arange(4.0),
+                                                             [1.0, 1.02, 1.02, 1.05], 1)[0])
+    slow = [_step(i, 1.35, 30, 1800.0) for i in range(4)]  # a motor of slow logs only
+    view = motor_view('m', 'water', markers, None, steps=slow)
+    assert view['estimator'] == 'ratio'
+    assert [p['value'] for p in view['leakage_factor']] == [1.01, 1.02, 1.02, 1.04]
+    fast = [_step(i, 1.35, 2 * 150 + 1, 600.0) for i in range(4)]  # 0.5 Hz, 301 samples
+    assert motor_view('m', 'water', markers, None, steps=fast)['estimator'] == 'monitor'
+
+
+def test_the_doc_gives_the_monitors_validity_as_the_code_has_it():
+    from pathlib import Path
+    from satmotor_ros.fleet.summary import MONITOR_MIN_RATE, MONITOR_MIN_SAMPLES
+    text = (Path(__file__).resolve().parents[1] / 'doc' / 'fleet.md').read_text()
+    text = ' '.join(text.split())
+    assert f'at {MONITOR_MIN_RATE:g} a second or faster' in text
+    assert f'at least {MONITOR_MIN_SAMPLES} usable samples' in text

@@ -445,13 +445,14 @@ def test_a_monitored_motors_view_is_the_monitors_figures_and_named_alarms():
     """On an epoch clock (calendar time) the monitor's own trend is the motor's."""
     steps = [{'recording': f'r{i}.csv', 'status': 'done', 'result': {
         'leakage_factor': {'value': v, 'ci95': [v - 0.01, v + 0.01]}, 'learning': False,
-        'trend_per_hour': 0.01, 'hours_to_limit': 48.0,
+        'trend_per_hour': 0.01, 'hours_to_limit': 48.0, 'n_samples': 451, 'n_skipped': 0,
         'span_s': [EPOCH + i * 100.0, EPOCH + i * 100.0 + 90],
         'alarms': [{'time_s': EPOCH + 150.0, 'kind': 'change', 'what': 'wear: leakage x1.3'}]
         if i else []}} for i, v in enumerate((1.0, 1.3))]
     markers = _markers([1.0, 1.0])
     view = motor_view('m', 'water', markers, None, steps=steps)
     assert [p['value'] for p in view['leakage_factor']] == [1.0, 1.3]
+    assert {p['estimator'] for p in view['leakage_factor']} == {'monitor'}
     assert view['trend_per_day'] == pytest.approx(0.24) and view['days_to_limit'] == 2.0
     assert [(a['kind'], a['recording']) for a in view['alarms']] == [('change', 'r1.csv')]
     assert view['alarms'][0]['what'].startswith('wear: leakage x1.3')

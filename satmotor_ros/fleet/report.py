@@ -14,6 +14,7 @@ import numpy as np
 from satmotor_ros.cli._output import png_metadata
 from satmotor_ros.fleet.config import FLEET_PLOT, PLOTS, REPORT_JSON, REPORT_MD
 from satmotor_ros.fleet.health import RATIO
+from satmotor_ros.fleet.summary import BY_MONITOR, MIXED
 
 
 def _replace(path: Path, text: str) -> None:
@@ -112,19 +113,28 @@ def markdown(motors: list[dict[str, Any]], header: dict[str, Any]) -> str:
             lines += ['', 'Refused recordings (whole, not salvaged):']
             lines += [f"- `{r['path']}`: {r['reason']}" for r in m['refused']]
         if m['leakage_factor']:
-            lines += ['', '| date | time from | recording | leakage factor | 95 % interval |',
-                      '| --- | --- | --- | --- | --- |']
+            lines += ['', '| date | time from | recording | leakage factor | 95 % interval '
+                      '| by |', '| --- | --- | --- | --- | --- | --- |']
             lines += [f"| {p['date']} | {p.get('time_source', '')} | `{p['recording']}` | "
-                      f"{p['value']:.4f} | [{p['ci95'][0]:.4f}, {p['ci95'][1]:.4f}] |"
-                      for p in m['leakage_factor']]
+                      f"{p['value']:.4f} | [{p['ci95'][0]:.4f}, {p['ci95'][1]:.4f}] | "
+                      f'{_by(p)} |' for p in m['leakage_factor']]
     return '\n'.join(lines) + '\n'
+
+
+def _by(point: dict[str, Any]) -> str:
+    """Say which estimator gave a point, and why not the monitor where it gave a figure."""
+    why = point.get('monitor_unused')
+    return point.get('estimator', '') + (f' (monitor not taken: {why})' if why else '')
 
 
 def _estimator(motor: dict[str, Any]) -> str:
     """Say which estimator gave a motor's figures."""
-    if motor.get('estimator') == 'monitor':
+    if motor.get('estimator') == BY_MONITOR:
         return ("the health monitor (`satmotor monitor`'s), run through the recordings in "
                 'time order')
+    if motor.get('estimator') == MIXED:
+        return ("the health monitor's figure where it is the recording's, the ratio where not "
+                '(each point says which; the table below)')
     return (f'{RATIO}: per recording, the ratio of measured to baseline losses, its interval '
             "widened by the residuals' autocorrelation")
 

@@ -4,8 +4,12 @@ The fleet's view: per motor the leakage factor over dates, its trend, alarms, ra
 
 Where the motor's recordings are time series, its one health monitor
 (:mod:`~satmotor_ros.fleet.chain`, ``satmotor monitor``'s estimator run over them in time
-order) gives the leakage factor after each recording, the trend, the hours to the limit and
-the alarms. Otherwise (steady-point tables, which the monitor cannot watch): the trend is a
+order) gives the leakage factor after each recording where that figure is the recording's
+(:func:`monitor_unfit`: fast enough, enough samples, an interval), and the trend, the hours
+to the limit and the alarms when its figures are taken throughout. A recording whose monitor
+figure is not valid (a steady-point table, which the monitor cannot watch; a recording the
+monitor is still learning on) gets its ratio (:mod:`~satmotor_ros.fleet.health`), and each
+point says which (``estimator``). For ratios: the trend is a
 least-squares line through the recordings since the motor's last change
 alarm (a step is not wear); the days to the limit are where that line meets it, counted
 from the last recording. A change is a step between consecutive recordings larger than
@@ -19,7 +23,7 @@ calendar time only when the samples carry epoch times: recordings whose clock st
 per hour *recorded*. For such a motor the trend per day and the days to the limit are the
 line through the monitor's figure after each recording against the recordings' times
 (as above, since the last step in those figures), and ``trend_clock`` says which clock each
-motor's trend is on. A figure without an interval (the monitor still learning) is no point.
+motor's trend is on.
 """
 
 from __future__ import annotations
@@ -46,6 +50,20 @@ MIN_TREND_POINTS = 3
 
 EPOCH_S = 9.0e8
 """A monitor clock beyond this is epoch seconds (as the fleet's discovery reads a time column)."""
+
+BY_MONITOR, BY_RATIO, MIXED = 'monitor', 'ratio', 'monitor+ratio'
+"""Which estimator gave a figure (each point's ``estimator``) and a motor's (``estimator``)."""
+
+LEARNING = 'the monitor gave no interval (still learning)'
+"""Why a recording's monitor figure is not taken while the monitor learns."""
+
+MONITOR_MIN_RATE = 0.5
+"""Fewest samples a second a recording's monitor figure is taken at, [1/s]: the monitor's
+10 s bins hold 5 samples; a steady-point table (a point a minute) gets its ratio."""
+
+MONITOR_MIN_SAMPLES = 150
+"""Fewest usable samples a recording's monitor figure is taken on, [-]: the monitor's 300 s
+window at :data:`MONITOR_MIN_RATE`, so the figure is this recording's."""
 
 RECORDING_TIMES = "calendar: the recordings' times"
 MONITOR_EPOCH = "calendar: the monitor's epoch clock"
@@ -77,19 +95,77 @@ def motor_view(motor: str, liquid: str, markers: list[dict[str, Any]],
     -------
     dict
         The DESIGN.md "Fleet output" entry, plus ``baseline``, ``limit``, ``time_sources``,
-        ``last`` (the latest leakage factor), ``estimator`` ('monitor' or 'ratio') and
-        ``trend_clock`` (:data:`RECORDING_TIMES` or :data:`MONITOR_EPOCH`); each point of
-        ``leakage_factor`` says its recording's ``time_source``.
+        ``last`` (the latest leakage factor), ``estimator`` (:data:`BY_MONITOR`,
+        :data:`BY_RATIO` or :data:`MIXED`) and ``trend_clock`` (:data:`RECORDING_TIMES` or
+        :data:`MONITOR_EPOCH`); each point of ``leakage_factor`` says its recording's
+        ``time_source``, its ``estimator`` and, for a ratio where the monitor gave a figure
+        not taken, why (``monitor_unused``, :func:`monitor_unfit`).
 
     """
     points = [m for m in markers if m.get('status') == 'done' and m.get('result')]
     watched = [s for s in steps or () if s.get('status') == 'done' and s.get('result')]
-    if any(_interval(s) for s in watched):
+    if any(not monitor_unfit(s) for s in watched):
         return _monitored(motor, liquid, markers, watched, baseline, limit)
-    series = [{'date': m['date'], 'value': m['result']['leakage_factor'],
-               'ci95': m['result']['ci95'], 'recording': m['recording'],
-               'time_source': m.get('time_source', '')} for m in points]
+    unfit = {s['recording']: monitor_unfit(s) for s in watched}
+    series = [_ratio_point(m, unfit.get(m['recording'], '')) for m in points]
     times = np.array([m['time'] for m in points], dtype=float)
+    alarms, trend, days = _ratio_alarms_and_trend(series, times, limit)
+    return _view(motor, liquid, markers, series, trend, days, alarms, baseline, limit, BY_RATIO,
+                 RECORDING_TIMES)
+
+
+def monitor_unfit(step: dict[str, Any]) -> str:
+    """
+    Say why the monitor's figure after a recording is not that recording's; '' when it is.
+
+    The figure is the recording's when the recording's samples come at
+    :data:`MONITOR_MIN_RATE` or faster on average (the monitor's 10 s bins and 5 min window
+    are built for time series: on a steady-point table, a point a minute, its factor is not
+    the calibrated one), the recording gave it :data:`MONITOR_MIN_SAMPLES` usable samples
+    (else the figure is mostly the recordings' before it, still in its window), and the
+    figure has a value and an interval (the monitor past learning).
+
+    Parameters
+    ----------
+    step : dict
+        A monitor chain step's marker (:func:`~satmotor_ros.fleet.chain.monitor_step`), [-]
+
+    Returns
+    -------
+    str
+        '' when the figure is valid for its recording, else one line saying why not.
+
+    """
+    result = step.get('result') or {}
+    if step.get('status') != 'done' or not result:
+        return f"the monitor's step is {step.get('status', 'missing')}"
+    n, skipped = int(result.get('n_samples') or 0), int(result.get('n_skipped') or 0)
+    span = result.get('span_s') or [0.0, 0.0]
+    seconds = float(span[1]) - float(span[0])
+    rate = (n - 1) / seconds if seconds > 0 and n > 1 else 0.0
+    if rate < MONITOR_MIN_RATE:
+        return (f'{rate:.3g} samples/s, below the {MONITOR_MIN_RATE:g} the monitor is built '
+                'for')
+    if n - skipped < MONITOR_MIN_SAMPLES:
+        return (f'{n - skipped} usable samples, fewer than {MONITOR_MIN_SAMPLES} (its '
+                "window is still the recordings' before)")
+    return '' if _interval(step) else LEARNING
+
+
+def _ratio_point(marker: dict[str, Any], unfit: str = '') -> dict[str, Any]:
+    """Return a recording's ratio figure as a point of ``leakage_factor``."""
+    point = {'date': marker['date'], 'value': marker['result']['leakage_factor'],
+             'ci95': marker['result']['ci95'], 'recording': marker['recording'],
+             'time_source': marker.get('time_source', ''), 'estimator': BY_RATIO}
+    if unfit:
+        point['monitor_unused'] = unfit
+    return point
+
+
+def _ratio_alarms_and_trend(series: list[dict[str, Any]], times: np.ndarray,
+                            limit: float) -> tuple[list[dict[str, Any]], float | None,
+                                                   float | None]:
+    """Return the change and limit alarms of a series, its trend and days to the limit."""
     values = np.array([s['value'] for s in series], dtype=float)
     half = np.array([(s['ci95'][1] - s['ci95'][0]) / 2.0 for s in series], dtype=float)
     alarms, start = _changes(series, times, values, half)
@@ -100,8 +176,7 @@ def motor_view(motor: str, liquid: str, markers: list[dict[str, Any]],
                                f'{limit:g}', 'recording': crossed['recording']})
     alarms.sort(key=lambda a: a['date'])
     trend, days = _trend(times[start:], values[start:], limit)
-    return _view(motor, liquid, markers, series, trend, days, alarms, baseline, limit, 'ratio',
-                 RECORDING_TIMES)
+    return alarms, trend, days
 
 
 def _view(motor: str, liquid: str, markers: list[dict[str, Any]],
@@ -124,12 +199,30 @@ def _view(motor: str, liquid: str, markers: list[dict[str, Any]],
 def _monitored(motor: str, liquid: str, markers: list[dict[str, Any]],
                watched: list[dict[str, Any]], baseline: dict[str, Any] | None,
                limit: float) -> dict[str, Any]:
-    """Build the view from the motor's one monitor: its figure after each recording."""
+    """
+    Build the view from the motor's one monitor where its figures are valid, else the ratios.
+
+    A recording whose monitor figure is unfit (:func:`monitor_unfit`) gets its ratio. The
+    monitor's own trend and days are the motor's only when every point is the monitor's on
+    an epoch clock; else the line through the points against the recordings' times.
+    """
     dates = {m['recording']: m['date'] for m in markers}
     times = {m['recording']: m for m in markers}
-    series = [{'date': dates.get(s['recording'], ''), 'recording': s['recording'],
-               'time_source': times.get(s['recording'], {}).get('time_source', ''),
-               **s['result']['leakage_factor']} for s in watched if _interval(s)]
+    steps = {s['recording']: s for s in watched}
+    ratios = {m['recording']: m for m in markers if m.get('status') == 'done' and m.get('result')}
+    order = [m['recording'] for m in markers]
+    order += [s['recording'] for s in watched if s['recording'] not in set(order)]
+    series = []
+    for recording in order:
+        step = steps.get(recording)
+        unfit = monitor_unfit(step) if step else ''
+        if step is not None and not unfit:
+            series.append({'date': dates.get(recording, ''), 'recording': recording,
+                           'time_source': times.get(recording, {}).get('time_source', ''),
+                           **step['result']['leakage_factor'], 'estimator': BY_MONITOR})
+        elif recording in ratios:
+            series.append(_ratio_point(ratios[recording], unfit))
+    fit = {p['recording'] for p in series if p['estimator'] == BY_MONITOR}
     last = watched[-1]['result']
     alarms = []
     for alarm in last.get('alarms', []):  # the snapshot's: each with its final name
@@ -137,18 +230,41 @@ def _monitored(motor: str, liquid: str, markers: list[dict[str, Any]],
         where = [s for s in watched if s['result'].get('span_s')
                  and s['result']['span_s'][0] <= at] or watched[:1]
         recording = where[-1]['recording']
+        if recording not in fit:  # raised on figures the fleet does not take
+            continue
         alarms.append({'date': dates.get(recording, ''), 'kind': alarm.get('kind', 'change'),
                        'what': f"{alarm.get('what', 'unexplained')} (in {recording})",
                        'recording': recording, 'source': 'monitor'})
-    if all((s['result'].get('span_s') or [0.0])[0] > EPOCH_S for s in watched):
+    if _monitor_trend_holds(series, watched):
         per_hour, hours = last.get('trend_per_hour'), last.get('hours_to_limit')
         return _view(motor, liquid, markers, series,
                      None if per_hour is None else 24.0 * per_hour,
                      None if hours is None else hours / 24.0, alarms, baseline, limit,
-                     'monitor', MONITOR_EPOCH)
+                     BY_MONITOR, MONITOR_EPOCH)
+    if len(fit) < len(series):  # the ratios' steps and limit, on the recordings they hold
+        timed = [p for p in series if times.get(p['recording'], {}).get('time') is not None]
+        ratio_alarms, _, _ = _ratio_alarms_and_trend(
+            timed, np.array([float(times[p['recording']]['time']) for p in timed]), limit)
+        alarms += [a for a in ratio_alarms if a['recording'] not in fit
+                   and not (a['kind'] == 'limit' and any(b['kind'] == 'limit' for b in alarms))]
+        alarms.sort(key=lambda a: a['date'])
     trend, days = _calendar_trend(series, times, limit)
     return _view(motor, liquid, markers, series, trend, days, alarms, baseline, limit,
-                 'monitor', RECORDING_TIMES)
+                 BY_MONITOR if len(fit) == len(series) else MIXED, RECORDING_TIMES)
+
+
+def _monitor_trend_holds(series: list[dict[str, Any]], watched: list[dict[str, Any]]) -> bool:
+    """
+    Whether the monitor's own trend is the motor's: an epoch clock, and its figures taken.
+
+    Every point from the monitor's first valid figure on is its, and the ones before are the
+    recordings it learned on (no interval yet): no recording fed it figures the fleet refused.
+    """
+    first = next((i for i, p in enumerate(series) if p['estimator'] == BY_MONITOR), None)
+    return first is not None \
+        and all(p['estimator'] == BY_MONITOR for p in series[first:]) \
+        and all(p.get('monitor_unused') == LEARNING for p in series[:first]) \
+        and all((s['result'].get('span_s') or [0.0])[0] > EPOCH_S for s in watched)
 
 
 def _interval(step: dict[str, Any]) -> bool:
@@ -315,6 +431,7 @@ def iso_now() -> str:
     return datetime.now(timezone.utc).isoformat(timespec='seconds')
 
 
-__all__ = ['CHANGE_SIGMAS', 'DAY', 'EPOCH_S', 'LIMIT', 'MIN_STEP', 'MIN_TREND_POINTS',
-           'MONITOR_EPOCH', 'NEAR', 'RECORDING_TIMES', 'iso_now',
+__all__ = ['BY_MONITOR', 'BY_RATIO', 'CHANGE_SIGMAS', 'DAY', 'EPOCH_S', 'LIMIT', 'MIN_STEP',
+           'LEARNING', 'MIN_TREND_POINTS', 'MIXED', 'MONITOR_EPOCH', 'MONITOR_MIN_RATE',
+           'MONITOR_MIN_SAMPLES', 'NEAR', 'RECORDING_TIMES', 'iso_now', 'monitor_unfit',
            'motor_view', 'rank']
