@@ -124,7 +124,7 @@ def markdown(motors: list[dict[str, Any]], header: dict[str, Any]) -> str:
 def _by(point: dict[str, Any]) -> str:
     """Say which estimator gave a point, and why not the monitor where it gave a figure."""
     why = point.get('monitor_unused')
-    return point.get('estimator', '') + (f' (monitor not taken: {why})' if why else '')
+    return str(point.get('estimator', '')) + (f' (monitor not taken: {why})' if why else '')
 
 
 def _estimator(motor: dict[str, Any]) -> str:
