@@ -7,10 +7,13 @@ environment below is in place before anything can import rclpy; subprocesses tha
 tests start inherit it.
 """
 
+import contextlib
+import io
 import os
 from pathlib import Path
 import sys
 import tempfile
+from types import SimpleNamespace
 
 import pytest
 
@@ -103,3 +106,42 @@ def ros(request):
         executor.shutdown()
         probe.destroy_node()
         context.try_shutdown()
+
+
+MBARI = ('2021.07.26T10.51.44.exp', 'FrictionIDMovesWithBiasCurr.exp')
+"""The two real MBARI power-take-off logs (test/data/real/mbari_pto)."""
+
+
+@pytest.fixture(scope='session')
+def mbari_calibrations(tmp_path_factory):
+    """
+    Calibrate both MBARI logs once per session through ``satmotor calibrate``.
+
+    With the Parker F11-5's displacement (0.30 in^3/rev). Gives name -> namespace of
+    ``code``, ``out``, ``err`` (the command's exit status, --out and stderr) and ``call``,
+    the positional arguments the command passed to :func:`identify.calibrate` (the table
+    read, the liquid, the spec, the options), and ``calibration``, what it returned.
+    """
+    from satmotor_ros.cli import calibrate as command
+    from satmotor_ros.cli.main import main
+    from vendored_data import data_path
+    runs = {}
+    for name in MBARI:
+        seen = []
+
+        def recorded(*args, **kwargs):
+            seen.append((args, kwargs, plain(*args, **kwargs)))
+            return seen[-1][2]
+
+        plain = command.calibrate
+        out = tmp_path_factory.mktemp('cal') / name
+        errors = io.StringIO()
+        with pytest.MonkeyPatch.context() as patch, contextlib.redirect_stderr(errors):
+            patch.setattr(command, 'calibrate', recorded)
+            code = main(['calibrate', str(data_path('real', 'mbari_pto', name)),
+                         '--columns', 'mbari_pto', '--liquid', 'oil',
+                         '--displacement', '0.30 in^3/rev', '--out', str(out)])
+        assert len(seen) == 1 and not seen[0][1], seen
+        runs[name] = SimpleNamespace(code=code, out=out, err=errors.getvalue(),
+                                     call=seen[0][0], calibration=seen[0][2])
+    return runs

@@ -1,8 +1,6 @@
 # SPDX-License-Identifier: Apache-2.0
 """Users' own logs through a column mapping: the MBARI logs, other layouts, one-line errors."""
 
-import contextlib
-import io
 import json
 import math
 
@@ -177,25 +175,11 @@ def test_packaged_mapping_is_found_by_name_and_by_path():
     assert by_path.fields == by_name.fields
 
 
-@pytest.fixture(scope='module')
-def mbari_calibrations(tmp_path_factory):
-    """Calibrate both MBARI logs once, with the F11-5's displacement: name -> (code, out, err)."""
-    runs = {}
-    for name in MBARI:
-        out = tmp_path_factory.mktemp('cal') / name
-        log = data_path('real', 'mbari_pto', name)
-        errors = io.StringIO()
-        with contextlib.redirect_stderr(errors):
-            code = main(['calibrate', str(log), '--columns', 'mbari_pto', '--liquid', 'oil',
-                         '--displacement', '0.30 in^3/rev', '--out', str(out)])
-        runs[name] = (code, out, errors.getvalue())
-    return runs
-
-
 @pytest.mark.slow
 @pytest.mark.parametrize('name', MBARI)
 def test_calibrate_each_mbari_log_with_the_f11_displacement(mbari_calibrations, name):
-    code, out, err = mbari_calibrations[name]
+    run = mbari_calibrations[name]  # conftest.py: both logs calibrated once a session
+    code, out, err = run.code, run.out, run.err
     assert code == 0, err
     assert 'warning: ' in err and "'p_b (LowerHydPress)'" in err
     result = json.loads((out / 'calibration.json').read_text())
@@ -235,8 +219,7 @@ def test_calibrate_each_mbari_log_with_the_f11_displacement(mbari_calibrations, 
 @pytest.mark.parametrize(('calibrated', 'data'), [MBARI, MBARI[::-1]])
 def test_validate_one_mbari_logs_calibration_on_the_other(mbari_calibrations, tmp_path, capsys,
                                                           calibrated, data):
-    _, out, _ = mbari_calibrations[calibrated]
-    _, own, _ = mbari_calibrations[data]
+    out, own = mbari_calibrations[calibrated].out, mbari_calibrations[data].out
     log = data_path('real', 'mbari_pto', data)
     code = main(['validate', str(log), '--columns', 'mbari_pto', '--liquid', 'oil',
                  '--motor', str(out / 'coefficients.yaml'), '--out', str(tmp_path / 'val')])
@@ -262,7 +245,7 @@ def test_a_valve_calibration_validated_on_its_own_log_gives_its_own_error(mbari_
     # the valve reads the measured port drop in validation as in calibration (not the port
     # drop of the motor's own flow, lower by the channel drop of the valve's flow)
     name = MBARI[1]
-    _, out, _ = mbari_calibrations[name]
+    out = mbari_calibrations[name].out
     code = main(['validate', str(data_path('real', 'mbari_pto', name)), '--columns',
                  'mbari_pto', '--liquid', 'oil', '--motor', str(out / 'coefficients.yaml'),
                  '--out', str(tmp_path / 'val')])

@@ -13,12 +13,8 @@ from dataclasses import replace
 
 import pytest
 from satmotor_ros.identify import calibrate, Options
-from satmotor_ros.identify.columns import load_mapping, read_log
 from satmotor_ros.identify.synthetic import (generate_transient, Injection, Plan,
                                              REALISTIC_DYNAMICS)
-from satmotor_ros.model.units import parse_quantity
-from satmotor_ros.options import MotorOptions
-from vendored_data import data_path
 
 SWAPPED = {'positive': 'negative', 'negative': 'positive', 'both': 'both'}
 PORTS = {'line_compliance': 'line_compliance_b', 'line_compliance_b': 'line_compliance'}
@@ -61,12 +57,13 @@ def test_a_mirrored_transient_recording_gives_the_mirrored_calibration():
 
 
 @pytest.mark.slow
-def test_the_mirrored_mbari_log_gives_the_mirrored_calibration():
-    log = data_path('real', 'mbari_pto', '2021.07.26T10.51.44.exp')
-    table = read_log(log, load_mapping('mbari_pto'))
-    displacement = parse_quantity('0.30 in^3/rev', 'displacement', 'cm^3/rev')
-    spec = MotorOptions(liquid='oil', displacement=displacement).spec()
-    one, other = (calibrate(t, 'oil', spec) for t in (table, mirrored(table)))
+def test_the_mirrored_mbari_log_gives_the_mirrored_calibration(mbari_calibrations):
+    # the log as ``satmotor calibrate`` read and calibrated it (conftest.py, once a session;
+    # the F11-5's displacement), and its mirror through the same call
+    run = mbari_calibrations['2021.07.26T10.51.44.exp']
+    table, *rest = run.call
+    assert table.source.endswith('2021.07.26T10.51.44.exp') and len(table) > 19000
+    one, other = run.calibration, calibrate(mirrored(table), *rest)
     first, second = _figures(one), _figures(other)
     _same(first, second, 0.02)
     named = [(e, SWAPPED[d]) for e, d in first[2]]
