@@ -15,6 +15,7 @@ import yaml
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
 
 WEAR = 3e-9  # clearance growth injected into the virtual motor [m/rev]
+RATE = 50.0  # controller, set-point and plant publishing rate: half the demo's [Hz]
 
 
 def _residuals(path):
@@ -34,12 +35,15 @@ def test_demo_bag_with_wear_is_calibrated_and_the_new_yaml_shrinks_the_speed_res
     the motor_model prediction (``satmotor replay`` runs the node's own code; test_replay_live
     holds them equal) with the new file must track the measured speed better than with the
     packaged one. 96 s: at 48 s (6e-9) or 24 s (3e-9) the tracking cycle's steps are too
-    short for the calibration to name the wear.
+    short for the calibration to name the wear. At half the demo's rate (50 Hz, 4 800
+    samples) the run costs half its CPU (the nodes' work is per message) and the figures
+    keep their margins: the wear at 1.002 of the injected, the RMS residual at 0.35 of the
+    packaged file's (0.33 at 100 Hz; limit 0.6).
     """
     from satmotor_ros.cli._demo_ros import run_cycle  # imports rclpy
     bag = tmp_path / 'water_model'
     run_cycle('water', 'model', default_cycle().scaled(96.0),
-              parse_effects([f'clearance_wear={WEAR}']), bag, None)
+              parse_effects([f'clearance_wear={WEAR}']), bag, None, RATE)
     cal = tmp_path / 'cal'
     assert main(['calibrate', str(bag), '--liquid', 'water', '--out', str(cal)]) == 0
     result = json.loads((cal / 'calibration.json').read_text())

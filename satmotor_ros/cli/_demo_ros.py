@@ -56,15 +56,16 @@ RECORDED = (  # topic relative to the run's namespace, type, reliable publisher?
 class Script(Node):
     """Publish the cycle's speed set-point and load torque on simulated time."""
 
-    def __init__(self, cycle: Cycle, motor: Node | None = None, **kwargs: Any) -> None:
-        """Start the timer on the node clock (use_sim_time); `motor` takes the case offsets."""
+    def __init__(self, cycle: Cycle, motor: Node | None = None, rate: float = CONTROL_RATE,
+                 **kwargs: Any) -> None:
+        """Tick at `rate` [Hz] on the node clock (use_sim_time); `motor` takes the case offsets."""
         super().__init__('demo_script', **kwargs)
         self.cycle = cycle
         self._motor = motor
         self._case_offset: float | None = None
         self._setpoint = self.create_publisher(Float64, SPEED_SETPOINT, 10)
         self._load = self.create_publisher(Float64, CHANNELS['torque'].topic, 10)
-        self.create_timer(1.0 / CONTROL_RATE, self._tick)
+        self.create_timer(1.0 / rate, self._tick)
 
     def _tick(self) -> None:
         segment = self.cycle.at(self.get_clock().now().nanoseconds * 1e-9)
@@ -187,7 +188,7 @@ def _wait_connected(executor: SingleThreadedExecutor, nodes: list[Node],
 
 
 def run_cycle(liquid: str, feedforward: str, cycle: Cycle, effects: dict[str, Any],
-              bag: Path, progress: Any) -> RunResult:
+              bag: Path, progress: Any, rate: float = CONTROL_RATE) -> RunResult:
     """
     Run the cycle once over ROS and write its bag.
 
@@ -205,6 +206,9 @@ def run_cycle(liquid: str, feedforward: str, cycle: Cycle, effects: dict[str, An
         Bag directory to create, [-]
     progress : Progress or None
         Progress bar, [-]
+    rate : float
+        Rate of the controller, the set-point script and the virtual motor's
+        publishing (:data:`CONTROL_RATE`; the demo's), [Hz]
 
     Returns
     -------
@@ -225,17 +229,17 @@ def run_cycle(liquid: str, feedforward: str, cycle: Cycle, effects: dict[str, An
             motor = VirtualMotorNode(context=context, namespace=namespace, parameter_overrides=[
                 Parameter('clock_mode', value='lockstep'), Parameter('paused', value=True),
                 Parameter('lockstep_wait', value=LOCKSTEP_WAIT), Parameter('liquid', value=liquid),
-                Parameter('publish_rate', value=CONTROL_RATE),
+                Parameter('publish_rate', value=rate),
                 *(Parameter(k, value=v) for k, v in effects.items())])
             sim = [Parameter('use_sim_time', value=True)]
             controller = SpeedControllerNode(context=context, namespace=namespace,
                                              parameter_overrides=[
                                                  *sim, Parameter('liquid', value=liquid),
                                                  Parameter('feedforward', value=feedforward),
-                                                 Parameter('rate', value=CONTROL_RATE)])
+                                                 Parameter('rate', value=rate)])
             predictor = MotorModelNode(context=context, namespace=namespace, parameter_overrides=[
                 *sim, Parameter('liquid', value=liquid)])
-            script = Script(cycle, motor, context=context, namespace=namespace,
+            script = Script(cycle, motor, rate, context=context, namespace=namespace,
                             parameter_overrides=sim)
             recorder = Recorder(list(RECORDED), context=context, namespace=namespace)
             nodes = [recorder, script, controller, predictor, motor]
@@ -247,7 +251,7 @@ def run_cycle(liquid: str, feedforward: str, cycle: Cycle, effects: dict[str, An
             start = time.monotonic()
             plant = motor.plant
             # two periods past the end: every message that answers the last period is in
-            beyond = cycle.duration + 2.0 / CONTROL_RATE
+            beyond = cycle.duration + 2.0 / rate
             while plant.state.time < beyond:
                 executor.spin_once(timeout_sec=0.1)
                 check()
