@@ -35,7 +35,15 @@ from satmotor_ros.model.errors import ConfigError, InvalidInputError, ModelError
 from satmotor_ros.model.results import from_table, INVALID, OperatingPoints, Point, PointStatus
 
 Channels = Mapping[str, float]
-_CACHE = 4096  # variants kept before the cache is cleared
+_CACHE = 8
+"""
+Variants kept before the cache is cleared.
+
+A steady channel (or a few alternating values) costs one build each. A channel that moves
+every sample (a wear over time, a temperature) builds a variant per point whatever the
+size, and a cache of thousands of live models makes each of Python's garbage collections
+walk them all: 4 096 took a point of clearance wear from 37 to 118 us.
+"""
 _TOLERANCE = Tolerance(0.0, 4e-16, maxiter=200)  # the effects' solves, to the last bits
 _EXPANSIONS = 60
 _INVALID_FLAGS = int(INVALID)
