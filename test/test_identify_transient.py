@@ -18,8 +18,8 @@ from satmotor_ros.identify.synthetic import (Dynamics, first_order, generate_ser
                                              generate_transient, Injection, Plan,
                                              REALISTIC_DYNAMICS, to_columns, write_bag_of)
 from satmotor_ros.identify.table import write_csv
-from satmotor_ros.identify.transient import (bin_means, bins, segments, transient_samples,
-                                             variance_inflation)
+from satmotor_ros.identify.transient import (bin_means, bins, segments, sparse_bin_means,
+                                             transient_samples, variance_inflation)
 from satmotor_ros.identify.validate import validate
 from satmotor_ros.model import MotorModel
 from satmotor_ros.model.units import LPM, MPA
@@ -63,6 +63,26 @@ def test_bin_means_are_trapezoid_means_and_a_derivative_mean_is_the_change():
     for lo, hi in zip(a, b):
         inside = (t2 >= time[lo]) & (t2 <= time[hi])
         assert np.trapezoid(rate[inside], t2[inside]) == pytest.approx(x[hi] - x[lo])
+
+
+def test_sparse_bin_means_are_the_bin_means_bit_for_bit():
+    rng = np.random.default_rng(2)
+    time = np.cumsum(rng.uniform(0.005, 0.015, 3000))
+    usable = rng.uniform(size=time.size) > 0.01
+    first, _ = segments(time, 3.0)
+    a, b = bins(usable, first, 9)
+    unknown = ~usable | (rng.uniform(size=time.size) < 0.003)  # NaN bins, as bin_means
+    means = sparse_bin_means(time, unknown, a, b)
+    for share in (0.05, 0.5, 0.0):
+        x = np.where(rng.uniform(size=time.size) < share, rng.normal(0, 1, time.size), 0.0)
+        if share:
+            x[[0, 1, 700, 701, time.size - 1]] = (1.5, -2.0, 3.0, 0.25, 0.5)  # ends, neighbours
+        x[unknown] = np.nan
+        at = rng.permutation(np.flatnonzero(np.nan_to_num(x) != 0.0))  # in any order
+        dense = bin_means(time, x, a, b)
+        assert np.isnan(dense).any() and (np.nan_to_num(dense) != 0.0).sum() >= (50 if share
+                                                                                 else 0)
+        np.testing.assert_array_equal(means(at, x[at]), dense)  # NaN where dense is
 
 
 def test_bins_never_span_a_gap_or_an_unusable_sample():

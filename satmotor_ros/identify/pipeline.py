@@ -29,7 +29,7 @@ from satmotor_ros.identify.selection import (at_bound, CrossValidatedSelector, E
 from satmotor_ros.identify.steady import (extract_steady, looks_like_series, steady_windows,
                                           SteadyTolerance)
 from satmotor_ros.identify.table import BenchTable
-from satmotor_ros.identify.transient import (averaged, dynamics_summary, Samples,
+from satmotor_ros.identify.transient import (averaged, averaged_sparse, dynamics_summary, Samples,
                                              transient_samples, TransientOptions)
 from satmotor_ros.model import load_motor, MotorModel, MotorSpec
 from satmotor_ros.model.effects import coefficients_without, Effect, kind_of, measured_range
@@ -690,7 +690,7 @@ def _sampled(samples: Samples | None) -> Sampled | None:
         return None
     raw = samples.samples
     dp = np.where(samples.usable, raw.p_in - raw.p_out, np.nan)
-    return Sampled(dp, lambda x: averaged(samples, x))
+    return Sampled(dp, lambda x: averaged(samples, x), averaged_sparse(samples))
 
 
 def _selector(options: Options, points: BenchTable,

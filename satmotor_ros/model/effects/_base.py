@@ -212,6 +212,9 @@ class Sampled(NamedTuple):
 
     dp: FloatArray  # signed port drop p_a - p_b at every sample (NaN where unusable) [Pa]
     mean: Callable[[FloatArray], FloatArray]  # a quantity at every sample -> its bin means
+    sparse: Callable[[np.ndarray, FloatArray], FloatArray] | None = None  # (the samples
+    # where a quantity may differ from 0, each once, none where dp is NaN; its values there)
+    # -> its bin means, NaN where dp is: `mean`'s, at a cost that grows with those samples
 
 
 class Synthetic(NamedTuple):

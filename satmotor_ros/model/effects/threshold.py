@@ -35,6 +35,10 @@ EXPONENTS = (0.05, 3.0)
 """Range of the fitted exponent e, [-]: below 1 down to a near step, a relief valve at its
 pressure override, whose drop hardly rises while the flow it passes (set by the demand) does."""
 
+SHAPES_KEPT = 4
+"""Shapes (crack, exponent) whose flow at every sample a candidate keeps, [-]: a fit's
+step, its finite differences and a rejected step's retry."""
+
 
 class Threshold(EffectKind):
     """A flow that starts above a pressure drop: a relief or bypass valve cracking open."""
@@ -176,9 +180,25 @@ class Threshold(EffectKind):
         acts = at.astype(float)
         if samples is not None:
             over = _at_samples(samples, direction)
+            known = np.flatnonzero(~np.isnan(over))
+            order = known[np.argsort(over[known])]  # by drop, rising
+            rising = over[order]
+            shapes: dict[tuple[float, float], FloatArray] = {}  # (x_c, e) -> the bins' flow
 
             def modify(k: float, x_c: float, e: float) -> Modifier:
-                flow = samples.mean((np.maximum(over - x_c, 0.0) / (top - x_c)) ** e)
+                # a fit's finite differences in k and the other coefficients keep the
+                # shape: its flow, the costly part (every sample), is computed once
+                flow = shapes.get((x_c, e))
+                if flow is None:
+                    if samples.sparse is not None and x_c < top:  # 0 at or below the crack
+                        at = order[np.searchsorted(rising, x_c, side='right'):]
+                        flow = samples.sparse(at, (np.maximum(over[at] - x_c, 0.0)
+                                                   / (top - x_c)) ** e)
+                    else:
+                        flow = samples.mean((np.maximum(over - x_c, 0.0) / (top - x_c)) ** e)
+                    if len(shapes) >= SHAPES_KEPT:
+                        shapes.pop(next(iter(shapes)))
+                    shapes[(x_c, e)] = flow
                 return Modifier(additive=acts * k * flow)
         else:
             def modify(k: float, x_c: float, e: float) -> Modifier:
