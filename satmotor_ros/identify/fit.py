@@ -133,7 +133,11 @@ def robust_root(z: FloatArray, c: float, redescending: bool = False) -> FloatArr
     if redescending:
         u = np.minimum((z / c) ** 2, 1.0)
         return np.sign(z) * c * np.sqrt((1.0 - (1.0 - u) ** 3) / 3.0)
-    return np.where(np.abs(z) <= c, z, np.sign(z) * np.sqrt(np.maximum(huber_rho(z, c), 0.0)))
+    out = np.array(z, dtype=float)  # z within c as it is; beyond c (the few) transformed
+    beyond = ~(np.abs(out) <= c)
+    tail = out[beyond]
+    out[beyond] = np.sign(tail) * np.sqrt(np.maximum(huber_rho(tail, c), 0.0))
+    return out
 
 
 @dataclass(frozen=True)
@@ -274,8 +278,11 @@ class LossFit:
         lower, upper, starts = self._starts(parts, start)
         m, c, tukey = self.m_, self.robust, self.redescending
 
+        every = index.size == len(parts) and bool(np.all(index == np.arange(index.size)))
+
         def residual(u: FloatArray) -> FloatArray:
-            z = (flow - self._predict(parts, u)[index]) / sigma
+            predicted = self._predict(parts, u)
+            z = (flow - (predicted if every else predicted[index])) / sigma
             if tukey or c:
                 z = robust_root(z, TUKEY if tukey else c, tukey)
             return np.concatenate((z, (u[:m] - 1.0) / PRIOR_SD)) if prior else z

@@ -60,7 +60,8 @@ def _scaled(mod: Modifier, factors: str, column: FloatArray) -> FloatArray:
     if not factors:
         return column
     for name in factors.split('*'):
-        column = getattr(mod, name) * column
+        factor = getattr(mod, name)
+        column = column if _one(factor) else factor * column
     return column
 
 
@@ -145,13 +146,29 @@ def predict_flow(parts: LossParts, scales: FloatArray, mod: Modifier = NO_EFFECT
         Predicted measured flow, [m^3/s]
 
     """
-    inner = parts.displacement / mod.speed_gain + mod.additive
+    # a gain of 1 and an extra loss or offset of 0 leave the sums as they are: skipped
+    inner = parts.displacement if _one(mod.speed_gain) else parts.displacement / mod.speed_gain
+    if not _zero(mod.additive):
+        inner = inner + mod.additive
     for scale, component in zip(scales, parts.components):
         inner = inner + scale * component.flow(mod)
     if nuisance is not None:
         for beta, x in zip(nuisance, parts.nuisance.values()):
             inner = inner + beta * x
-    return mod.flow_gain * inner + mod.offset * parts.sign
+    flow = inner if _one(mod.flow_gain) else mod.flow_gain * inner
+    if not _zero(mod.offset):
+        return flow + mod.offset * parts.sign
+    return flow.copy() if flow is parts.displacement else flow  # never the parts' own array
+
+
+def _one(x: FloatArray | float) -> bool:
+    """Tell whether `x` is the number 1 (not an array): a product by it changes nothing."""
+    return isinstance(x, float | int) and x == 1.0
+
+
+def _zero(x: FloatArray | float) -> bool:
+    """Tell whether `x` is the number 0 (not an array): a sum with it changes nothing."""
+    return isinstance(x, float | int) and x == 0.0
 
 
 def loss_parts(model: MotorModel, table: BenchTable,

@@ -340,6 +340,8 @@ def sparse_bin_means(time: FloatArray, unknown: np.ndarray, a: np.ndarray,
     holes = np.concatenate(([0], np.cumsum(bad)))
     lost = holes[b] > holes[a]
     span = time[b] - time[a]
+    ends, where = np.unique(np.concatenate((a, b)), return_inverse=True)
+    at_a, at_b = where[:a.size], where[a.size:]
 
     def means(at: np.ndarray, values: FloatArray) -> FloatArray:
         x = np.zeros(time.size)
@@ -350,8 +352,10 @@ def sparse_bin_means(time: FloatArray, unknown: np.ndarray, a: np.ndarray,
         # that touch `at` and hold no NaN
         area = np.concatenate(([0.0], np.cumsum(0.5 * (x[j + 1] + x[j])
                                                 * (time[j + 1] - time[j]))))
-        first, last = np.searchsorted(j, a), np.searchsorted(j, b)  # pieces before each end
-        return np.where(lost, np.nan, (area[last] - area[first]) / span)
+        # the pieces before each end: a piece counts for every end after it
+        before = np.cumsum(np.bincount(np.searchsorted(ends, j, side='right'),
+                                       minlength=ends.size + 1))
+        return np.where(lost, np.nan, (area[before[at_b]] - area[before[at_a]]) / span)
     return means
 
 

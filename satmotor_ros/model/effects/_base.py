@@ -207,6 +207,12 @@ class CandidateData(NamedTuple):
     # samples' own port drop, so a kind nonlinear in it is averaged as the model will be
 
 
+SHAPES_KEPT = 4
+"""Shapes (a crack, exponents) whose form a candidate keeps computed, [-]: a fit's finite
+differences in the coefficients keep the shape (the form is reused), and a step, its
+differences in the shape and a rejected step's retry each need one."""
+
+
 class Sampled(NamedTuple):
     """The samples each point (a bin of a time series) averages, for kinds that read dp."""
 

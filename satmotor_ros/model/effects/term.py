@@ -12,7 +12,7 @@ import numpy as np
 
 from satmotor_ros.model._typing import FloatArray, Real
 from satmotor_ros.model.effects._base import (Candidate, CandidateData, Effect, EffectKind,
-                                              finite, Loss, Modifier, Shape)
+                                              finite, Loss, Modifier, Shape, SHAPES_KEPT)
 from satmotor_ros.model.errors import ConfigError
 from satmotor_ros.model.units import LPM
 
@@ -161,10 +161,18 @@ class Term(EffectKind):
         def powers(theta: tuple[float, ...]) -> dict[str, float]:
             return {'dp': 0.0, 'n': 0.0, **dict(zip(form, theta))}
 
+        shapes: dict[tuple[float, ...], FloatArray | float] = {}  # exponents -> the form
+
         def modify(k: float, *theta: float) -> Modifier:
-            x: FloatArray | float = 1.0
-            for name, p in zip(form, theta):
-                x = x * columns[name] ** p
+            # a fit's finite differences in k and the other coefficients keep the exponents
+            x = shapes.get(theta)
+            if x is None:
+                x = 1.0
+                for name, p in zip(form, theta):
+                    x = x * columns[name] ** p
+                if len(shapes) >= SHAPES_KEPT:
+                    shapes.pop(next(iter(shapes)))
+                shapes[theta] = x
             return Modifier(additive=k * x)
 
         def make(k: float, *theta: float) -> Effect:

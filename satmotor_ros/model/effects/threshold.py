@@ -17,8 +17,8 @@ import numpy as np
 from satmotor_ros.model._typing import FloatArray, Real
 from satmotor_ros.model.effects._base import (Candidate, CandidateData, DIRECTIONS, Effect,
                                               EffectKind, finite, Loss, Modifier, negative_rows,
-                                              PlantParameter, Sampled, Shape, Synthetic,
-                                              two_sided)
+                                              PlantParameter, Sampled, Shape, SHAPES_KEPT,
+                                              Synthetic, two_sided)
 from satmotor_ros.model.effects.term import MAX_EXPONENT
 from satmotor_ros.model.errors import ConfigError
 from satmotor_ros.model.units import LPM
@@ -34,10 +34,6 @@ the side's drops (one side: a valve cracks near the top of its side's range), [-
 EXPONENTS = (0.05, 3.0)
 """Range of the fitted exponent e, [-]: below 1 down to a near step, a relief valve at its
 pressure override, whose drop hardly rises while the flow it passes (set by the demand) does."""
-
-SHAPES_KEPT = 4
-"""Shapes (crack, exponent) whose flow at every sample a candidate keeps, [-]: a fit's
-step, its finite differences and a rejected step's retry."""
 
 
 class Threshold(EffectKind):
