@@ -327,3 +327,43 @@ def test_validate_reads_a_transient_recording_as_calibrate_does(tmp_path, capsys
     assert val['n_points'] + val['n_flagged'] >= cal['n_points'] - len(cal['outliers'])
     # the model as calibrated, the bench's transient terms refitted: the in-sample error
     assert val['error']['rmse_lpm'] < 1.2 * cal['error_after']['rmse_lpm']
+
+
+def test_a_valve_candidate_at_the_samples_above_its_crack_is_the_one_at_every_sample():
+    from satmotor_ros.identify.pipeline import _sampled
+    from satmotor_ros.model.effects import CandidateData
+    from satmotor_ros.model.effects.threshold import KIND
+    rec = _recording('water', 'external_leakage', duration_s=40.0)
+    model = MotorModel.default('water')
+    rows = read_rows(model, rec, Options(mode='transient'))
+    sampled = _sampled(rows.samples)
+    data = CandidateData(rows.parts, {}, standard_law(model.liquid, 'water'), frozenset(), '',
+                         sampled)
+    dense = data._replace(samples=sampled._replace(sparse=None))
+    fast, _ = KIND.candidates(data)
+    assert fast
+    for i, f in enumerate(fast):
+        low, span = f.shape[0].to_unit
+        for v, e in ((0.0, 1.0), (0.5, 0.3), (0.5, 1.0), (0.97, 2.0), (0.5, 0.3)):
+            x_c = low + span * v
+            for k in (1.0, 2.5):  # the shape's flow reused for another coefficient
+                got = f.modify(k * LPM, x_c, e).additive
+                fresh = KIND.candidates(dense)[0][i]  # nothing kept from other calls
+                np.testing.assert_array_equal(got, fresh.modify(k * LPM, x_c, e).additive)
+        assert np.any(f.modify(LPM, low, 1.0).additive > 0.0)
+
+
+def test_a_fitted_form_keeps_its_form_per_exponents_only():
+    from satmotor_ros.model.effects import CandidateData
+    from satmotor_ros.model.effects.term import KIND
+    model = MotorModel.default('water')
+    rows = read_rows(model, _recording('water', duration_s=20.0), Options(mode='transient'))
+    data = CandidateData(rows.parts, {}, standard_law(model.liquid, 'water'), frozenset())
+    kept, _ = KIND.candidates(data)
+    for i, c in enumerate(kept):
+        for theta in ((0.5, 2.0), (0.5, 1.0), (2.0, 1.0), (0.5, 2.0), (1.5, 0.7), (0.5, 1.0)):
+            theta = theta[:len(c.shape)]
+            for k in (1.0, 3.0):
+                fresh = KIND.candidates(data)[0][i]
+                np.testing.assert_array_equal(c.modify(k * LPM, *theta).additive,
+                                              fresh.modify(k * LPM, *theta).additive)
