@@ -103,7 +103,7 @@ def calibrate_into(data: str, out: str, mode: Mode, alpha: float, folds: int,
     kinds = [k for k in (IMPLAUSIBLE, EMPTIED, AT_BOUND) if any(w.startswith(k) for w in warnings)]
     line = (f'WARNING {" and ".join(kinds)} (see report.md); ' if kinds else '') + \
         (f'WARNING: {settled.warning}; ' if settled.warning else '') + \
-        f'effect: {effect}'
+        f'effect: {summary["name"]}'
     if effect != 'none':
         line += (f' ({summary["regressor"]}, coefficient {summary["coefficient"]:.4g} '
                  f'{summary["unit"]})')
@@ -111,7 +111,7 @@ def calibrate_into(data: str, out: str, mode: Mode, alpha: float, folds: int,
     if runner is not None:
         line += f', near tie with {runner.label}'
     if len(summary['effects']) > 1:
-        line += ', then ' + ', '.join(e['effect'] for e in summary['effects'][1:])
+        line += ', then ' + ', '.join(e['name'] for e in summary['effects'][1:])
     line += f'; family {summary["family"]}'
     tie = summary['family_comparison'].get('near_tie')
     if tie:

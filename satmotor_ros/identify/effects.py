@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 from satmotor_ros.model import load_motor, MotorModel
 from satmotor_ros.model._typing import FloatArray
-from satmotor_ros.model.effects import flow_reading
+from satmotor_ros.model.effects import effect_name, flow_reading, kind_of
 from satmotor_ros.model.engine.screening import Status
 from satmotor_ros.model.results import OperatingPoints
 
@@ -126,9 +126,13 @@ class CalibratedModel:
         Returns
         -------
         list of dict
-            ``{'effect': id, 'regressor': ..., 'coefficient': ...}`` per effect, in
-            the file's order; empty without one.
+            ``{'effect': id, 'name': ..., 'direction': ..., 'regressor': ...,
+            'coefficient': ...}`` per effect (a valve's ``threshold`` and ``exponent`` too),
+            in the file's order; empty without one.
 
         """
-        return [{'effect': e.name, 'regressor': e.regressor, 'coefficient': e.coefficient}
+        return [{'effect': e.name, 'name': effect_name(e), 'direction': e.direction,
+                 'regressor': e.regressor, 'coefficient': e.coefficient,
+                 **({'threshold': {'regressor': 'dp', 'value': e.reference, 'unit': 'Pa'},
+                     'exponent': e.option('exponent', 1.0)} if kind_of(e).bypass else {})}
                 for e in self.model.effects]

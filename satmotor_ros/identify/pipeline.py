@@ -32,7 +32,8 @@ from satmotor_ros.identify.table import BenchTable
 from satmotor_ros.identify.transient import (averaged, averaged_sparse, dynamics_summary, Samples,
                                              transient_samples, TransientOptions)
 from satmotor_ros.model import load_motor, MotorModel, MotorSpec
-from satmotor_ros.model.effects import coefficients_without, Effect, kind_of, measured_range
+from satmotor_ros.model.effects import (coefficients_without, Effect, effect_name, kind_of,
+                                        measured_range)
 from satmotor_ros.model.revolutions import sampled_revolutions
 from satmotor_ros.model.units import LPM
 from satmotor_ros.model.viscosity import standard_law, ViscosityLaw
@@ -144,6 +145,7 @@ class Calibration:
             value, ci95 = _coefficient_interval(self.final, position, candidate)
             row: dict[str, Any] = {
                 'effect': effect.name if candidate.shape else candidate.effect,
+                'name': effect_name(effect),
                 'regressor': effect.regressor if candidate.shape else candidate.regressor,
                 'coefficient': written(value), 'ci95': [written(v) for v in ci95],
                 'unit': candidate.unit, 'p_value': float(f'{score.p_value:.3g}'),
@@ -239,8 +241,8 @@ class Calibration:
         Returns
         -------
         dict
-            liquid, n_points, effect, regressor, coefficient, ci95, unit,
-            error_before, error_after, effects, outliers, candidates,
+            liquid, n_points, effect, name, direction, regressor, coefficient, ci95,
+            unit, error_before, error_after, effects, outliers, candidates,
             family_comparison, the transient mode's fields, and ``warnings``
             when the data are implausible or a fitted value is on a bound. The
             top-level effect fields are those of the first effect; with no
@@ -254,7 +256,8 @@ class Calibration:
         return {
             'liquid': self.liquid, 'family': self.model.family.name,
             'n_points': len(self.parts),
-            'effect': first.get('effect', 'none'), 'regressor': first.get('regressor'),
+            'effect': first.get('effect', 'none'), 'name': first.get('name', 'none'),
+            'direction': first.get('direction'), 'regressor': first.get('regressor'),
             'coefficient': first.get('coefficient'), 'ci95': first.get('ci95'),
             'unit': first.get('unit'),
             'error_before': self.error_before.as_dict(),
@@ -394,6 +397,11 @@ def _coefficient_interval(report: FitReport, position: int,
         step[j] = h
         grad[j] = (coefficient(values + step) - coefficient(values - step)) / (2 * h)
     value = coefficient(values)
+    if candidate.bounds[0] >= 0.0 and value > 0.0:
+        # k >= 0 and, for a fitted form, k = size / x^e: on the log scale the exponent enters
+        # linearly, and the interval stays within the bound (a linear one spanned 0)
+        spread = min(float(t * np.sqrt(max(float(grad @ cov @ grad), 0.0))) / value, 700.0)
+        return value, (value * float(np.exp(-spread)), value * float(np.exp(spread)))
     half = float(t * np.sqrt(max(float(grad @ cov @ grad), 0.0)))
     return value, (value - half, value + half)
 

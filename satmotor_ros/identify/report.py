@@ -25,7 +25,7 @@ from satmotor_ros.interface import SPEED_SETPOINT
 from satmotor_ros.limits import PLOT_MAX_PANELS
 from satmotor_ros.model import MotorModel
 from satmotor_ros.model._typing import FloatArray
-from satmotor_ros.model.effects import coefficients_without
+from satmotor_ros.model.effects import coefficients_without, effect_name
 from satmotor_ros.model.units import LPM, MPA, RPM
 
 UNSEPARABLE = 0.95
@@ -346,18 +346,60 @@ def _errors_row(name: str, e: Errors) -> list[str]:
     return [name, f'{e.rmse_lpm:.4g}', f'{e.mean_abs_pct:.3g}', f'{e.max_abs_lpm:.4g}']
 
 
+SAME_FIGURE = 0.005
+"""Relative difference below which a step's plain figure is the table's, [-]."""
+
+
+def _refitted(cal: Calibration, step: int) -> str:
+    """
+    Flag a step whose plain figures are not the table's for the same effects.
+
+    A step after the first refits the effects found so far under its own noise weights and
+    judges its candidates against that refit over its own rows: its plain RMSE is then another
+    figure than the table's (that of the effects' own step, over the final model's rows).
+
+    Parameters
+    ----------
+    cal : Calibration
+        The result, [-]
+    step : int
+        The step, from 1, [-]
+
+    Returns
+    -------
+    str
+        '' when the figures agree (or for the first step); else a sentence that gives both.
+
+    """
+    if step < 2:
+        return ''
+    baseline, found = cal.forward.steps[step - 1].baseline, cal.found[:step - 1]
+    table = cal.errors(found[-1]).rmse_lpm
+    if abs(baseline.rmse / LPM - table) <= SAME_FIGURE * table:
+        return ''
+    left_out = cal.forward.steps[step - 1].left_out
+    rows = int(np.count_nonzero(~left_out))
+    same_rows = float(np.sqrt(np.mean(baseline.cv_error[cal.inliers] ** 2))) / LPM
+    effects = ' + '.join(f'`{effect_name(e)}`' for e in cal.effects()[:step - 1])
+    return (f" **Not the table's figures:** this step refits {effects} under its own noise "
+            f'weights and judges against that refit over its {rows} rows, plain RMSE '
+            f"{baseline.rmse / LPM:.4g} l/min ({same_rows:.4g} over the table's rows), where "
+            f'the table gives {table:.4g} l/min for the same effects as fitted at step '
+            f'{step - 1} (the model written)')
+
+
 def _steps(cal: Calibration) -> list[str]:
     """List the forward selection's steps: the verdicts and the error after each effect."""
     lines = []
     for i, step in enumerate(cal.forward.steps, 1):
-        lines.append(f'{i}. {step.verdict}.')
+        lines.append(f'{i}. {step.verdict}.' + _refitted(cal, i))
     lines += [f'- {note}.' for note in (one_sided(score.added, effect) for score, effect in
                                         zip(cal.found, cal.effects())) if note]
     rows = [_errors_row('packaged model (in sample)', cal.error_packaged),
             _errors_row('fitted, no effect', cal.error_before)]
     names = []
-    for score in cal.found:
-        names.append(f'`{score.label}`')
+    for score, effect in zip(cal.found, cal.effects()):
+        names.append(f'`{effect_name(effect)}`')
         rows.append(_errors_row(f'+ {" + ".join(names)}', cal.errors(score)))
     header = ['model', 'RMSE [l/min]', 'mean abs [% of mean Q_vl]', 'max abs [l/min]']
     return lines + ['', _table(rows, header), '',
@@ -454,13 +496,15 @@ def _written_effects(summary: dict[str, Any]) -> list[str]:
                            for k, (lo, hi) in fitted.items()]
                           + ([f"threshold {e['threshold']['value']:.5g} "
                               f"{e['threshold']['unit']}"] if e.get('threshold') else []))
-        rows.append([f"`{e['effect']}`", f"{e['coefficient']:.5g} {e['unit']}",
+        rows.append([f"`{e['name']}`", f"{e['coefficient']:.5g} {e['unit']}",
                      f"[{e['ci95'][0]:.5g}, {e['ci95'][1]:.5g}]", shape or '-'])
     return ['The effects as `calibration.json` and `coefficients.yaml` write them, the '
             'coefficient k in SI. For a fitted form the fit estimates its size (the rows above: '
             'the extra loss at the largest regressor value) and k follows from the size and the '
             'exponents, so the interval of k also carries the uncertainty of the exponents and '
-            'can be much wider, even span 0, while the interval of the size does not.', '',
+            'can be much wider than that of the size; a k that cannot be negative (a valve, a '
+            'leak) has it on the log scale, where the exponents enter linearly and the '
+            'interval stays above 0.', '',
             _table(rows, ['effect', 'coefficient k', 'ci95', 'fitted shape']), '']
 
 
@@ -486,7 +530,7 @@ def write_report(cal: Calibration, out: Path, summary: dict[str, object]) -> Pat
     for name, plot in PLOTS.items():
         plot(cal, out / f'{name}.png')
     sel = cal.selection
-    found = ', '.join(f'`{s.label}`' for s in cal.found) or '`none`'
+    found = ', '.join(f'`{effect_name(e)}`' for e in cal.effects()) or '`none`'
     data = (f'{len(cal.parts)} rows of {cal.samples.n_samples} samples'
             if cal.samples is not None else f'{len(cal.parts)} steady operating points')
     lines = [f'# Calibration of {cal.spec.name} on {cal.liquid}', '',

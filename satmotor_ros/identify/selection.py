@@ -69,6 +69,7 @@ from satmotor_ros.identify.regional import (acting, local_gain, LocalGain, RECUR
 from satmotor_ros.identify.regions import clustered, regions, Space
 from satmotor_ros.identify.transient import variance_inflation
 from satmotor_ros.model._typing import FloatArray
+from satmotor_ros.model.effects import effect_name
 from satmotor_ros.model.units import LPM
 from scipy import special
 
@@ -130,8 +131,8 @@ class Score:
         """Return the effect as found (a fitted form by its expression), or ``'none'``."""
         if self.candidate is None:
             return 'none'
-        if self.candidate.shape:
-            return self.fit.found()[-1][1].key
+        if self.candidate.shape:  # the one name of every output (a valve's side and crack)
+            return effect_name(self.fit.found()[-1][1])
         return self.candidate.label
 
     @property
@@ -146,7 +147,7 @@ class Score:
         """Return the effect id as found, or ``'none'`` for the baseline."""
         if self.candidate is None:
             return 'none'
-        return self.label if self.candidate.shape else self.candidate.effect
+        return self.fit.found()[-1][1].key if self.candidate.shape else self.candidate.effect
 
 
 @dataclass(frozen=True)

@@ -66,7 +66,7 @@ class Validation:
 
     def describe_effects(self) -> str:
         """Return the effects' names, comma-separated, or ``'none'``."""
-        return ', '.join(e['effect'] for e in self.effects) or 'none'
+        return ', '.join(e['name'] for e in self.effects) or 'none'
 
     def summary(self) -> dict[str, Any]:
         """

@@ -151,6 +151,25 @@ def kind_of(effect: Effect) -> EffectKind:
     return kind
 
 
+def effect_name(effect: Effect) -> str:
+    """
+    Return the one name of an effect that every output gives (:meth:`EffectKind.named`).
+
+    Parameters
+    ----------
+    effect : Effect
+        The effect, [-]
+
+    Returns
+    -------
+    str
+        Its id with its direction, and what places it (a valve's crack pressure), e.g.
+        ``threshold:dp@negative cracking at 19.87 MPa`` or ``external_leakage``.
+
+    """
+    return kind_of(effect).named(effect)
+
+
 FITTED_RANGE = 'fitted_range'
 """The YAML key of an effect's fitted range: ``{quantity: [min, max]}``, SI (degC)."""
 
@@ -533,6 +552,7 @@ __all__ = ['Candidate', 'CandidateData', 'Conditions', 'DIRECTION', 'DIRECTIONS'
            'Modifier', 'PlantInjection', 'PlantParameter', 'Sampled', 'SENSOR_KINDS',
            'SensorError',
            'Shape', 'Synthetic', 'build_candidates', 'check_effects', 'effect_from_mapping',
-           'effect_to_mapping', 'FITTED_RANGE', 'flow_reading', 'kind_of', 'measured_range',
+           'effect_name', 'effect_to_mapping', 'FITTED_RANGE', 'flow_reading', 'kind_of',
+           'measured_range',
            'plant_injection', 'ranked', 'register', 'sensor_error', 'true_flow', 'true_speed',
            'unregister', 'check_coefficients', 'coefficients_without']

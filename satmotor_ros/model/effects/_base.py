@@ -398,6 +398,17 @@ class EffectKind:
             block[key] = value
         return block
 
+    def named(self, effect: Effect) -> str:
+        """
+        Return the effect's one name for people: its id with its direction (:attr:`Effect.key`).
+
+        Every output that names a calibrated or loaded effect (the command's summary line,
+        the reports, ``calibration.json``'s and ``validation.json``'s ``name``) takes it from
+        here, through :func:`satmotor_ros.model.effects.effect_name`; a kind whose law has a
+        place of its own (a valve's crack pressure) adds it.
+        """
+        return effect.key
+
     # -- the model -----------------------------------------------------------------------
 
     def coefficients(self, effect: Effect, coef: LossCoefficients) -> LossCoefficients:

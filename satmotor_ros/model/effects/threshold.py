@@ -21,7 +21,7 @@ from satmotor_ros.model.effects._base import (Candidate, CandidateData, DIRECTIO
                                               Synthetic, two_sided)
 from satmotor_ros.model.effects.term import MAX_EXPONENT
 from satmotor_ros.model.errors import ConfigError
-from satmotor_ros.model.units import LPM
+from satmotor_ros.model.units import LPM, MPA
 
 MIN_ABOVE = {'both': (0.15, 4), 'positive': (0.01, 8), 'negative': (0.01, 8)}
 """Least share of the points, and least number, above a fitted threshold, [-]: a one-sided
@@ -78,6 +78,10 @@ class Threshold(EffectKind):
             return super().plant_values(None)
         return {'valve_conductance': effect.coefficient, 'valve_crack': effect.reference,
                 'valve_direction': effect.direction}
+
+    def named(self, effect: Effect) -> str:
+        """Return ``threshold:dp@negative cracking at 19.87 MPa``: side and crack pressure."""
+        return f'{effect.key} cracking at {effect.reference / MPA:.4g} MPa'
 
     def regressor(self, suffix: str, value: Any, where: str) -> str:
         """Read the regressor of the id's suffix: ``dp``."""
