@@ -312,11 +312,11 @@ def fit_base(spec: MotorSpec, liquid: str, points: BenchTable,
     spans = low <= top_factor * EDGE and high >= top_factor * (1.0 - EDGE)
     at_top = best >= top_factor * (1.0 - EDGE)
     if gain <= limit or spans or at_top:
-        why = (f'the data do not pin it (profile: chi2 gain {gain:.3g} <= {limit:.3g}'
+        why = (f'the data do not pin it (profile: chi2 gain {gain:.3g} <= {limit:.3g}, '
                if gain <= limit else 'the 95 % profile interval spans the whole range ('
                if spans else 'the profile is least at the top of the range (')
         return _kept(result, names, model, kept_factor,
-                     f'{why}, factor range 0-{top_factor:.3g}); kept at {why_kept}')
+                     f'{why}factor range 0-{top_factor:.3g}); kept at {why_kept}')
     if best <= top_factor * EDGE:  # least at no drop: a bound, not an estimate
         return _kept(result, names, model, high,
                      f'the data refute the packaged drop (profile: chi2 gain {gain:.3g} > '
