@@ -17,6 +17,7 @@ from satmotor_ros.cli import main
 from satmotor_ros.identify.candidates import build_library
 from satmotor_ros.identify.parts import loss_parts
 from satmotor_ros.identify.pipeline import _coefficient_interval
+from satmotor_ros.identify.valve_reach import says
 from satmotor_ros.model import MotorModel
 from satmotor_ros.model.effects import Effect, effect_name
 from satmotor_ros.model.units import MPA
@@ -67,6 +68,9 @@ def test_every_output_of_calibrate_and_validate_gives_the_same_name(valve_output
     assert f'| + `{name}` |' in report  # the table of the errors after each effect
     assert re.search(rf'^\| `{re.escape(name)}` \| {summary["coefficient"]:.5g} ', report, re.M)
     assert not re.search(r'`threshold:dp`', report)  # never without its side
+    reach = summary['effects'][0]['full_drop']  # the law at the top of its side's drop
+    assert reach['fitted_dp_mpa'] <= reach['data_dp_mpa'] <= 28.0
+    assert f'{says(summary["effects"][0])}.' in report
     doc = yaml.safe_load((work / 'cal' / 'coefficients.yaml').read_text(encoding='utf-8'))
     (key,) = doc['coefficient_sets']['oil']['effects']
     assert name.startswith(key + ' ') and key == 'threshold:dp@negative'

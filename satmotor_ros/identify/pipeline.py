@@ -31,6 +31,7 @@ from satmotor_ros.identify.steady import (extract_steady, looks_like_series, ste
 from satmotor_ros.identify.table import BenchTable
 from satmotor_ros.identify.transient import (averaged, averaged_sparse, dynamics_summary, Samples,
                                              transient_samples, TransientOptions)
+from satmotor_ros.identify.valve_reach import valve_reach
 from satmotor_ros.model import load_motor, MotorModel, MotorSpec
 from satmotor_ros.model.effects import (coefficients_without, Effect, effect_name, kind_of,
                                         measured_range)
@@ -167,6 +168,7 @@ class Calibration:
                                     'unit': 'Pa',
                                     'ci95': [written(v) for v in self.final.ci95[position + 1]]}
                 row['exponent'] = written(effect.option('exponent'))
+            row.update(valve_reach(self, effect))  # a valve's law at the top of the drop
             rows.append(row)
             position += 1 + len(candidate.shape)
         return rows

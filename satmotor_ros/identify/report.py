@@ -21,6 +21,7 @@ from satmotor_ros.identify.residual_map import coverage_section, plot_residual_m
 from satmotor_ros.identify.selection import at_bound, Errors
 from satmotor_ros.identify.table import BenchTable
 from satmotor_ros.identify.transient import transient_section
+from satmotor_ros.identify.valve_reach import says
 from satmotor_ros.interface import SPEED_SETPOINT
 from satmotor_ros.limits import PLOT_MAX_PANELS
 from satmotor_ros.model import MotorModel
@@ -542,6 +543,8 @@ def write_report(cal: Calibration, out: Path, summary: dict[str, object]) -> Pat
     lines += [''] + _families(cal)
     lines += ['## Result', '', f'**Effects: {found}**, found one after the other:', '']
     lines += _steps(cal) + ['']
+    reach = [says(e) for e in summary.get('effects') or []]  # type: ignore[attr-defined]
+    lines += [f'{text}.' for text in reach if text] + ([''] if any(reach) else [])
     lines += coverage_section(cal, summary)
     for step in cal.forward.steps:
         if step.runner_up is not None and step.chosen is not None:
