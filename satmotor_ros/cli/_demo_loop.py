@@ -105,7 +105,8 @@ def verdict(injected: dict[str, float], summary: dict[str, Any], cal: Calibratio
 
     """
     found = {e['effect']: e for e in summary['effects']}
-    labels = {s.effect: s.label for s in cal.found}
+    # the effect's parameter in the final fit: a fitted form's by its id and side
+    labels = {s.effect: s.effect if s.added.shape else s.label for s in cal.found}
     out = []
     for name, value in injected.items():
         e = found.get(name)
