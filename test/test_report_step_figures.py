@@ -19,7 +19,7 @@ VALVE = Effect('threshold:dp', 2e-10, 'dp', 19.868e6, direction='negative',
 
 
 def _calibration(step_rmse, table_rmse, rows=10):
-    """A calibration of one effect and two steps: the second's baseline at `step_rmse`."""
+    """Return a calibration of one effect and two steps, the second's baseline at `step_rmse`."""
     error = np.full(rows, step_rmse * LPM)
     left_out = np.zeros(rows, dtype=bool)
     left_out[0] = True
