@@ -3,11 +3,11 @@
 The health monitor: samples in, the leakage factor, its trend, change and limit alarms out.
 
 Samples are evaluated a block at a time (vectorised, :meth:`Baseline.losses`) and pooled
-into bins of ``bin_s``: the bin's weighted least-squares leakage factor k_b = sum w Lb Lm /
-sum w Lb^2 and its information I_b = sum w Lb^2, with w the inverse of each sample's noise
-variance (:mod:`.noise`). The bins then drive, at constant cost and memory, the windowed
-factor (the pooled factor over ``window_s``), the trend (:mod:`.trend`) and the change
-detector (:mod:`.detector`).
+into bins of ``bin_s`` (longer on a log slower than 1 Hz: :mod:`.timing`): the bin's
+weighted least-squares leakage factor k_b = sum w Lb Lm / sum w Lb^2 and its information
+I_b = sum w Lb^2, with w the inverse of each sample's noise variance (:mod:`.noise`). The
+bins then drive, at constant cost and memory, the windowed factor (the pooled factor over
+``window_s``), the trend (:mod:`.trend`) and the change detector (:mod:`.detector`).
 
 The first ``learn_hours`` of operation teach the monitor the data: first (a third of it)
 the sample noise model; then the level k_ref, the
@@ -44,6 +44,7 @@ from satmotor_ros.identify.health.detector import Cusum, DELTA_MAX, threshold_fo
 from satmotor_ros.identify.health.noise import fit_variance
 from satmotor_ros.identify.health.records import (Alarm, Estimate, HealthPoint, HealthSamples,
                                                   HealthSettings, HealthSnapshot, SKIP_REASONS)
+from satmotor_ros.identify.health.timing import median_step, Timing
 from satmotor_ros.identify.health.trend import Trend
 from satmotor_ros.model._typing import FloatArray
 
@@ -151,8 +152,10 @@ class HealthMonitor:
         self.reference_dp = math.nan
         self.reference_loss = math.nan  # baseline Q_vl at the reference [m^3/s]
         self.limit_k = s.limit_leakage_factor
-        self.window: deque[tuple[float, float, float]] = deque(
-            maxlen=max(1, int(round(s.window_s / s.bin_s))))
+        self.step_s = math.nan  # the sample step the bins follow, once known [s]
+        self.timing = Timing.for_step(s, 0.0)
+        self.held: list[HealthSamples] = []  # the first samples, until the step is known
+        self.window: deque[tuple[float, float, float]] = deque(maxlen=self.timing.window_bins)
         self.trend = Trend(s.trend_hours)
         self.trend_point = np.zeros(4)  # sbm, sbb, op_s, start time
         self.trend_point[3] = math.nan
@@ -184,6 +187,43 @@ class HealthMonitor:
         """
         if len(block) == 0:
             return []
+        if math.isnan(self.step_s):  # the bins follow the step of the first samples
+            self.held.append(block)
+            if not self._fix_step(final=False):
+                return []
+            block = _concat(self.held)
+            self.held = []
+        return self._update(block)
+
+    def flush(self) -> list[Alarm]:
+        """
+        Take the samples held while too few came to know their step (the end of the data).
+
+        Returns
+        -------
+        list of Alarm
+            The alarms they raise (:meth:`update`'s).
+
+        """
+        if not self.held:
+            return []
+        self._fix_step(final=True)
+        block, self.held = _concat(self.held), []
+        return self._update(block)
+
+    def _fix_step(self, final: bool) -> bool:
+        """Fix the bins and the gap from the held samples' step; False if too few yet."""
+        times = np.concatenate([np.asarray(b.time, dtype=float) for b in self.held])
+        step = median_step(times, final)
+        if step is None:
+            return False
+        self.step_s = step
+        self.timing = Timing.for_step(self.settings, step)
+        self.window = deque(self.window, maxlen=self.timing.window_bins)
+        return True
+
+    def _update(self, block: HealthSamples) -> list[Alarm]:
+        """Take a block, the timing known."""
         s = self.settings
         time = np.asarray(block.time, dtype=float)
         if math.isnan(self.t0) and np.isfinite(time).any():
@@ -200,7 +240,7 @@ class HealthMonitor:
         self.n_samples += len(block)
         used = reason == OK
         dt = np.diff(np.concatenate([[self.t_last], time]))
-        dt = np.where(np.isfinite(dt) & (dt > 0) & (dt <= s.max_gap_s), dt, 0.0)
+        dt = np.where(np.isfinite(dt) & (dt > 0) & (dt <= self.timing.gap_s), dt, 0.0)
         rate = self._rate(block, time)
         if np.isfinite(time).any():
             self.t_last = float(np.nanmax(np.concatenate([[self.t_last], time])))
@@ -228,7 +268,7 @@ class HealthMonitor:
                                    np.where(used, losses.displacement, 0.0), lb,
                                    np.where(used, losses.speed, 0.0),
                                    np.where(used, losses.dp, 0.0)])
-        index = np.floor((time - self.t0) / s.bin_s)
+        index = np.floor((time - self.t0) / self.timing.bin_s)
         index = np.where(used & np.isfinite(index), index, -1).astype(np.int64)
         if self.bin_index < 0:
             self.bin_index = int(index[used][0])
@@ -259,7 +299,7 @@ class HealthMonitor:
         dt = np.diff(np.concatenate([[t_prev], time]))
         with np.errstate(invalid='ignore', divide='ignore'):
             rate = np.abs(dx / dt)
-        rate = np.where(np.isfinite(rate) & (dt > 0) & (dt <= self.settings.max_gap_s), rate, 0.0)
+        rate = np.where(np.isfinite(rate) & (dt > 0) & (dt <= self.timing.gap_s), rate, 0.0)
         if len(time):
             self.last_flow_rate_x = (float(time[-1]), float(x[-1]))
         return rate
@@ -304,7 +344,7 @@ class HealthMonitor:
         """Take one finished bin: learning, or the detector, window, trend and limits."""
         s = self.settings
         n, sbb, sbm, op_s, disp, lb, speed, dp = (float(x) for x in sums)
-        end_s = self.t0 + (index + 1) * s.bin_s
+        end_s = self.t0 + (index + 1) * self.timing.bin_s
         self.op_s += op_s  # operation is counted bin by bin: the clock of the trend
         if n < MIN_BIN_SAMPLES or sbb <= 0.0:
             return []
@@ -319,7 +359,7 @@ class HealthMonitor:
                     and len(self.learn_bins) >= 10:
                 self._finish_learning()
         else:
-            alarms += self._detect(k_b, sbb, sbm, end_s - s.bin_s, end_s)
+            alarms += self._detect(k_b, sbb, sbm, end_s - self.timing.bin_s, end_s)
         self._add_to_trend(sbm, sbb, op_s, end_s)
         alarms += self._check_limit(end_s)
         window = self._window_factor()
@@ -509,13 +549,13 @@ class HealthMonitor:
 
     def _add_to_trend(self, sbm: float, sbb: float, op_s: float, end_s: float) -> None:
         """Pool the bin into the current trend point; close the point when long enough."""
-        s = self.settings
         point = self.trend_point
         if math.isnan(point[3]):
-            point[3] = end_s - s.bin_s
+            point[3] = end_s - self.timing.bin_s
         point[:3] += (sbm, sbb, op_s)
-        long_enough = end_s - point[3] >= s.trend_point_s * (1.0 - EPS)
-        if long_enough and point[2] >= 0.5 * s.trend_point_s and point[1] > 0:
+        point_s = self.timing.point_s
+        long_enough = end_s - point[3] >= point_s * (1.0 - EPS)
+        if long_enough and point[2] >= 0.5 * point_s and point[1] > 0:
             self.trend.add(self.op_s / 3600.0 - 0.5 * point[2] / 3600.0, point[0] / point[1])
             point[:] = [0.0, 0.0, 0.0, math.nan]
 
@@ -627,9 +667,12 @@ class HealthMonitor:
                    'bin_inflation': c2, 'bin_autocorrelation': phi,
                    'trend_autocorrelation': phi_t,
                    'reference_temperature': self.baseline.reference_temperature},
-            n_samples=self.n_samples, n_skipped=sum(self.skipped.values()),
+            n_samples=self.n_samples + sum(len(b) for b in self.held),
+            n_skipped=sum(self.skipped.values()),
             skipped=dict(self.skipped), alarms=tuple(self.alarms), change_s=self.change_s,
-            what_changed=self.what_changed, acknowledged=self.acknowledged)
+            what_changed=self.what_changed, acknowledged=self.acknowledged,
+            timing={'sample_step_s': self.step_s, 'bin_s': self.timing.bin_s,
+                    'max_gap_s': self.timing.gap_s, 'trend_point_s': self.timing.point_s})
 
     def pop_points(self) -> list[HealthPoint]:
         """
@@ -667,7 +710,8 @@ class HealthMonitor:
         return path
 
     def _state(self) -> dict[str, Any]:
-        skip = {'baseline', 'explainer', 'settings', 'recent', 'points', 'last_point'}
+        skip = {'baseline', 'explainer', 'settings', 'recent', 'points', 'last_point', 'timing',
+                'held'}
         state = {k: v for k, v in vars(self).items() if k not in skip}
         state['cusum'] = asdict(self.cusum)
         state['trend'] = self.trend.state()
@@ -675,6 +719,7 @@ class HealthMonitor:
         state['alarms'] = [asdict(a) for a in self.alarms]
         state['settings'] = asdict(self.settings)
         state['recent'] = [asdict(b) for b in self.recent]
+        state['held'] = [asdict(b) for b in self.held]
         state['version'] = STATE_VERSION
         state['baseline'] = self.baseline.fingerprint
         return state
@@ -725,9 +770,11 @@ class HealthMonitor:
         for key, value in state.pop('trend').items():
             setattr(trend, key, value)
         monitor.trend = trend
-        monitor.window.extend(tuple(w) for w in state.pop('window'))
+        window = [tuple(w) for w in state.pop('window')]
         monitor.alarms = [Alarm(**a) for a in state.pop('alarms')]
         monitor.recent.extend(_samples(b) for b in state.pop('recent'))
+        monitor.held = [_samples(b) for b in state.pop('held', [])]
+        state.setdefault('step_s', 0.0)  # a state saved before the bins followed the step
         for name in ('version', 'baseline'):
             state.pop(name)
         state['last_flow_rate_x'] = tuple(state['last_flow_rate_x'])
@@ -740,6 +787,9 @@ class HealthMonitor:
                 msg = f'{path}: {key}: not a field of the health state'
                 raise DataError(msg)
             setattr(monitor, key, value)
+        if not math.isnan(monitor.step_s):
+            monitor.timing = Timing.for_step(settings, monitor.step_s)
+        monitor.window = deque(window, maxlen=monitor.timing.window_bins)
         return monitor
 
 
@@ -783,8 +833,12 @@ def _concat(blocks: list[HealthSamples]) -> HealthSamples:
     def every(name: str) -> FloatArray:
         return np.concatenate([getattr(b, name) for b in blocks])
 
+    stale = None
+    if any(b.stale is not None for b in blocks):  # a node's blocks say which are stale
+        stale = np.concatenate([np.zeros(len(b), dtype=bool) if b.stale is None else b.stale
+                                for b in blocks])
     return HealthSamples(every('time'), every('speed'), every('flow'), every('p_in'),
-                         every('p_out'), join('p_case'), join('temperature'))
+                         every('p_out'), join('p_case'), join('temperature'), stale)
 
 
 def _samples(saved: dict[str, Any]) -> HealthSamples:

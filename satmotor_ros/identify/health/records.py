@@ -150,7 +150,7 @@ class HealthSettings:
     limit_volumetric_efficiency: float | None = None  # instead: eta_v at the reference [-]
     change_fraction: float = 0.2  # relative change of the losses the detector is tuned to [-]
     learn_hours: float = 0.25  # operation that teaches the noise model and the level [h]
-    bin_s: float = 10.0  # length of a bin, the detector's time step [s]
+    bin_s: float = 10.0  # shortest bin, the detector's time step (8 sample steps at least) [s]
     window_s: float = 300.0  # the window of the windowed leakage factor [s]
     trend_hours: float = 200.0  # forgetting time constant of the trend [h]
     trend_point_s: float = 600.0  # bins are pooled into trend points this long [s]
@@ -158,7 +158,7 @@ class HealthSettings:
     reference_speed: float | None = None  # [rad/s]; None: typical of the learning data
     reference_dp: float | None = None  # [Pa]; None: typical of the learning data
     min_speed: float = 0.5  # below it a sample is stalled [rad/s]
-    max_gap_s: float = 5.0  # a longer gap in time is no operation [s]
+    max_gap_s: float = 5.0  # a longer step is no operation (and than 3 sample steps) [s]
     explain: bool = True  # on a change, run the calibration's candidates (what changed)
     explain_s: float = 900.0  # raw samples kept for that before a change [s]
 
@@ -266,6 +266,7 @@ class HealthSnapshot:
     change_s: float = math.nan  # start of the last change [s]
     what_changed: str = ''  # its explanation ('' before any change)
     acknowledged: int = 0  # the first this many alarms are acknowledged [-]
+    timing: dict[str, float] = field(default_factory=dict)  # the sample step, bin, gap [s]
 
     @property
     def unacknowledged(self) -> tuple[Alarm, ...]:

@@ -64,6 +64,7 @@ def summary(run: MonitorRun) -> dict[str, Any]:
         'hours_to_limit_ci95': [hours_json(to_limit.low), hours_json(to_limit.high)],
         'hours_to_limit_note': hours_note(to_limit.value),
         'n_samples': snap.n_samples, 'n_skipped': snap.n_skipped, 'skipped': snap.skipped,
+        'timing': {k: _num(v) for k, v in snap.timing.items()},
         'limit_leakage_factor': _num(snap.limit_leakage_factor),
         'leakage_factor_now': snap.leakage_factor.as_dict(),
         'trend_now': snap.trend.as_dict(),
@@ -121,7 +122,7 @@ def _plot_leakage(run: MonitorRun, path: Path) -> None:
         low = np.array([p.leakage_factor.low for p in points])
         high = np.array([p.leakage_factor.high for p in points])
         ax.plot(hours, [p.bin_factor for p in points], '.', color='0.75', ms=2,
-                label=f'each {run.settings.bin_s:.0f} s bin')
+                label=f"each {run.snapshot.timing.get('bin_s', run.settings.bin_s):.0f} s bin")
         ax.fill_between(hours, low, high, color='C0', alpha=0.25, lw=0,
                         label='95 % interval')
         ax.plot(hours, value, color='C0', lw=1.2,

@@ -151,6 +151,8 @@ def monitor_recordings(tables: Sequence[BenchTable], baseline: Baseline,
         recordings.append(Recording(table.source, len(samples), float(finite[0] + shift - origin),
                                     float(finite[-1] + shift - origin), shift))
         last = float(finite[-1] + shift)
+    monitor.flush()  # fewer samples than tell their step: taken with the steps there are
+    points += monitor.pop_points()
     epoch = monitor.t0 if math.isfinite(monitor.t0) and monitor.t0 > EPOCH_S else None
     return MonitorRun(monitor.snapshot(), tuple(points), tuple(recordings), monitor.settings,
                       baseline.source, epoch, monitor.t0, tuple(notes))
