@@ -6,6 +6,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import numpy as np
+from scipy.signal import lfilter
 
 from satmotor_ros.identify.health import Baseline, HealthSamples
 from satmotor_ros.model.units import LPM, MPA
@@ -16,11 +17,14 @@ DISPLACEMENT = 2.0e-6
 
 def recording(hours: float, seed: int = 0, rate_hz: float = 5.0, noise_lpm: float = 0.05,
               scale: Callable[[np.ndarray], np.ndarray] | None = None,
-              baseline: Baseline | None = None, t0: float = 0.0) -> HealthSamples:
+              baseline: Baseline | None = None, t0: float = 0.0,
+              correlation_s: float | None = None) -> HealthSamples:
     """
     Return a motor cycling through speeds and loads, its losses times `scale(t)`.
 
-    The noise is white plus a slow correlated part (an AR(1) of 2 s), as a real flowmeter's.
+    The noise is white plus a slow correlated part (an AR(1) of 0.9 from one sample to the
+    next: 2 s at 5 Hz), as a real flowmeter's; with `correlation_s` the AR(1)'s correlation
+    time is that many seconds whatever the rate (a logger reading the same flowmeter slower).
     """
     baseline = baseline or Baseline.for_family('paszota', DISPLACEMENT)
     rng = np.random.default_rng(seed)
@@ -33,10 +37,10 @@ def recording(hours: float, seed: int = 0, rate_hz: float = 5.0, noise_lpm: floa
     if scale is not None:
         flow = flow + (scale(t) - 1.0) * loss
     if noise_lpm:
-        colored = np.zeros(t.size)
-        shocks = rng.normal(0.0, noise_lpm * np.sqrt(1 - 0.9 ** 2), t.size)
-        for i in range(1, t.size):
-            colored[i] = 0.9 * colored[i - 1] + shocks[i]
+        phi = 0.9 if correlation_s is None else float(np.exp(-1.0 / (rate_hz * correlation_s)))
+        shocks = rng.normal(0.0, noise_lpm * np.sqrt(1 - phi ** 2), t.size)
+        shocks[0] = 0.0
+        colored = lfilter([1.0], [1.0, -phi], shocks)
         flow = flow + (colored + rng.normal(0.0, 0.3 * noise_lpm, t.size)) * LPM
     p_out = np.full(t.size, 0.5 * MPA)
     return HealthSamples(t, speed, flow, p_out + dp, p_out)

@@ -63,7 +63,7 @@ def fit_variance(rate: FloatArray, residual: FloatArray) -> tuple[float, float]:
     """
     ok = np.isfinite(rate) & np.isfinite(residual)
     rate, residual = rate[ok], residual[ok]
-    if residual.size < 2 * GROUPS:
+    if residual.size < 2 * GROUPS or not np.any(rate > 0):  # no rate seen: the floor alone
         var = float(np.median(residual ** 2) / CHI2_MEDIAN) if residual.size else 1.0
         return max(var, RESOLUTION ** 2), 0.0
     groups = np.array_split(np.argsort(rate), GROUPS)
