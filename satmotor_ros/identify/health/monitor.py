@@ -137,6 +137,9 @@ class HealthMonitor:
         # bins
         self.bin_index = -1
         self.open_bin = np.zeros(len(FIELDS))
+        self.carry = np.zeros(len(FIELDS))  # a closed bin too thin for a factor, joining the next
+        self.n_noise = 0  # usable samples that taught the noise model (stage 1)
+        self.n_binned = 0  # usable samples in bins that gave a factor
         # stage 2: the level, c, phi, the reference point, h
         self.learn_bins: list[list[float]] = []  # k, I, op_s, speed, dp, sbm, sbb per bin
         self.learning = True
@@ -261,6 +264,7 @@ class HealthMonitor:
             early = np.cumsum(op) < need
             early[:int(np.argmin(early)) + 1] = True  # up to the sample that completes it
             teach = used & early
+            self.n_noise += int(teach.sum())
             self.op_s += float(op[teach].sum())
             self._gather_noise(rate[teach], residual[teach])
             used = used & ~early
@@ -351,11 +355,17 @@ class HealthMonitor:
     def _close_bin(self, sums: FloatArray, index: int) -> list[Alarm]:
         """Take one finished bin: learning, or the detector, window, trend and limits."""
         s = self.settings
-        n, sbb, sbm, op_s, disp, lb, speed, dp = (float(x) for x in sums)
         end_s = self.t0 + (index + 1) * self.timing.bin_s
-        self.op_s += op_s  # operation is counted bin by bin: the clock of the trend
+        self.op_s += float(sums[3])  # operation is counted bin by bin: the clock of the trend
+        # a bin too thin for a factor (the edge of a gap, a log dropping samples) joins the
+        # next one: every usable sample counts in a bin (it was dropped, unsaid)
+        sums = sums + self.carry
+        n, sbb, sbm, op_s, disp, lb, speed, dp = (float(x) for x in sums)
         if n < MIN_BIN_SAMPLES or sbb <= 0.0:
+            self.carry = np.asarray(sums, dtype=float).copy()
             return []
+        self.carry = np.zeros(len(FIELDS))
+        self.n_binned += int(round(n))
         k_b = sbm / sbb
         self.window.append((sbm, sbb, op_s))
         alarms: list[Alarm] = []
@@ -681,6 +691,9 @@ class HealthMonitor:
                    'reference_temperature': self.baseline.reference_temperature},
             n_samples=self.n_samples + sum(len(b) for b in self.held),
             n_skipped=sum(self.skipped.values()),
+            n_used={'noise_model': self.n_noise, 'bins': self.n_binned,
+                    'open': int(round(self.open_bin[0] + self.carry[0])),
+                    'held': sum(len(b) for b in self.held)},
             skipped=dict(self.skipped), alarms=tuple(self.alarms), change_s=self.change_s,
             what_changed=self.what_changed, acknowledged=self.acknowledged,
             timing={'sample_step_s': self.step_s, 'bin_s': self.timing.bin_s,
@@ -791,6 +804,8 @@ class HealthMonitor:
             state.pop(name)
         state['last_flow_rate_x'] = tuple(state['last_flow_rate_x'])
         state['open_bin'] = np.asarray(state['open_bin'], dtype=float)
+        if 'carry' in state:
+            state['carry'] = np.asarray(state['carry'], dtype=float)
         state['trend_point'] = np.asarray(state['trend_point'], dtype=float)
         state['noise_rate'] = [np.asarray(x, dtype=float) for x in state['noise_rate']]
         state['noise_residual'] = [np.asarray(x, dtype=float) for x in state['noise_residual']]

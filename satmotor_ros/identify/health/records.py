@@ -267,6 +267,9 @@ class HealthSnapshot:
     what_changed: str = ''  # its explanation ('' before any change)
     acknowledged: int = 0  # the first this many alarms are acknowledged [-]
     timing: dict[str, float] = field(default_factory=dict)  # the sample step, bin, gap [s]
+    n_used: dict[str, int] = field(default_factory=dict)  # where the samples not skipped went:
+    # noise_model (the first third of the learning), bins (with a factor), open (the bin not
+    # yet closed, with a thin one joining it), held (until the sample step is known) [-]
 
     @property
     def unacknowledged(self) -> tuple[Alarm, ...]:

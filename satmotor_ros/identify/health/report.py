@@ -64,6 +64,7 @@ def summary(run: MonitorRun) -> dict[str, Any]:
         'hours_to_limit_ci95': [hours_json(to_limit.low), hours_json(to_limit.high)],
         'hours_to_limit_note': hours_note(to_limit.value),
         'n_samples': snap.n_samples, 'n_skipped': snap.n_skipped, 'skipped': snap.skipped,
+        'n_used': snap.n_used,
         'timing': {k: _num(v) for k, v in snap.timing.items()},
         'limit_leakage_factor': _num(snap.limit_leakage_factor),
         'leakage_factor_now': snap.leakage_factor.as_dict(),
