@@ -29,11 +29,11 @@ os.environ.setdefault('OMP_NUM_THREADS', '1')
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 import numpy as np  # noqa: E402
-from scipy.signal import lfilter  # noqa: E402
 
 from satmotor_ros.identify.health import (Baseline, HealthMonitor, HealthSamples,  # noqa: E402
                                           HealthSettings)
 from satmotor_ros.model.units import LPM, MPA  # noqa: E402
+from scipy.signal import lfilter  # noqa: E402
 
 DISPLACEMENT = 2.0e-6
 NOISE_LPM = 0.05
@@ -96,7 +96,8 @@ def main() -> None:
             covered.append(float(np.mean((values[:, 1] <= 1.0) & (1.0 <= values[:, 2]))))
             print(f'  {rate:g} Hz clean seed {seed}: alarms '
                   f'{[round(a.time_s / 3600, 2) for a in snap.alarms]}, mean factor '
-                  f'{means[-1]:.4f}, interval holds 1 in {100 * covered[-1]:.1f} %, h {snap.threshold:.2f}, noise {snap.noise}', flush=True)
+                  f'{means[-1]:.4f}, interval holds 1 in {100 * covered[-1]:.1f} %, '
+                  f'h {snap.threshold:.2f}, noise {snap.noise}', flush=True)
         delays, missed = [], 0
         rng = np.random.default_rng(7)
         for k in range(args.steps):
@@ -111,7 +112,8 @@ def main() -> None:
                  f'{np.percentile(delays, 90):.2f} min' if delays else 'none found')
         print(f'{rate:g} Hz: {alarms} false change alarms in {op_h:.0f} h of operation '
               f'({args.seeds} x {args.hours:g} h); mean factor {np.nanmean(means):.4f} '
-              f'(runs {np.nanmin(means):.4f}-{np.nanmax(means):.4f}), its 95 % interval holds 1 in '
+              f'(runs {np.nanmin(means):.4f}-{np.nanmax(means):.4f}), its 95 % interval '
+              'holds 1 in '
               f'{100 * np.mean(covered):.1f} % of the bins; +20 % step: {delay}, '
               f'missed {missed} of {args.steps}', flush=True)
 

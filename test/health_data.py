@@ -6,10 +6,10 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import numpy as np
-from scipy.signal import lfilter
 
 from satmotor_ros.identify.health import Baseline, HealthSamples
 from satmotor_ros.model.units import LPM, MPA
+from scipy.signal import lfilter
 
 DISPLACEMENT = 2.0e-6
 """q_t/(2 pi) of the test motor, [m^3/rad]."""
