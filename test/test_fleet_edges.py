@@ -263,3 +263,31 @@ def test_the_doc_gives_the_monitors_validity_as_the_code_has_it():
     text = ' '.join(text.split())
     assert f'at {MONITOR_MIN_RATE:g} a second or faster' in text
     assert f'at least {MONITOR_MIN_SAMPLES} usable samples' in text
+
+
+def test_a_monitor_alarm_is_explained_like_the_ratios(tmp_path):
+    """Cold review F2 of issue 24: a change alarm of the monitor's had no 'what changed'."""
+    import json
+    from satmotor_ros.fleet.config import FleetConfig
+    from satmotor_ros.fleet.discover import discover
+    from satmotor_ros.fleet.explain import CHANGE, explain_alarms
+    from satmotor_ros.fleet.synthetic import LEAK_FACTOR, write_recording
+    from satmotor_ros.fleet.tasks import RunOptions
+    from satmotor_ros.model.io.config import default_config_path
+    for i, factor in enumerate((1.0, LEAK_FACTOR)):
+        write_recording(tmp_path / 'root' / 'm' / f'run_2026-03-0{1 + i}.csv', factor, 40 + i, 40)
+    (motor,) = discover(tmp_path / 'root', FleetConfig())
+    first, second = (r.relative for r in motor.recordings)
+    baseline = {'coefficients': str(default_config_path('sm075_25.yaml')), 'liquid': 'water',
+                'key': 'b'}
+    markers = {first: {'status': 'done', 'content': 'a'}, second: {'status': 'done',
+                                                                  'content': 'b'}}
+    alarm = {'kind': 'change', 'recording': second, 'source': 'monitor', 'date': 'd',
+             'what': f'unexplained (in {second})'}
+    view = {'leakage_factor': [{'recording': second}], 'alarms': [alarm]}  # the first: none
+    explain_alarms(view, motor, baseline, markers, RunOptions(str(tmp_path / 'out'),
+                                                              liquid='water'))
+    assert alarm['what'].startswith(f'unexplained (in {second}); what changed: ')
+    kept = json.loads((tmp_path / 'out' / 'm' / motor.recordings[1].name / CHANGE).read_text())
+    assert kept['before'] == first  # the recording before the alarm's, its point or not
+    assert alarm['what'].endswith(f"what changed: {kept['what']}")

@@ -2,7 +2,8 @@
 """
 What changed at a fleet's change alarm: the health monitor's explainer on the two recordings.
 
-A change alarm sits between two consecutive recordings of a motor. The calibration loop's
+A change alarm sits between two consecutive recordings of a motor (the health monitor's own,
+raised in a recording, between it and the point before it). The calibration loop's
 candidates run on the recording before it and on the one after, against the motor's
 baseline (:func:`~satmotor_ros.identify.health.explain.explain_change`, as ``satmotor
 monitor`` names a change), and the effect the second asks for and the first does not is
@@ -28,7 +29,7 @@ CHANGE = '.fleet-change.json'
 def explain_alarms(view: dict[str, Any], motor: Motor, baseline: dict[str, Any] | None,
                    markers: dict[str, dict[str, Any]], run: RunOptions) -> None:
     """
-    Add what changed to each change alarm of a motor's view (in place).
+    Add what changed to each change alarm of a motor's view, the monitor's too (in place).
 
     Parameters
     ----------
@@ -50,12 +51,11 @@ def explain_alarms(view: dict[str, Any], motor: Motor, baseline: dict[str, Any] 
     records = {r.relative: r for r in motor.recordings}
     for alarm in view['alarms']:
         after = alarm.get('recording')
-        if alarm['kind'] != 'change' or alarm.get('source') == 'monitor' \
-                or after not in series or series.index(after) == 0:
+        before = _before(after, series, motor, markers)
+        if alarm['kind'] != 'change' or after not in records or before is None:
             continue
-        before = series[series.index(after) - 1]
-        key = options_key({'before': markers[before].get('content'),
-                           'after': markers[after].get('content'),
+        key = options_key({'before': markers.get(before, {}).get('content'),
+                           'after': markers.get(after, {}).get('content'),
                            'baseline': baseline.get('key')})
         place = Path(run.out) / motor.motor / records[after].name / CHANGE
         found = _cached(place, key)
@@ -63,6 +63,24 @@ def explain_alarms(view: dict[str, Any], motor: Motor, baseline: dict[str, Any] 
             found = _explain(records[before], records[after], motor, baseline, run)
             _keep(place, {'key': key, 'what': found, 'before': before})
         alarm['what'] += f'; what changed: {found}'
+
+
+def _before(after: str | None, series: list[str], motor: Motor,
+            markers: dict[str, dict[str, Any]]) -> str | None:
+    """
+    Return the recording an alarm's is compared with: the point before it, else the done one.
+
+    A change alarm of the ratios is between two points; the monitor's is raised in its
+    recording, whose point may be the first (the recordings before it refused, or learned on).
+    """
+    if after in series and series.index(after) > 0:
+        return series[series.index(after) - 1]
+    names = [r.relative for r in motor.recordings]
+    if after not in names:
+        return None
+    done = [n for n in names[:names.index(after)]
+            if markers.get(n, {}).get('status') == 'done']
+    return done[-1] if done else None
 
 
 def _cached(place: Path, key: str) -> str | None:
@@ -74,6 +92,7 @@ def _cached(place: Path, key: str) -> str | None:
 
 
 def _keep(place: Path, content: dict[str, Any]) -> None:
+    place.parent.mkdir(parents=True, exist_ok=True)
     temporary = place.with_name(f'{place.name}.partial-{os.getpid()}')
     temporary.write_text(json.dumps(content) + '\n', encoding='utf-8')
     os.replace(temporary, place)
