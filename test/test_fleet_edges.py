@@ -57,7 +57,7 @@ def test_a_monitor_on_a_restarting_clock_is_trended_on_the_recordings_calendar_t
                       'result': {'leakage_factor': {'value': value, 'ci95': bounds},
                                  'trend_per_hour': 0.1 * 3600 / 610, 'hours_to_limit': 0.5,
                                  'span_s': [start, start + 600.0], 'alarms': [],
-                                 'n_samples': 3001, 'n_skipped': 0}})
+                                 'recording_samples': 3001, 'recording_skipped': 0}})
         markers.append({'status': 'done', 'recording': steps[-1]['recording'],
                         'date': f'2026-03-{3 + 2 * i:02d}T00:00:00+00:00',
                         'time': EPOCH + (2 + 2 * i) * DAY, 'time_source': PATH_DATE,
@@ -211,8 +211,9 @@ def _step(i, value, n, seconds, skipped=0, alarms=()):
     start = EPOCH + i * DAY
     return {'recording': f'r{i}.csv', 'status': 'done', 'result': {
         'leakage_factor': {'value': value, 'ci95': [value - 0.01, value + 0.01]},
-        'learning': False, 'trend_per_hour': 0.01, 'hours_to_limit': 48.0,
-        'span_s': [start, start + seconds], 'n_samples': n, 'n_skipped': skipped,
+        'learning': False, 'trend_per_hour': 0.05, 'trend_per_day': 0.24, 'hours_to_limit': 48.0,
+        'span_s': [start, start + seconds], 'recording_samples': n,
+        'n_samples': 10 ** 6, 'recording_skipped': skipped,
         'alarms': list(alarms)}}
 
 
@@ -280,8 +281,8 @@ def test_a_monitor_alarm_is_explained_like_the_ratios(tmp_path):
     first, second = (r.relative for r in motor.recordings)
     baseline = {'coefficients': str(default_config_path('sm075_25.yaml')), 'liquid': 'water',
                 'key': 'b'}
-    markers = {first: {'status': 'done', 'content': 'a'}, second: {'status': 'done',
-                                                                  'content': 'b'}}
+    markers = {first: {'status': 'done', 'content': 'a'},
+               second: {'status': 'done', 'content': 'b'}}
     alarm = {'kind': 'change', 'recording': second, 'source': 'monitor', 'date': 'd',
              'what': f'unexplained (in {second})'}
     view = {'leakage_factor': [{'recording': second}], 'alarms': [alarm]}  # the first: none

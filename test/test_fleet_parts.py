@@ -431,6 +431,8 @@ def test_one_monitor_runs_through_the_motors_recordings_in_time_order(tmp_path):
     steps.append(monitor_step(motor.recordings[1], rule, baseline, run, steps[0]))
     assert [s['status'] for s in steps] == ['done', 'done']
     assert [s['result']['learning'] for s in steps] == [True, False]  # the same monitor
+    assert [(s['result']['recording_samples'], s['result']['n_samples']) for s in steps] == \
+        [(3000, 3000), (3000, 6000)]  # its own samples, and the monitor's since its first
     assert steps[1]['prev'] == steps[0]['chain']
     for rec in motor.recordings:  # what `satmotor monitor` writes, per recording
         assert {p.name for p in (tmp_path / 'out' / 'm1' / rec.name / 'monitor').iterdir()} \
@@ -441,11 +443,49 @@ def test_one_monitor_runs_through_the_motors_recordings_in_time_order(tmp_path):
     assert valid_steps(motor, run, 'b') == []
 
 
+def test_the_monitors_trend_per_operating_hour_is_made_per_calendar_day(tmp_path):
+    """
+    Cold review F3 of issue 24: the trend per day was 24 x the trend per OPERATING hour.
+
+    Four 20-minute series at 1 Hz, 2 h apart (a healthy motor: a wear's steps between them,
+    against the detector's low noise, are changes that restart the trend): the monitor
+    operates 1.3 of the 6.3 h its clock spans; a calendar day holds 24 x that share of
+    operating hours.
+    """
+    from satmotor_ros.fleet.chain import monitor_step
+    from satmotor_ros.fleet.tasks import RunOptions
+    from satmotor_ros.identify.synthetic import generate_series, Injection, Plan, to_columns
+    from satmotor_ros.identify.table import write_csv
+    from satmotor_ros.model.io.config import default_config_path
+    for i in range(4):
+        table = generate_series(Plan(liquid='water', n_points=20, duration_s=1200.0),
+                                Injection(), 50 + i, samples=1200, rate=1.0)
+        columns = to_columns(table)
+        columns['time'] = ('s', columns['time'][1] + EPOCH + i * 7200.0)
+        (tmp_path / 'root' / 'm1').mkdir(parents=True, exist_ok=True)
+        write_csv(tmp_path / 'root' / 'm1' / f'r{i}.csv', columns)
+    motor = discover(tmp_path / 'root', FleetConfig())[0]
+    run = RunOptions(str(tmp_path / 'out'), liquid='water')
+    baseline = {'coefficients': str(default_config_path('sm075_25.yaml')), 'liquid': 'water',
+                'key': 'b'}
+    steps = []
+    for rec in motor.recordings:
+        steps.append(monitor_step(rec, motor.rule, baseline, run, steps[-1] if steps else None))
+    last = steps[-1]['result']
+    share = last['operating_hours'] / last['recording_hours']
+    assert last['trend_per_hour'] is not None and last['trend_per_hour'] != 0
+    assert 0.1 < share < 0.3  # 1.3 h of operation over 6.3 h
+    view = motor_view('m1', 'water', [], None, steps=steps)
+    assert view['trend_clock'] == MONITOR_EPOCH
+    assert view['trend_per_day'] == pytest.approx(24.0 * last['trend_per_hour'] * share)
+
+
 def test_a_monitored_motors_view_is_the_monitors_figures_and_named_alarms():
     """On an epoch clock (calendar time) the monitor's own trend is the motor's."""
     steps = [{'recording': f'r{i}.csv', 'status': 'done', 'result': {
         'leakage_factor': {'value': v, 'ci95': [v - 0.01, v + 0.01]}, 'learning': False,
-        'trend_per_hour': 0.01, 'hours_to_limit': 48.0, 'n_samples': 451, 'n_skipped': 0,
+        'trend_per_hour': 0.05, 'trend_per_day': 0.24, 'hours_to_limit': 48.0,
+        'recording_samples': 451, 'recording_skipped': 0,
         'span_s': [EPOCH + i * 100.0, EPOCH + i * 100.0 + 90],
         'alarms': [{'time_s': EPOCH + 150.0, 'kind': 'change', 'what': 'wear: leakage x1.3'}]
         if i else []}} for i, v in enumerate((1.0, 1.3))]

@@ -29,7 +29,7 @@ from satmotor_ros.fleet.tasks import (columns_of, input_of, load_screened, MONIT
                                       motor_options, no_baseline, Refused, rule_identity,
                                       RunOptions, STATE, STEP)
 
-CHAIN = 'monitor-chain-v1'
+CHAIN = 'monitor-chain-v2'
 """Names the chain in each step's key: a new one redoes every step."""
 
 STEADY = 'no time column: the health monitor has nothing to watch'
@@ -141,6 +141,7 @@ def _watch(table: Any, baseline: dict[str, Any], state: str, out: Path) -> dict[
         base = _baseline(baseline)
         monitor = (HealthMonitor.resume(state, base) if state
                    else HealthMonitor(base, HealthSettings()))
+        given, skipped = monitor.n_samples, sum(monitor.skipped.values())  # before this one
         run = monitor_recordings([table], base, monitor=monitor)
         out.mkdir(parents=True, exist_ok=True)
         with output_dir('--out', out / MONITOR_DIR, 'monitor') as tmp:
@@ -150,15 +151,47 @@ def _watch(table: Any, baseline: dict[str, Any], state: str, out: Path) -> dict[
         text = str(err).strip().splitlines()
         raise Refused('the health monitor: ' + (text[0] if text else type(err).__name__)) \
             from None
-    hours = content.get('hours_to_limit')  # NEVER_HOURS: not drifting
+    hours = content.get('hours_to_limit')  # NEVER_HOURS: not drifting; calendar hours
     snap = run.snapshot  # its alarms carry their final names (update()'s may be 'pending')
     span = run.recordings[0] if run.recordings else None
+    per_hour = content.get('trend_per_hour')  # per OPERATING hour
     return {'leakage_factor': snap.leakage_factor.as_dict(), 'learning': snap.learning,
-            'trend_per_hour': content.get('trend_per_hour'),
+            'trend_per_hour': per_hour,
+            'trend_per_day': calendar_trend_per_day(per_hour, snap.operating_hours,
+                                                    snap.recording_hours),
+            'operating_hours': snap.operating_hours, 'recording_hours': snap.recording_hours,
             'hours_to_limit': None if hours == NEVER_HOURS else hours,  # days_to_limit null
             'alarms': [a.as_dict() for a in snap.alarms],
             'span_s': [span.start_s + monitor.t0, span.end_s + monitor.t0] if span else None,
-            'n_samples': snap.n_samples, 'n_skipped': snap.n_skipped}
+            'n_samples': snap.n_samples, 'n_skipped': snap.n_skipped,  # since the first
+            'recording_samples': snap.n_samples - given,  # this recording's
+            'recording_skipped': snap.n_skipped - skipped}
+
+
+def calendar_trend_per_day(per_hour: float | None, operating_hours: float,
+                           recording_hours: float) -> float | None:
+    """
+    Return the monitor's trend per calendar day from its trend per operating hour.
+
+    A day of calendar time holds 24 operating_hours / recording_hours hours of operation
+    (the motor's share of time in operation since the monitor's first sample).
+
+    Parameters
+    ----------
+    per_hour : float or None
+        The trend per operating hour, [1/h]
+    operating_hours, recording_hours : float
+        Operation, and time since the first sample, [h]
+
+    Returns
+    -------
+    float or None
+        The trend per calendar day, [1/day]; None without a trend.
+
+    """
+    if per_hour is None or recording_hours <= 0.0:
+        return None
+    return 24.0 * per_hour * min(operating_hours / recording_hours, 1.0)
 
 
 def _baseline(baseline: dict[str, Any]) -> Any:
@@ -178,5 +211,5 @@ def _write(directory: Path, marker: dict[str, Any]) -> None:
     os.replace(temporary, directory / STEP)
 
 
-__all__ = ['CHAIN', 'STEADY', 'monitor_step', 'read_step',
+__all__ = ['CHAIN', 'STEADY', 'calendar_trend_per_day', 'monitor_step', 'read_step',
            'step_options', 'valid_steps']

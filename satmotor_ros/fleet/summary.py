@@ -139,7 +139,8 @@ def monitor_unfit(step: dict[str, Any]) -> str:
     result = step.get('result') or {}
     if step.get('status') != 'done' or not result:
         return f"the monitor's step is {step.get('status', 'missing')}"
-    n, skipped = int(result.get('n_samples') or 0), int(result.get('n_skipped') or 0)
+    n = int(result.get('recording_samples') or 0)  # this recording's, not the monitor's
+    skipped = int(result.get('recording_skipped') or 0)
     span = result.get('span_s') or [0.0, 0.0]
     seconds = float(span[1]) - float(span[0])
     rate = (n - 1) / seconds if seconds > 0 and n > 1 else 0.0
@@ -236,9 +237,8 @@ def _monitored(motor: str, liquid: str, markers: list[dict[str, Any]],
                        'what': f"{alarm.get('what', 'unexplained')} (in {recording})",
                        'recording': recording, 'source': 'monitor'})
     if _monitor_trend_holds(series, watched):
-        per_hour, hours = last.get('trend_per_hour'), last.get('hours_to_limit')
-        return _view(motor, liquid, markers, series,
-                     None if per_hour is None else 24.0 * per_hour,
+        hours = last.get('hours_to_limit')  # calendar hours; the trend per calendar day
+        return _view(motor, liquid, markers, series, last.get('trend_per_day'),
                      None if hours is None else hours / 24.0, alarms, baseline, limit,
                      BY_MONITOR, MONITOR_EPOCH)
     if len(fit) < len(series):  # the ratios' steps and limit, on the recordings they hold
