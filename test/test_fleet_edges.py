@@ -292,3 +292,62 @@ def test_a_monitor_alarm_is_explained_like_the_ratios(tmp_path):
     kept = json.loads((tmp_path / 'out' / 'm' / motor.recordings[1].name / CHANGE).read_text())
     assert kept['before'] == first  # the recording before the alarm's, its point or not
     assert alarm['what'].endswith(f"what changed: {kept['what']}")
+
+
+def _series(path, seed, start):
+    from satmotor_ros.identify.synthetic import generate_series, Injection, Plan, to_columns
+    from satmotor_ros.identify.table import write_csv
+    table = generate_series(Plan(liquid='water', n_points=20, duration_s=600.0), Injection(),
+                            seed, samples=3000, rate=5.0)
+    columns = to_columns(table)
+    columns['time'] = ('s', columns['time'][1] + start)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    write_csv(path, columns)
+
+
+def test_a_refused_monitor_step_is_reported_and_a_rerun_starts_no_cluster(tmp_path):
+    """
+    Cold review F4 of issue 24: monitor/ holding a user's file made the step a failed task.
+
+    It was in no report, and every rerun started a cluster to fail on it again. It is
+    refused in one line, reported, held by a rerun (nothing to do), and run again once the
+    user's directory is gone.
+    """
+    import json
+    from satmotor_ros.fleet import run_fleet
+    from satmotor_ros.fleet.chain import monitor_step
+    from satmotor_ros.fleet.config import load_fleet
+    from satmotor_ros.fleet.discover import discover
+    from satmotor_ros.fleet.engine import plan
+    from satmotor_ros.fleet.tasks import given_baseline, process_recording, RunOptions
+    from satmotor_ros.model.io.config import default_config_path
+    root, out = tmp_path / 'root', tmp_path / 'out'
+    for i in range(2):
+        _series(root / 'm' / f'r{i}.csv', 60 + i, EPOCH + i * DAY)
+    (root / 'fleet.yaml').write_text(
+        f"motors: [{{pattern: 'm/**', motor: m, liquid: water, "
+        f"motor_file: '{default_config_path('sm075_25.yaml')}'}}]\n")
+    (motor,) = discover(root, load_fleet(root / 'fleet.yaml'))
+    run = RunOptions(str(out))
+    baseline = given_baseline(motor, run)
+    users = out / 'm' / 'r1.csv' / 'monitor'
+    users.mkdir(parents=True)
+    (users / 'notes.txt').write_text('mine\n')
+    (out / '.satmotor-output.json').write_text('{"command": "fleet"}\n')
+    step = None
+    for rec in motor.recordings:  # what a first run's workers do
+        process_recording(rec, motor.rule, baseline, run)
+        step = monitor_step(rec, motor.rule, baseline, run, step)
+    assert step['status'] == 'refused' and '\n' not in step['reason']
+    assert 'is not an earlier output of satmotor monitor' in step['reason']
+    lines = []
+    again = run_fleet(str(root), str(out), show_progress=False, say=lines.append)
+    assert again.cluster == '' and 'no cluster started' in lines[0]
+    (view,) = json.loads((out / 'fleet.json').read_text())['motors']
+    assert [(r['path'], r['status']) for r in view['monitor_refused']] == \
+        [('m/r1.csv', 'refused')]
+    assert view['leakage_factor'][-1]['estimator'] == 'ratio'  # its point: its ratio
+    assert 'satmotor monitor' in (out / 'fleet.md').read_text()
+    assert (users / 'notes.txt').read_text() == 'mine\n'
+    (users / 'notes.txt').unlink()
+    assert plan([motor], run).chain_from == {'m': 1}  # the step can run now

@@ -65,6 +65,8 @@ def valid_steps(motor: Motor, run: RunOptions, baseline_key: str,
         state = marker.get('state', '')
         if state and not Path(state).is_file():
             break
+        if marker.get('conflict') and not _conflicts(Path(marker['conflict'])):
+            break  # the user's monitor/ went: the step can run now
         if marker.get('status') == 'done' and not (
                 Path(run.out) / motor.motor / rec.name / MONITOR_DIR / 'monitor.json').is_file():
             break
@@ -122,14 +124,29 @@ def monitor_step(rec: Recording, rule: MotorRule, baseline: dict[str, Any], run:
         else:
             result = _watch(table, baseline, state, out)
             marker.update(status='done', reason='', state=str(out / STATE), result=result)
+    except _Conflict as err:  # monitor/ holds what we did not write: kept, said, redone when
+        marker.update(status='refused', reason=str(err), state=state, result=None,  # it goes
+                      conflict=str(out / MONITOR_DIR))
     except Refused as err:
         marker.update(status='refused', reason=str(err), state=state, result=None)
     _write(out, marker)
     return marker
 
 
+class _Conflict(Refused):
+    """The step's output directory holds what the monitor did not write: the step refused."""
+
+
+def _conflicts(target: Path) -> bool:
+    """Whether `target` still holds what ``satmotor monitor`` did not write."""
+    from satmotor_ros.cli._output import written_by
+    return target.exists() and not written_by('monitor')(target) \
+        and not (target.is_dir() and not any(target.iterdir()))
+
+
 def _watch(table: Any, baseline: dict[str, Any], state: str, out: Path) -> dict[str, Any]:
     """Resume the monitor, run it over `table`, write its output and save its state."""
+    from satmotor_ros.cli._common import CliError
     from satmotor_ros.cli._output import output_dir
     from satmotor_ros.identify import IdentificationError
     from satmotor_ros.identify.health import HealthMonitor, HealthSettings
@@ -147,6 +164,8 @@ def _watch(table: Any, baseline: dict[str, Any], state: str, out: Path) -> dict[
         with output_dir('--out', out / MONITOR_DIR, 'monitor') as tmp:
             content = write_monitor(run, tmp)
         monitor.save(out / STATE)
+    except CliError as err:  # output_dir: monitor/ is not ours
+        raise _Conflict(f'the health monitor: {str(err).strip().splitlines()[0]}') from None
     except (IdentificationError, ModelError, OSError) as err:
         text = str(err).strip().splitlines()
         raise Refused('the health monitor: ' + (text[0] if text else type(err).__name__)) \

@@ -112,6 +112,11 @@ def markdown(motors: list[dict[str, Any]], header: dict[str, Any]) -> str:
         if m['refused']:
             lines += ['', 'Refused recordings (whole, not salvaged):']
             lines += [f"- `{r['path']}`: {r['reason']}" for r in m['refused']]
+        if m.get('monitor_refused'):
+            lines += ['', "Recordings the health monitor's step refused or failed on (its state "
+                      'passed on unchanged; their points are their ratios):']
+            lines += [f"- `{r['path']}` ({r['status']}): {r['reason']}"
+                      for r in m['monitor_refused']]
         if m['leakage_factor']:
             lines += ['', '| date | time from | recording | leakage factor | 95 % interval '
                       '| by |', '| --- | --- | --- | --- | --- | --- |']

@@ -99,11 +99,25 @@ def motor_view(motor: str, liquid: str, markers: list[dict[str, Any]],
         :data:`BY_RATIO` or :data:`MIXED`) and ``trend_clock`` (:data:`RECORDING_TIMES` or
         :data:`MONITOR_EPOCH`); each point of ``leakage_factor`` says its recording's
         ``time_source``, its ``estimator`` and, for a ratio where the monitor gave a figure
-        not taken, why (``monitor_unused``, :func:`monitor_unfit`).
+        not taken, why (``monitor_unused``, :func:`monitor_unfit`); ``monitor_refused``
+        lists the recordings (not refused whole) whose monitor step was refused or failed,
+        with the one-line reason.
 
     """
+    view = _motor_view(motor, liquid, markers, baseline, limit, steps or [])
+    refused = {r['path'] for r in view['refused']}  # a recording refused whole says it there
+    view['monitor_refused'] = [{'path': s['recording'], 'reason': s.get('reason', ''),
+                                'status': s.get('status')} for s in steps or ()
+                               if s.get('status') in ('refused', 'failed')
+                               and s['recording'] not in refused]
+    return view
+
+
+def _motor_view(motor: str, liquid: str, markers: list[dict[str, Any]],
+                baseline: dict[str, Any] | None, limit: float,
+                steps: list[dict[str, Any]]) -> dict[str, Any]:
     points = [m for m in markers if m.get('status') == 'done' and m.get('result')]
-    watched = [s for s in steps or () if s.get('status') == 'done' and s.get('result')]
+    watched = [s for s in steps if s.get('status') == 'done' and s.get('result')]
     if any(not monitor_unfit(s) for s in watched):
         return _monitored(motor, liquid, markers, watched, baseline, limit)
     unfit = {s['recording']: monitor_unfit(s) for s in watched}
