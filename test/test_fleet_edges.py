@@ -351,3 +351,36 @@ def test_a_refused_monitor_step_is_reported_and_a_rerun_starts_no_cluster(tmp_pa
     assert (users / 'notes.txt').read_text() == 'mine\n'
     (users / 'notes.txt').unlink()
     assert plan([motor], run).chain_from == {'m': 1}  # the step can run now
+
+
+def test_a_users_calibrate_dir_does_not_move_the_baseline(tmp_path):
+    """
+    Cold review F5 of issue 24: a user's file in calibrate/ moved the baseline on.
+
+    The first recording's calibrate/ holding a user's file made the next recording the
+    baseline (every figure then against another calibration). The motor gets no baseline, said in one line, a rerun holds that (nothing to do), and
+    once the user's directory is gone the first recording is calibrated.
+    """
+    from satmotor_ros.fleet.config import FleetConfig
+    from satmotor_ros.fleet.discover import discover
+    from satmotor_ros.fleet.engine import plan
+    from satmotor_ros.fleet.synthetic import write_recording
+    from satmotor_ros.fleet.tasks import calibrate_baseline, process_recording, RunOptions
+    for i in range(2):
+        write_recording(tmp_path / 'root' / 'm' / f'run_2026-03-0{1 + i}.csv', 1.0, 70 + i, 24)
+    (motor,) = discover(tmp_path / 'root', FleetConfig())
+    run = RunOptions(str(tmp_path / 'out'), liquid='water')
+    users = tmp_path / 'out' / 'm' / motor.recordings[0].name / 'calibrate'
+    users.mkdir(parents=True)
+    (users / 'notes.txt').write_text('mine\n')
+    baseline = calibrate_baseline(motor, run)
+    assert baseline['recording'] is None and motor.recordings[0].relative in baseline['reason']
+    assert 'satmotor calibrate did not write' in baseline['reason']
+    assert not (tmp_path / 'out' / 'm' / motor.recordings[1].name / 'calibrate').exists()
+    marker = process_recording(motor.recordings[1], motor.rule, baseline, run)
+    assert marker['status'] == 'refused' and marker['reason'] == baseline['reason']
+    held = plan([motor], run).baselines['m']  # held: a rerun does not calibrate again
+    assert held == baseline and held['conflict'] == str(users)
+    (users / 'notes.txt').unlink()
+    assert 'm' not in plan([motor], run).baselines  # gone: it is calibrated again
+    assert [f.name for f in users.iterdir()] == []

@@ -26,8 +26,8 @@ from satmotor_ros.fleet.discover import Motor, Recording
 from satmotor_ros.fleet.resume import (content_of, HashCache, options_key, read_marker,
                                        stat_of)
 from satmotor_ros.fleet.tasks import (columns_of, input_of, load_screened, MONITOR_DIR,
-                                      motor_options, no_baseline, Refused, rule_identity,
-                                      RunOptions, STATE, STEP)
+                                      motor_options, no_baseline, output_conflict, Refused,
+                                      rule_identity, RunOptions, STATE, STEP)
 
 CHAIN = 'monitor-chain-v2'
 """Names the chain in each step's key: a new one redoes every step."""
@@ -65,7 +65,7 @@ def valid_steps(motor: Motor, run: RunOptions, baseline_key: str,
         state = marker.get('state', '')
         if state and not Path(state).is_file():
             break
-        if marker.get('conflict') and not _conflicts(Path(marker['conflict'])):
+        if marker.get('conflict') and not output_conflict(Path(marker['conflict']), 'monitor'):
             break  # the user's monitor/ went: the step can run now
         if marker.get('status') == 'done' and not (
                 Path(run.out) / motor.motor / rec.name / MONITOR_DIR / 'monitor.json').is_file():
@@ -135,13 +135,6 @@ def monitor_step(rec: Recording, rule: MotorRule, baseline: dict[str, Any], run:
 
 class _Conflict(Refused):
     """The step's output directory holds what the monitor did not write: the step refused."""
-
-
-def _conflicts(target: Path) -> bool:
-    """Whether `target` still holds what ``satmotor monitor`` did not write."""
-    from satmotor_ros.cli._output import written_by
-    return target.exists() and not written_by('monitor')(target) \
-        and not (target.is_dir() and not any(target.iterdir()))
 
 
 def _watch(table: Any, baseline: dict[str, Any], state: str, out: Path) -> dict[str, Any]:

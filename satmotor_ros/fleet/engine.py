@@ -27,8 +27,8 @@ from satmotor_ros.fleet.discover import Motor, Recording
 from satmotor_ros.fleet.errors import FleetError
 from satmotor_ros.fleet.resume import HashCache, is_done, options_key, stat_of
 from satmotor_ros.fleet.tasks import (BASELINE, baseline_rule_key, calibrate_baseline,
-                                      given_baseline, process_recording, recording_options,
-                                      RunOptions)
+                                      given_baseline, output_conflict, process_recording,
+                                      recording_options, RunOptions)
 
 MEMORY_FRACTION = 0.8
 """Share of the machine's memory the local workers may hold together, [-]."""
@@ -127,11 +127,15 @@ def _valid_baseline(motor: Motor, run: RunOptions,
         return None
     if not isinstance(found, dict) or found.get('rule') != baseline_rule_key(motor.rule, run):
         return None
+    conflict = found.get('conflict')  # the baseline's calibrate/ held a user's files
+    if conflict and not output_conflict(Path(conflict), 'calibrate'):
+        return None  # they went: it can be calibrated now
     before = [entry.get('recording') for entry in found.get('refused_before', [])]
+    head = found.get('recording') or found.get('blocked')  # the baseline, or the one blocked
     calibrated = found.get('recording') is not None  # else every recording was refused
-    names = [rec.relative for rec in motor.recordings[:len(before) + calibrated]]
-    if names != [*before, found.get('recording')][:len(before) + calibrated] \
-            or not calibrated and len(motor.recordings) != len(before):
+    n = len(before) + (head is not None)
+    names = [rec.relative for rec in motor.recordings[:n]]
+    if names != [*before, head][:n] or head is None and len(motor.recordings) != len(before):
         return None  # an earlier recording appeared, or one went away
     contents = [e.get('content') for e in found['refused_before']] + [found.get('content')]
     stats = found.get('stats', {})

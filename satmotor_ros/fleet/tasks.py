@@ -225,6 +225,9 @@ def calibrate_baseline(motor: Motor, run: RunOptions) -> dict[str, Any]:
         fingerprint = input_of(rec)
         stats[rec.relative] = fingerprint['stat']
         target = Path(run.out) / motor.motor / rec.name / CALIBRATE_DIR
+        if output_conflict(target, 'calibrate'):  # the user's: the baseline is not moved on
+            return _conflict_baseline(motor, run, rec, fingerprint['content'], target, refused,
+                                      stats)
         try:
             table, settled = load_screened(rec, motor_options(motor.rule, run), columns)
             calibrate_into(rec.path, str(target), 'auto', run.alpha, run.folds, settled,
@@ -252,6 +255,53 @@ def calibrate_baseline(motor: Motor, run: RunOptions) -> dict[str, Any]:
                             'rule': baseline_rule_key(motor.rule, run)}
     none['key'] = options_key(none)
     none['stats'] = stats  # kept too: a rerun with the same recordings and options redoes none
+    _write_baseline(Path(run.out) / motor.motor, none)
+    return none
+
+
+def output_conflict(target: Path, command: str) -> bool:
+    """
+    Whether an output directory holds what `command` did not write (so it cannot be written).
+
+    Parameters
+    ----------
+    target : pathlib.Path
+        The directory, [-]
+    command : str
+        The satmotor command that writes it, [-]
+
+    Returns
+    -------
+    bool
+        True when it exists, is not empty and is not wholly an earlier output of `command`.
+
+    """
+    from satmotor_ros.cli._output import written_by
+    if not (target.exists() or target.is_symlink()):
+        return False
+    if target.is_dir() and not target.is_symlink() and not any(target.iterdir()):
+        return False
+    return not written_by(command)(target)
+
+
+def _conflict_baseline(motor: Motor, run: RunOptions, rec: Recording, content: str,
+                       target: Path, refused: list[dict[str, Any]],
+                       stats: dict[str, Any]) -> dict[str, Any]:
+    """
+    Return (and write) no baseline: the recording that would be it cannot be written.
+
+    Its ``calibrate/`` holds a user's files: the baseline does not move on to the next
+    recording (its health figures would be against another calibration); the motor waits,
+    said in one line, until that directory is emptied or removed (``conflict``; ``blocked``
+    and ``content`` name the recording).
+    """
+    reason = (f'no baseline: {rec.relative} would be it, but {target} holds files satmotor '
+              'calibrate did not write (kept; empty or remove it and run again)')
+    none: dict[str, Any] = {'recording': None, 'reason': reason, 'refused_before': refused,
+                            'rule': baseline_rule_key(motor.rule, run), 'conflict': str(target),
+                            'blocked': rec.relative, 'content': content}
+    none['key'] = options_key(none)
+    none['stats'] = stats
     _write_baseline(Path(run.out) / motor.motor, none)
     return none
 
@@ -426,4 +476,5 @@ __all__ = ['BASELINE', 'CALIBRATE_DIR', 'MONITOR_DIR', 'MotorRefused', 'NO_LIQUI
            'OUTPUTS', 'Refused', 'STATE', 'STEP', 'VALIDATE_DIR', 'ZERO_PRESSURE',
            'baseline_rule_key', 'drop_stale', 'file_digest',
            'calibrate_baseline', 'columns_of', 'given_baseline', 'input_of', 'load_screened',
-           'motor_options', 'no_baseline', 'process_recording', 'recording_options']
+           'motor_options', 'no_baseline', 'output_conflict', 'process_recording',
+           'recording_options']
