@@ -358,8 +358,9 @@ def test_a_users_calibrate_dir_does_not_move_the_baseline(tmp_path):
     Cold review F5 of issue 24: a user's file in calibrate/ moved the baseline on.
 
     The first recording's calibrate/ holding a user's file made the next recording the
-    baseline (every figure then against another calibration). The motor gets no baseline, said in one line, a rerun holds that (nothing to do), and
-    once the user's directory is gone the first recording is calibrated.
+    baseline (every figure then against another calibration). The motor gets no baseline,
+    said in one line, a rerun holds that, and once the user's directory is gone the first
+    recording is calibrated.
     """
     from satmotor_ros.fleet.config import FleetConfig
     from satmotor_ros.fleet.discover import discover
