@@ -84,6 +84,21 @@ def test_discovery_groups_by_first_level_and_orders_by_time_and_says_how(tmp_pat
         ('m2/bag1', 'bag', BAG_START)]
 
 
+def test_a_csv_time_in_ms_is_read_in_its_unit(tmp_path):
+    """Cold review F7 of issue 24: a ``time [ms]`` epoch was no epoch (1.77e12): dated by mtime."""
+    for name, unit, scale, day in (('a.csv', 'ms', 1e3, 2), ('b.csv', 'min', 1 / 60, 1)):
+        path = tmp_path / 'm' / name
+        path.parent.mkdir(parents=True, exist_ok=True)
+        first = (EPOCH + day * DAY) * scale
+        path.write_text(f'time [{unit}],speed [rpm],flow [l/min],p_in [MPa],p_out [MPa]\n'
+                        f'{first!r},1000,20,10,1\n{first + scale!r},1000,20,10,1\n')
+        os.utime(path, (EPOCH, EPOCH))
+    (motor,) = discover(tmp_path, FleetConfig())
+    assert [(r.relative, r.time_source) for r in motor.recordings] == [
+        ('m/b.csv', TIME_COLUMN), ('m/a.csv', TIME_COLUMN)]
+    assert [r.time for r in motor.recordings] == pytest.approx([EPOCH + DAY, EPOCH + 2 * DAY])
+
+
 def test_motor_ids_are_distinct_and_never_a_report_file(tmp_path):
     """Directories that make one safe id, or a report's name, stay apart (F7, F8)."""
     root = tmp_path / 'root'

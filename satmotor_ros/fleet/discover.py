@@ -319,7 +319,16 @@ def _bag_start(path: Path) -> float | None:
 
 
 def _time_column(path: Path) -> float | None:
-    """Return the first ``time`` value of a CSV when it is epoch seconds, else None."""
+    """
+    Return the first ``time`` value of a CSV in seconds when it is an epoch, else None.
+
+    The value is read in the column's unit and converted as the bench table reads it
+    (``time [ms]`` is milliseconds: 1.77e12 ms is 1.77e9 s).
+    """
+    from satmotor_ros.identify import DataError
+    from satmotor_ros.identify.table import column_to_si
+    from satmotor_ros.identify.textfile import split_unit
+    import numpy as np
     try:
         with path.open('rb') as file:
             head = file.read(_HEAD_BYTES).decode('utf-8', errors='replace')
@@ -328,13 +337,16 @@ def _time_column(path: Path) -> float | None:
     lines = [line for line in head.splitlines() if line.strip()]
     if len(lines) < 2:
         return None
-    names = [cell.split('[')[0].strip().lower() for cell in lines[0].split(',')]
+    header = [split_unit(cell.strip()) for cell in lines[0].split(',')]
+    names = [name.strip().lower() for name, _ in header]
     if 'time' not in names:
         return None
+    column = names.index('time')
     cells = lines[1].split(',')
     try:
-        value = float(cells[names.index('time')])
-    except (ValueError, IndexError):
+        value = float(column_to_si('time', header[column][1] or 's',  # none: s, as before
+                                   np.array([float(cells[column])]))[0])
+    except (ValueError, IndexError, DataError):
         return None
     return value if EPOCH_RANGE[0] <= value <= EPOCH_RANGE[1] else None
 
