@@ -395,6 +395,31 @@ def test_fleet_command_refuses_a_bad_fleet_yaml_and_an_out_it_did_not_write(tmp_
     assert 'not a directory' in capsys.readouterr().err
 
 
+def test_force_never_replaces_a_report_file_a_fleet_run_did_not_write(tmp_path, capsys):
+    """Cold review F9 of issue 24: --force replaced the user's own fleet.md."""
+    import json
+    from satmotor_ros.fleet.report import not_ours, write_report
+    _csv(tmp_path / 'root' / 'm1' / 'a.csv')
+    theirs = tmp_path / 'theirs'
+    theirs.mkdir()
+    (theirs / 'fleet.md').write_text('my notes\n')
+    assert main(['fleet', str(tmp_path / 'root'), '--out', str(theirs), '--force']) == 1
+    err = capsys.readouterr().err
+    assert err.count('\n') == 1 and 'fleet.md not written by satmotor fleet' in err
+    assert (theirs / 'fleet.md').read_text() == 'my notes\n'
+    ours = tmp_path / 'ours'  # what a run wrote is ours; an edit, or a user's plot, is not
+    ours.mkdir()
+    header = {'root': 'r', 'recordings': 0, 'refused': 0, 'ran': 0, 'reused': 0,
+              'written': 'now', 'estimator': 'e', 'limit': 2.0}
+    write_report(ours, [], header)
+    assert not_ours(ours, ['m1']) == []
+    (ours / 'plots' / 'm1.png').write_bytes(b'\x89PNG mine')
+    (ours / 'fleet.md').write_text('edited\n')
+    assert not_ours(ours, ['m1']) == ['fleet.md', 'plots/m1.png']
+    (ours / '.satmotor-output.json').write_text(json.dumps({'command': 'fleet'}))
+    assert not_ours(ours, []) == []  # a marker from before the digests: taken at its word
+
+
 @pytest.mark.slow
 def test_a_bag_recording_is_timed_by_its_start_and_watched_by_the_health_monitor(tmp_path):
     from satmotor_ros.fleet.synthetic import make_fleet

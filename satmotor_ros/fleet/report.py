@@ -23,6 +23,50 @@ def _replace(path: Path, text: str) -> None:
     os.replace(temporary, path)
 
 
+def _digest(text: bytes) -> str:
+    import hashlib
+    return hashlib.blake2b(text, digest_size=16).hexdigest()
+
+
+def not_ours(out: Path, motors: list[str]) -> list[str]:
+    """
+    Return the report files in `out` a fleet run did not write (never replaced, --force or not).
+
+    fleet.json and fleet.md are ours when their content is what the last report wrote (its
+    digest in DIR's marker; a marker from before the digests takes them at its word), a plot
+    when its PNG says ``satmotor fleet`` wrote it.
+
+    Parameters
+    ----------
+    out : pathlib.Path
+        DIR, [-]
+    motors : list of str
+        The motors whose plots this run draws, [-]
+
+    Returns
+    -------
+    list of str
+        Their paths relative to `out`; empty when every one may be replaced.
+
+    """
+    from satmotor_ros.cli._output import MARKER, png_by
+    from satmotor_ros.fleet.resume import read_marker
+    marker = read_marker(out / MARKER) or {}
+    written = marker.get('report') if marker.get('command') == 'fleet' else {}
+    found = []
+    for name in (REPORT_JSON, REPORT_MD):
+        path = out / name
+        if path.is_symlink() or path.exists() and (
+                not path.is_file() or written is not None
+                and (written or {}).get(name) != _digest(path.read_bytes())):
+            found.append(name)
+    for name in [*motors, FLEET_PLOT]:
+        path = out / PLOTS / f'{name}.png'
+        if (path.exists() or path.is_symlink()) and not png_by('fleet')(path):
+            found.append(f'{PLOTS}/{name}.png')
+    return found
+
+
 def write_report(out: Path, motors: list[dict[str, Any]], header: dict[str, Any]) -> None:
     """
     Write the fleet's report into `out`.
@@ -42,18 +86,24 @@ def write_report(out: Path, motors: list[dict[str, Any]], header: dict[str, Any]
     for motor in motors:
         plot_motor(out / PLOTS / f"{motor['motor']}.png", motor)
     plot_fleet(out / PLOTS / f'{FLEET_PLOT}.png', motors)
-    _replace(out / REPORT_JSON, json.dumps({**header, 'motors': motors}, indent=1) + '\n')
-    _replace(out / REPORT_MD, markdown(motors, header))
+    texts = {REPORT_JSON: json.dumps({**header, 'motors': motors}, indent=1) + '\n',
+             REPORT_MD: markdown(motors, header)}
+    for name, text in texts.items():
+        _replace(out / name, text)
+    from satmotor_ros.cli._output import MARKER  # the report's digests: what is ours
+    _replace(out / MARKER, json.dumps({'command': 'fleet', 'report': {
+        name: _digest(text.encode('utf-8')) for name, text in texts.items()}}) + '\n')
 
 
 def _drop_plots(out: Path, motors: set[str]) -> None:
     """Remove the plots the last report drew of motors this one has not (gone, renamed)."""
+    from satmotor_ros.cli._output import png_by
     from satmotor_ros.fleet.resume import read_marker
     earlier = (read_marker(out / REPORT_JSON) or {}).get('motors')
     for entry in earlier if isinstance(earlier, list) else ():
         name = entry.get('motor') if isinstance(entry, dict) else None
         if isinstance(name, str) and name not in motors and '/' not in name \
-                and name.lower() != FLEET_PLOT:
+                and name.lower() != FLEET_PLOT and png_by('fleet')(out / PLOTS / f'{name}.png'):
             (out / PLOTS / f'{name}.png').unlink(missing_ok=True)
 
 
@@ -271,4 +321,4 @@ def plot_fleet(path: Path, motors: list[dict[str, Any]]) -> None:
         plt.close(fig)
 
 
-__all__ = ['PLOTS', 'markdown', 'plot_fleet', 'plot_motor', 'write_report']
+__all__ = ['not_ours', 'PLOTS', 'markdown', 'plot_fleet', 'plot_motor', 'write_report']

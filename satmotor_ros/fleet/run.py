@@ -17,7 +17,7 @@ from satmotor_ros.fleet.engine import check_address, execute, plan
 from satmotor_ros.fleet.errors import FleetError
 from satmotor_ros.fleet.explain import explain_alarms
 from satmotor_ros.fleet.health import ESTIMATOR
-from satmotor_ros.fleet.report import write_report
+from satmotor_ros.fleet.report import not_ours, write_report
 from satmotor_ros.fleet.resume import read_marker
 from satmotor_ros.fleet.summary import iso_now, LIMIT, motor_view, rank
 from satmotor_ros.fleet.tasks import BASELINE, RunOptions
@@ -96,8 +96,13 @@ def run_fleet(root: str, out: str, fleet: str = '', workers: int = 0, scheduler:
     if not motors:
         raise FleetError(f'ROOT {root!r}: no recordings (rosbag2 directories, *.csv, or logs '
                          'of a motor with columns in fleet.yaml)')
+    theirs = not_ours(target, [m.motor for m in motors])
+    if theirs:  # --force or not: a file we did not write is never replaced
+        raise FleetError(f"--out {out!r}: {', '.join(theirs)} not written by satmotor fleet "
+                         '(never replaced, even with --force: move it away)')
     target.mkdir(parents=True, exist_ok=True)
-    (target / MARKER).write_text(json.dumps({'command': 'fleet'}) + '\n', encoding='utf-8')
+    if (read_marker(target / MARKER) or {}).get('command') != 'fleet':  # keep its digests
+        (target / MARKER).write_text(json.dumps({'command': 'fleet'}) + '\n', encoding='utf-8')
     options = RunOptions(str(target), calibrate, validate, liquid)
     work = plan(motors, options)
     markers = dict(work.done)
