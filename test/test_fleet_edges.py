@@ -340,9 +340,12 @@ def test_a_refused_monitor_step_is_reported_and_a_rerun_starts_no_cluster(tmp_pa
         step = monitor_step(rec, motor.rule, baseline, run, step)
     assert step['status'] == 'refused' and '\n' not in step['reason']
     assert 'is not an earlier output of satmotor monitor' in step['reason']
+    (out / 'm' / 'deleted.csv').mkdir()  # a recording deleted from ROOT since (F10)
+    (out / 'm' / 'deleted.csv' / '.fleet-done.json').write_text('{}')
     lines = []
     again = run_fleet(str(root), str(out), show_progress=False, say=lines.append)
     assert again.cluster == '' and 'no cluster started' in lines[0]
+    assert 'm/deleted.csv' in lines[1] and not (out / 'm' / 'deleted.csv').exists()
     (view,) = json.loads((out / 'fleet.json').read_text())['motors']
     assert [(r['path'], r['status']) for r in view['monitor_refused']] == \
         [('m/r1.csv', 'refused')]
@@ -385,3 +388,33 @@ def test_a_users_calibrate_dir_does_not_move_the_baseline(tmp_path):
     (users / 'notes.txt').unlink()
     assert 'm' not in plan([motor], run).baselines  # gone: it is calibrated again
     assert [f.name for f in users.iterdir()] == []
+
+
+def test_the_outputs_of_a_deleted_recording_or_motor_go_where_wholly_ours(tmp_path):
+    """Cold review F10 of issue 24: a deleted recording's outputs lingered in DIR."""
+    from satmotor_ros.cli._output import write_marker
+    from satmotor_ros.fleet.config import FleetConfig, RESERVED
+    from satmotor_ros.fleet.discover import discover
+    from satmotor_ros.fleet.prune import prune
+    _csv(tmp_path / 'root' / 'm' / 'kept.csv')
+    out = tmp_path / 'out'
+
+    def made(path, extra=None):
+        path.mkdir(parents=True)
+        (path / '.fleet-done.json').write_text('{}')
+        (path / '.fleet-monitor.json').write_text('{}')
+        (path / 'health').mkdir()
+        (path / 'health' / 'health.json').write_text('{}')
+        write_marker(path / 'health', 'fleet-health')  # lists health.json as its own
+        if extra:
+            (path / extra).write_text('mine\n')
+    made(out / 'm' / 'kept.csv')
+    made(out / 'm' / 'gone.csv')
+    made(out / 'm' / 'noted.csv', extra='notes.txt')
+    made(out / 'old' / 'r.csv')
+    (out / 'old' / 'baseline.json').write_text('{}')
+    (out / 'plots').mkdir()
+    removed = prune(out, discover(tmp_path / 'root', FleetConfig()), RESERVED)
+    assert sorted(removed) == ['m/gone.csv', 'old', 'old/r.csv']
+    assert sorted(p.name for p in (out / 'm').iterdir()) == ['kept.csv', 'noted.csv']
+    assert (out / 'plots').is_dir() and not (out / 'old').exists()

@@ -11,12 +11,13 @@ import time
 from typing import Any
 
 from satmotor_ros.cli._output import check_target, MARKER, written_by
-from satmotor_ros.fleet.config import FLEET_FILE, FleetConfig, load_fleet
+from satmotor_ros.fleet.config import FLEET_FILE, FleetConfig, load_fleet, RESERVED
 from satmotor_ros.fleet.discover import discover
 from satmotor_ros.fleet.engine import check_address, execute, plan
 from satmotor_ros.fleet.errors import FleetError
 from satmotor_ros.fleet.explain import explain_alarms
 from satmotor_ros.fleet.health import ESTIMATOR
+from satmotor_ros.fleet.prune import prune
 from satmotor_ros.fleet.report import not_ours, write_report
 from satmotor_ros.fleet.resume import read_marker
 from satmotor_ros.fleet.summary import iso_now, LIMIT, motor_view, rank
@@ -114,6 +115,11 @@ def run_fleet(root: str, out: str, fleet: str = '', workers: int = 0, scheduler:
     else:
         say(f'fleet: all {len(markers)} recordings already done for these inputs and options; '
             'no cluster started')
+    gone = prune(target, motors, RESERVED)  # recordings and motors no longer under ROOT
+    if gone:
+        more = ' ...' if len(gone) > 5 else ''
+        say(f'fleet: removed the outputs of {len(gone)} recording(s) or motor(s) no longer '
+            f"under ROOT: {', '.join(gone[:5])}{more}")
     views = []
     for motor in motors:
         baseline = work.baselines.get(motor.motor) or _read_baseline(target / motor.motor)

@@ -1,0 +1,82 @@
+# SPDX-License-Identifier: Apache-2.0
+"""
+Remove what a fleet run wrote for recordings that are no longer under ROOT.
+
+A recording deleted (or moved, renamed) leaves ``DIR/<motor>/<recording>/`` behind; a motor
+gone, ``DIR/<motor>/``. They are removed only when everything in them is the fleet's own:
+its markers and state files, and output directories their own marker says the tool wrote
+whole (:func:`~satmotor_ros.cli._output.written_by`). A file a user put there keeps it.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+import shutil
+
+from satmotor_ros.fleet.discover import Motor
+
+OWN_FILES = ('.fleet-done.json', '.fleet-monitor.json', '.monitor-state.json',
+             '.fleet-change.json')
+"""The files a fleet run writes in a recording's directory."""
+
+MOTOR_FILES = ('baseline.json', 'columns.yaml')
+"""The files a fleet run writes in a motor's directory."""
+
+
+def prune(out: Path, motors: list[Motor], report: tuple[str, ...]) -> list[str]:
+    """
+    Remove the directories of recordings and motors that are gone, where wholly ours.
+
+    Parameters
+    ----------
+    out : pathlib.Path
+        DIR, [-]
+    motors : list of Motor
+        The fleet as discovered now, [-]
+    report : tuple of str
+        The names of the report's own entries in DIR (fleet.json, plots...), never touched, [-]
+
+    Returns
+    -------
+    list of str
+        What was removed, relative to DIR.
+
+    """
+    current = {m.motor: {r.name for r in m.recordings} for m in motors}
+    removed = []
+    for motor in sorted(p for p in out.iterdir() if p.is_dir() and not p.is_symlink()):
+        if motor.name in report or motor.name.startswith('.'):
+            continue
+        names = current.get(motor.name, set())
+        for recording in sorted(p for p in motor.iterdir() if p.is_dir()
+                                and not p.is_symlink() and p.name not in names):
+            if _ours(recording):
+                shutil.rmtree(recording)
+                removed.append(f'{motor.name}/{recording.name}')
+        if motor.name not in current and all(
+                p.is_file() and p.name in MOTOR_FILES for p in motor.iterdir()):
+            shutil.rmtree(motor)
+            removed.append(motor.name)
+    return removed
+
+
+def _ours(directory: Path) -> bool:
+    """Whether a recording's directory holds only what a fleet run writes (and a marker)."""
+    from satmotor_ros.cli._output import written_by
+    from satmotor_ros.fleet.tasks import MONITOR_DIR, OUTPUTS
+    commands = {**OUTPUTS, MONITOR_DIR: 'monitor'}
+    entries = list(directory.iterdir())
+    if not any(p.name in OWN_FILES[:2] for p in entries):
+        return False  # no marker of ours: not a recording's directory we made
+    for entry in entries:
+        if entry.is_symlink():
+            return False
+        if entry.is_file() and entry.name in OWN_FILES:
+            continue
+        if entry.is_dir() and entry.name in commands and written_by(commands[entry.name])(entry):
+            continue
+        return False
+    return True
+
+
+__all__ = ['MOTOR_FILES', 'OWN_FILES', 'prune']
