@@ -9,6 +9,7 @@ worker``) reached through ``--scheduler``.
 import json
 import os
 from pathlib import Path
+import re
 import subprocess
 import sys
 import time
@@ -50,6 +51,15 @@ def test_fleet_ranks_the_wearing_motor_first_and_names_the_leak_and_the_bad_reco
     assert 'what changed: ' in leak['alarms'][0]['what']  # the monitor's explainer (30 points
     # a recording may be too few for it to name the wear: 40 named it, doc/fleet.md)
     assert leak['leakage_factor'][-1]['value'] == pytest.approx(1.6, rel=0.03)
+    said = re.search(r'leakage factor ([\d.]+) -> ([\d.]+) \(\+(\d+) %\) since (\S+),',
+                     leak['alarms'][0]['what'])  # as README and doc/fleet.md give it
+    assert said and float(said[1]) == pytest.approx(1.0, abs=0.02)
+    assert float(said[2]) == pytest.approx(1.6, abs=0.04) and 55 <= int(said[3]) <= 65
+    assert said[4] == f'2026-03-{LEAK_DAY:02d}'
+    readme = ' '.join((REPOSITORY / 'README.md').read_text().split())
+    assert "wearing first, the leak's change alarm (leakage factor 1 -> 1.6), 3 refused" in readme
+    doc = ' '.join((REPOSITORY / 'doc' / 'fleet.md').read_text().split())
+    assert f'`leakage factor 1 -> 1.6 (+60 %) since 2026-03-{LEAK_DAY:02d}`' in doc
     assert not healthy['alarms'] and healthy['days_to_limit'] is None
     for point in healthy['leakage_factor']:
         assert point['ci95'][0] <= point['value'] <= point['ci95'][1]
