@@ -149,3 +149,40 @@ def test_fleet_runs_on_a_scheduler_and_worker_started_apart(tmp_path):
     assert '1 worker(s)' in lines[0] and 'memory per task 1.00 GiB' in lines[0]
     report = json.loads((tmp_path / 'out' / 'fleet.json').read_text())
     assert [len(m['leakage_factor']) for m in report['motors']] == [3]
+
+
+def test_a_scheduler_lost_mid_run_is_one_line_and_exit_1(tmp_path):
+    """Cold review F6 of issue 24: a scheduler gone mid-run exited 0 after a traceback."""
+    root = make_fleet(tmp_path / 'root', days=2, points=30, motors=('healthy',))
+    address_file = tmp_path / 'scheduler.json'
+    log = (tmp_path / 'dask.log').open('w')
+    scheduler = _start(['scheduler', '--scheduler-file', str(address_file), '--port', '0',
+                        '--no-dashboard'], log)
+    worker = run = None
+    try:
+        deadline = time.monotonic() + 60
+        while not address_file.exists() and time.monotonic() < deadline:
+            time.sleep(0.2)
+        address = json.loads(address_file.read_text())['address']
+        worker = _start(['worker', address, '--nthreads', '1', '--no-dashboard'], log)
+        run = subprocess.Popen(
+            [sys.executable, '-c', 'import sys; from satmotor_ros.cli.main import main; '
+             'sys.exit(main(sys.argv[1:]))', 'fleet', str(root), '--out', str(tmp_path / 'out'),
+             '--scheduler', address, '--liquid', 'water', '--no-progress'],
+            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+            env={**os.environ, 'PYTHONPATH': str(REPOSITORY)})
+        baseline = tmp_path / 'out' / 'healthy' / 'baseline.json'
+        deadline = time.monotonic() + 120
+        while not baseline.exists() and time.monotonic() < deadline:  # work under way
+            time.sleep(0.1)
+        scheduler.terminate()
+        scheduler.wait(timeout=30)
+        out, err = run.communicate(timeout=120)
+    finally:
+        for process in (run, worker, scheduler):
+            if process is not None and process.poll() is None:
+                process.terminate()
+                process.wait(timeout=30)
+        log.close()
+    assert run.returncode == 1, (out, err)
+    assert err.count('\n') == 1 and 'lost mid-run' in err and 'run again to resume' in err

@@ -17,6 +17,7 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 import json
+import logging
 import os
 from pathlib import Path
 import sys
@@ -257,12 +258,18 @@ def connect(workers: int = 0, scheduler: str = '') -> Iterator[tuple[Any, Cluste
             # without a TLS configuration; ValueError: an address distributed cannot use
             where = f'--scheduler {scheduler!r}' if scheduler else 'the local cluster'
             raise FleetError(f'{where}: cannot connect ({_first_line(err)})') from None
+        quiet = logging.getLogger('distributed.client')  # a lost scheduler is our one line,
+        level = quiet.level  # not its reconnect traceback
+        quiet.setLevel(logging.CRITICAL)
         try:
             yield client, _describe(client, scheduler, cluster is not None)
         finally:
-            client.close()
-            if cluster is not None:
-                cluster.close()
+            try:
+                client.close()
+                if cluster is not None:
+                    cluster.close()
+            finally:
+                quiet.setLevel(level)
 
 
 def run_on(client: Any, work: Plan, run: RunOptions,
@@ -293,7 +300,22 @@ def run_on(client: Any, work: Plan, run: RunOptions,
         progress([*futures.values(), *steps.values()])
     for rec, future in steps.items():
         work.steps[rec.relative] = _outcome(rec, future)
-    return [_outcome(rec, f) for rec, f in futures.items()]
+    markers = [_outcome(rec, f) for rec, f in futures.items()]
+    lost = [m for m in [*markers, *work.steps.values()] if m.get('status') == LOST]
+    if lost:  # cancelled by no one: the cluster went away; what finished is kept on disk
+        raise FleetError(f'{where_of(client)}: lost mid-run ({lost[0]["reason"]}); what '
+                         'finished is kept: run again to resume')
+    return markers
+
+
+LOST = 'lost'
+"""A task's status when the cluster cancelled it (the scheduler gone): the run stops."""
+
+
+def where_of(client: Any) -> str:
+    """Name the cluster a client is on, for a one-line message."""
+    address = getattr(getattr(client, 'scheduler', None), 'address', '') or ''
+    return f'the cluster at {address}' if address else 'the cluster'
 
 
 def check_address(scheduler: str) -> None:
@@ -375,14 +397,23 @@ def _submit(client: Any, work: Plan,
 
 def _outcome(rec: Recording, future: Any) -> dict[str, Any]:
     """Return the marker a task returned, or a 'failed' one naming what stopped it."""
+    from asyncio import CancelledError
     try:
         return dict(future.result())
-    except Exception as err:  # noqa: B902 - any task error is one recording's, reported
+    except (Exception, CancelledError) as err:  # noqa: B902 - a task's error is its own
         text = str(err).strip().splitlines()
         reason = f'{type(err).__name__}: {text[0]}' if text else type(err).__name__
         return {'recording': rec.relative, 'motor': rec.motor, 'date': rec.date,
-                'time': rec.time, 'time_source': rec.time_source, 'status': 'failed',
-                'reason': reason, 'result': None}
+                'time': rec.time, 'time_source': rec.time_source,
+                'status': LOST if _cancelled(err) else 'failed', 'reason': reason,
+                'result': None}
+
+
+def _cancelled(err: BaseException) -> bool:
+    """Whether a task was cancelled (we cancel none: the scheduler or the cluster went)."""
+    from asyncio import CancelledError
+    from distributed.client import FutureCancelledError
+    return isinstance(err, (CancelledError, FutureCancelledError))
 
 
 __all__ = ['Cluster', 'MEMORY_CAP', 'MEMORY_FRACTION', 'Plan', 'WORKER_WAIT', 'check_address',
