@@ -23,6 +23,7 @@ from satmotor_ros.identify import regional
 from satmotor_ros.identify.fit import HUBER
 from satmotor_ros.identify.regional import (acting, CONFINED, local_gain, LocalGain,
                                             recurrence)
+from satmotor_ros.identify.selection import CrossValidatedSelector, Score
 from satmotor_ros.identify.semireal import (build_case, demand_relief, estimate_noise,
                                             load_trajectory, write_mbari_log)
 from satmotor_ros.model.effects.threshold import supported
@@ -241,3 +242,31 @@ def test_a_valve_on_both_sides_past_every_drop_of_one_side_is_that_sides():
     assert supported('both', 5e6, (10e6, 20e6)) == 'both'  # drops past it on both sides
     assert supported('negative', 15e6, (20e6, 10e6)) == 'negative'  # a side stays its side
     assert supported('both', 25e6, (10e6, 20e6)) == 'both'  # past every drop: nothing to say
+
+
+# -- the weighted error over every row: a confined effect may not raise it beyond chance ------
+
+
+def _scored(error, cv_rmse):
+    """Return a Score that carries only what the harm test reads (errors and their figure)."""
+    return Score(None, None, error, cv_rmse, 1.0)
+
+
+def test_a_confined_effect_may_move_the_error_elsewhere_within_chance_but_not_beyond():
+    rng = np.random.default_rng(7)
+    n, block = 400, 10
+    sigma = np.full(n, 0.3 * LPM)
+    index = np.arange(n)
+    selector = CrossValidatedSelector(time_ordered=True, correlated=True, block=block)
+    base = rng.normal(0.0, 0.3 * LPM, n)
+    jitter = base + rng.normal(0.0, 0.01 * LPM, n)  # the base's coefficients moved a hair
+    baseline = _scored(base, 1.0)
+    # a rise of the figure whose sign is chance (the blocks split both ways): no harm
+    assert not recurrence(jitter, base, sigma, index, block).passes()
+    assert not selector._worse(_scored(jitter, 1.001), baseline, sigma, index)
+    # the same rise in every block: the baseline's gain recurs, the candidate harms
+    worse = 1.3 * base
+    assert recurrence(worse, base, sigma, index, block).passes()
+    assert selector._worse(_scored(worse, 1.001), baseline, sigma, index)
+    # a figure that falls is no harm, whatever the blocks say
+    assert not selector._worse(_scored(worse, 0.999), baseline, sigma, index)

@@ -17,7 +17,11 @@ each event better or worse with probability 1/2) gives as many with probability 
 transients at the start of a few moves improves some and worsens others; a valve opens every
 time the drop passes its crack.
 The global tests still hold (the F-test with the variance inflation, the plain error over
-every row, the weighted error over every row must not rise).
+every row must not rise), and the weighted error over every row must not rise beyond chance:
+the base's coefficients move with the effect, so over the other rows that error moves by a
+fraction of a per cent either way, and its sign alone would turn on one row; it fails when
+the baseline's gain over the candidate recurs across the blocks (:func:`recurrence`, one-sided
+at :data:`RECUR_ALPHA`).
 """
 
 from __future__ import annotations

@@ -416,11 +416,29 @@ class CrossValidatedSelector:
             return None
         return local_gain(at, baseline.cv_error, score.cv_error, sigma, index, self.block)
 
+    def _worse(self, score: Score, baseline: Score, sigma: FloatArray,
+               index: np.ndarray) -> bool:
+        """
+        Return whether a confined candidate's weighted error over every row rises beyond chance.
+
+        Its rows are a few per cent of the recording, and the base's coefficients move with
+        it: over the other rows the weighted cross-validated error may rise by a fraction of
+        a per cent either way, and the sign of that decides nothing (one row deleted flips
+        it). The error rises beyond chance when the baseline's gain over the candidate recurs
+        across the blocks (:func:`~.regional.recurrence`, the same one-sided test at
+        :data:`~.regional.RECUR_ALPHA`, its false-positive rate).
+        """
+        if score.cv_rmse < baseline.cv_rmse:
+            return False
+        return recurrence(score.cv_error, baseline.cv_error, sigma, index,
+                          self.block).passes()
+
     def _confined(self, estimated: Sequence[Score], baseline: Score, sigma: FloatArray,
                   index: np.ndarray, m: int) -> Score | None:
         """Return the best candidate passing every test but the gain, which it has locally."""
         for score in estimated:
-            if not (score.p_value < self.alpha / m and score.cv_rmse < baseline.cv_rmse
+            if not (score.p_value < self.alpha / m
+                    and not self._worse(score, baseline, sigma, index)
                     and not score.rmse >= baseline.rmse and determined(score.fit)):
                 continue
             local = self._local(score, baseline, sigma, index)
@@ -672,11 +690,12 @@ ENDS_SEARCH = ('the search goes on, and a further effect must also recur across 
 def _local_verdict(score: Score, baseline: Score, alpha: float, m: int,
                    local: LocalGain | None) -> str:
     """Say why an effect confined to a region was accepted by its gain where it acts."""
+    cut = 1.0 - score.cv_rmse / baseline.cv_rmse
+    every = (f'cuts the cross-validated error by {100 * cut:.1f} %' if cut > 0.0 else
+             f'raises the cross-validated error by {-100 * cut:.1f} %, within chance')
     return (f'{score.label}: an effect confined to a region: '
             f'{"" if local is None else local.says()}; p = {score.p_value:.2g} < {alpha:g}/{m}; '
-            f'over every row it cuts the cross-validated error by '
-            f'{100 * (1.0 - score.cv_rmse / baseline.cv_rmse):.1f} %, plain RMSE '
-            f'{_plain(baseline, score)}; {ENDS_SEARCH}')
+            f'over every row it {every}, plain RMSE {_plain(baseline, score)}; {ENDS_SEARCH}')
 
 
 def _with_verdict(step: Selection, verdict: str) -> Selection:
