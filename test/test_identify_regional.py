@@ -19,7 +19,8 @@ import json
 import numpy as np
 import pytest
 from satmotor_ros.cli.main import main
-from satmotor_ros.identify import regional
+from satmotor_ros.identify import calibrate, regional
+from satmotor_ros.identify.columns import load_mapping, read_log
 from satmotor_ros.identify.fit import HUBER
 from satmotor_ros.identify.regional import (acting, CONFINED, local_gain, LocalGain,
                                             recurrence)
@@ -27,7 +28,8 @@ from satmotor_ros.identify.selection import CrossValidatedSelector, Score
 from satmotor_ros.identify.semireal import (build_case, demand_relief, estimate_noise,
                                             load_trajectory, write_mbari_log)
 from satmotor_ros.model.effects.threshold import supported
-from satmotor_ros.model.units import LPM
+from satmotor_ros.model.units import LPM, parse_quantity
+from satmotor_ros.options import MotorOptions
 from vendored_data import data_path
 
 STEPPED = '2021.07.26T10.51.44.exp'
@@ -270,3 +272,18 @@ def test_a_confined_effect_may_move_the_error_elsewhere_within_chance_but_not_be
     assert selector._worse(_scored(worse, 1.001), baseline, sigma, index)
     # a figure that falls is no harm, whatever the blocks say
     assert not selector._worse(_scored(worse, 0.999), baseline, sigma, index)
+
+
+@pytest.mark.slow  # the real 2021 log calibrated
+def test_the_2021_logs_relief_is_named_with_one_row_deleted():
+    """One row less (t = 100 s) moved the weighted error over every row by +0.3 %: no valve."""
+    table = read_log(data_path('real', 'mbari_pto', STEPPED), load_mapping('mbari_pto'))
+    keep = np.abs(table.channels['time'] - 100.0) > 0.005
+    assert int((~keep).sum()) == 1
+    displacement = parse_quantity('0.30 in^3/rev', 'displacement', 'cm^3/rev')
+    spec = MotorOptions(liquid='oil', displacement=displacement).spec()
+    cal = calibrate(table.select(keep), 'oil', spec)
+    valves = [e for e in cal.effect_rows() if e['effect'] == 'threshold:dp']
+    assert [e['direction'] for e in valves] == ['negative'], cal.effect_rows()
+    assert valves[0]['threshold']['value'] == pytest.approx(19.6e6, rel=0.05)  # ~2 850 psi
+    assert cal.error_after.rmse_lpm < 0.9 * cal.error_before.rmse_lpm
