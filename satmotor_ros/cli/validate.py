@@ -70,7 +70,8 @@ def validate_into(data: str, out: str, mode: Mode, options: MotorOptions, column
     written = Calibrated(motor_file) if motor_file else None
     result = validate(table, model, options.liquid, mode,
                       calibrated=written.envelope if written else None,
-                      dynamics=written.dynamics if written else None)
+                      dynamics=written.dynamics if written else None,
+                      speed_delay=written.speed_delay if written else None)
     with output_dir('--out', out, 'validate', inputs, force) as tmp:
         summary = write_validation(result, tmp)
     target = Path(out)

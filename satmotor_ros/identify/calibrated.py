@@ -5,7 +5,8 @@ What a calibration wrote into a ``coefficients.yaml`` beside the model, read bac
 ``satmotor calibrate`` writes the envelope its fit used (``coverage.envelope``,
 :func:`~satmotor_ros.identify.coverage.envelope`) and, on a time series read with every
 sample, the transient terms it fitted (``dynamics``,
-:data:`~satmotor_ros.identify.transient.DYNAMIC_TERMS`). ``validate`` reads both, the
+:data:`~satmotor_ros.identify.transient.DYNAMIC_TERMS`) and the delay of the speed reading
+(``speed_delay``, :mod:`~satmotor_ros.identify.delay`). ``validate`` reads both, the
 health monitor the envelope; each block is checked when it is asked for, so a monitor is
 not refused for a malformed block it does not use.
 """
@@ -93,6 +94,24 @@ class Calibrated:
                 msg = f'{self.path}: dynamics.{name} = {value!r}: need a finite number'
                 raise DataError(msg)
         return {name: float(value) for name, value in terms.items()}
+
+    @property
+    def speed_delay(self) -> float | None:
+        """
+        Return the delay of the speed reading behind the flow reading, [s].
+
+        None when the file holds none (no calibration on a time series wrote it); DataError
+        naming the field when ``speed_delay.seconds`` is no finite number.
+        """
+        if 'speed_delay' not in self.blocks:
+            return None
+        block = self.blocks['speed_delay']
+        value = block.get('seconds') if isinstance(block, dict) else None
+        if isinstance(value, bool) or not isinstance(value, (int, float)) \
+                or not np.isfinite(value):
+            msg = f'{self.path}: speed_delay.seconds = {value!r}: need a finite number [s]'
+            raise DataError(msg)
+        return float(value)
 
 
 __all__ = ['Calibrated']

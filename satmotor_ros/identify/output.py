@@ -136,7 +136,21 @@ def _document(cal: Calibration) -> dict[str, Any]:
         # where the fit's data lie; `satmotor validate` counts the samples outside it
         'coverage': cal.coverage,
         **_dynamics(cal),
+        **_delay(cal),
     }
+
+
+def _delay(cal: Calibration) -> dict[str, Any]:
+    """
+    Return the delay of the speed reading behind the flow reading, [s], on a time series.
+
+    Same rig, same sensors: `satmotor validate` reads the speed that much later, as the
+    calibration did (:func:`~satmotor_ros.identify.delay.shifted`).
+    """
+    if cal.delay is None:
+        return {}
+    return {'speed_delay': {'seconds': cal.delay.as_dict()['seconds'],
+                            'fitted': cal.delay.fitted}}
 
 
 def _dynamics(cal: Calibration) -> dict[str, Any]:
@@ -192,6 +206,10 @@ def write_yaml(cal: Calibration, path: str | Path) -> None:
         head += ('# dynamics: the transient terms fitted beside the model (the bench, not the '
                  'motor; SI,\n# doc/calibration.md); `satmotor validate` applies them '
                  'unchanged.\n')
+    if 'speed_delay' in doc:
+        head += ('# speed_delay: seconds the speed reading lags the flow reading (the bench\'s '
+                 'sensors, eq. D1 of\n# satmotor_ros.identify.delay; 0 when kept); '
+                 '`satmotor validate` reads the speed that much later.\n')
     body = yaml.safe_dump(doc, sort_keys=False, allow_unicode=True,
                           width=99)
     Path(path).write_text(head + body, encoding='utf-8')

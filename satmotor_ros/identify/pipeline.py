@@ -19,6 +19,7 @@ from satmotor_ros.identify.base import (BaseFit, EMPTIED, emptied, fit_base, gue
 from satmotor_ros.identify.candidates import build_library, Candidate, Sampled
 from satmotor_ros.identify.coverage import (coverage, COVERED, envelope, envelope_share, MOST,
                                             TAIL)
+from satmotor_ros.identify.delay import DelayFit, fit_delay, kept, shifted
 from satmotor_ros.identify.errors import DataError, IdentificationError
 from satmotor_ros.identify.families import compare_families, family_specs, FamilyChoice
 from satmotor_ros.identify.fit import check_identifiable, FitReport, MIN_POINTS, written
@@ -87,6 +88,7 @@ class Calibration:
     n_folds: int = 5  # cross-validation folds asked for (at most one per point) [-]
     base: BaseFit | None = None  # the nonlinear coefficients the base fitted and kept
     coverage: dict[str, Any] = field(default_factory=dict)  # Rows.coverage
+    delay: DelayFit | None = None  # the speed reading's delay (None: no time series)
 
     @property
     def selection(self) -> Selection:
@@ -345,9 +347,10 @@ class Calibration:
             :func:`~satmotor_ros.identify.transient.dynamics_summary`).
 
         """
+        delay = {'speed_delay': self.delay.as_dict()} if self.delay is not None else {}
         if self.samples is None:
-            return {'mode': self.mode, 'mode_reason': self.mode_reason}
-        return {'mode': self.mode, 'mode_reason': self.mode_reason,
+            return {'mode': self.mode, 'mode_reason': self.mode_reason, **delay}
+        return {'mode': self.mode, 'mode_reason': self.mode_reason, **delay,
                 'n_samples': self.samples.n_samples, 'bin_size': self.samples.bin_size,
                 'variance_inflation': written(self.inflation),
                 'dynamics': dynamics_summary(self.final, self.samples)}
@@ -635,7 +638,8 @@ def calibrate(table: BenchTable, liquid: str = 'oil', spec: MotorSpec | None = N
         msg = f'liquid {liquid!r} is not a coefficient set of {spec.name} ({", ".join(spec.sets)})'
         raise IdentificationError(msg)
     spec, table = _without_effects(spec, liquid, table)
-    spec, model, read, choice = _family_and_rows(spec, liquid, table, options)
+    table, delay, first_read = _with_delay(spec, liquid, table, options)
+    spec, model, read, choice = _family_and_rows(spec, liquid, table, options, first_read)
     spec, model, read, base = _with_base(spec, liquid, table, options, read, choice)
     points, parts, rows, samples = read.table, read.parts, read.source_rows, read.samples
     note = implausible(parts)
@@ -664,7 +668,45 @@ def calibrate(table: BenchTable, liquid: str = 'oil', spec: MotorSpec | None = N
                        Errors.of(first.baseline.cv_error[at], parts.loss[at]),
                        Errors.of(forward.final.cv_error[at], parts.loss[at]), rows, choice,
                        read.mode, read.reason, samples, inflation,
-                       options.n_folds, base, read.coverage)
+                       options.n_folds, base, read.coverage, delay)
+
+
+def _with_delay(spec: MotorSpec, liquid: str, table: BenchTable,
+                options: Options) -> tuple[BenchTable, DelayFit | None, Rows | None]:
+    """
+    Fit the delay of the speed reading behind the flow reading (:mod:`.delay`) on a series.
+
+    Only a time series read with every sample has one to fit; steady points, and a series
+    read as its steady windows, keep 0. A fitted delay shifts the speed of every sample, and
+    the rows are read again from the shifted samples (in the mode and for the reason the
+    first reading gave).
+
+    Returns
+    -------
+    BenchTable
+        The samples, the speed shifted by a fitted delay.
+    DelayFit or None
+        The delay fitted or kept (None: the rows are no time series).
+    Rows or None
+        The rows read, for the family comparison (None: to be read).
+
+    """
+    if 'time' not in table.channels or not is_series(table) or options.mode in ('points',
+                                                                                 'series'):
+        return table, None, None
+    try:
+        read = read_rows(_open(spec, liquid), table, options)
+    except (DataError, IdentificationError):
+        return table, kept('the rows could not be read at no delay'), None
+    if read.samples is None:
+        return table, kept('the rows are steady windows, where the readings do not move'), read
+    delay = fit_delay(read.samples, _open(spec, liquid), options.transient.gap)
+    if not delay.fitted:
+        return table, delay, read
+    table, lost = shifted(table, delay.seconds, options.transient.gap)
+    again = read_rows(_open(spec, liquid), table, replace(options, mode=read.mode))
+    return table, replace(delay, unserved=lost), replace(
+        again, reason=read.reason, coverage={**read.coverage, **again.coverage})
 
 
 def _with_base(spec: MotorSpec, liquid: str, table: BenchTable, options: Options, read: Rows,
@@ -724,15 +766,16 @@ def _block(samples: Samples | None) -> int:
     return max(2 * samples.guard + 1, int(np.ceil(BLOCK_SECONDS / seconds)) if seconds > 0 else 1)
 
 
-def _family_and_rows(spec: MotorSpec, liquid: str, table: BenchTable,
-                     options: Options) -> tuple[MotorSpec, MotorModel, Rows, FamilyChoice | None]:
-    """Read the rows with the motor's family, compare the families there, re-read if another."""
+def _family_and_rows(spec: MotorSpec, liquid: str, table: BenchTable, options: Options,
+                     first: Rows | None = None
+                     ) -> tuple[MotorSpec, MotorModel, Rows, FamilyChoice | None]:
+    """Read the rows with the motor's family (or take `first`), compare the families there."""
     model = MotorModel.from_spec(spec, liquid)
     if not options.compare_families:
-        return spec, model, read_rows(_open(spec, liquid), table, options), None
+        return spec, model, first or read_rows(_open(spec, liquid), table, options), None
     read: Rows | None = None
     try:
-        read = read_rows(_open(spec, liquid), table, options)
+        read = first or read_rows(_open(spec, liquid), table, options)
         compared = read.table  # in transient mode the bins' means: the steady maps compared
     except IdentificationError as err:  # the motor's own family cannot use the data; another may
         steady: Mode = options.mode if options.mode != 'transient' else 'auto'

@@ -473,16 +473,27 @@ def _families(cal: Calibration) -> list[str]:
 
 
 def _base(cal: Calibration) -> list[str]:
-    """Say which nonlinear coefficients the base fitted (channel drop) and which it kept."""
+    """Say what the base fitted (speed delay, channel drop) and which coefficients it kept."""
+    delay = cal.delay
+    said = ([f'**Delay of the speed reading, before any effect** '
+             f'(`satmotor_ros.identify.delay`): {delay.note}'
+             + (f'; {delay.unserved} samples at the ends of stretches left out (their '
+                'shifted speed lies past the stretch)' if delay.unserved else '') + '.', '']
+            if delay is not None else [])
     if cal.base is None:
-        return []
+        return said
     base = cal.base
     fitted = [f'`{f["coefficient"]}` = {f["value"]:.4g} (packaged {f["packaged"]:.4g}, 95 % '
               f'[{f["ci95"][0]:.4g}, {f["ci95"][1]:.4g}])' for f in base.fitted]
+    if delay is not None and delay.fitted and delay.ci95 is not None:
+        fitted.append(f'`speed_delay` = {delay.seconds:.4g} s (95 % [{delay.ci95[0]:.4g}, '
+                      f'{delay.ci95[1]:.4g}])')
     kept = ', '.join(f'`{k["coefficient"]}` = {k["value"]:.4g}' for k in base.kept)
-    return [f'**Base, before any effect**: {base.note}.', '',
-            f'- fitted: {"; ".join(fitted) or "none"}',
-            f'- kept (the data cannot pin them): {kept or "none"}', '']
+    if delay is not None and not delay.fitted:
+        kept += (', ' if kept else '') + '`speed_delay` = 0 s'
+    return said + [f'**Base, before any effect**: {base.note}.', '',
+                   f'- fitted: {"; ".join(fitted) or "none"}',
+                   f'- kept (the data cannot pin them): {kept or "none"}', '']
 
 
 def _written_effects(summary: dict[str, Any]) -> list[str]:

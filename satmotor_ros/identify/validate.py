@@ -30,10 +30,11 @@ from typing import Any
 import numpy as np
 
 from satmotor_ros.identify.coverage import outside
+from satmotor_ros.identify.delay import shifted
 from satmotor_ros.identify.effects import CalibratedModel
 from satmotor_ros.identify.errors import DataError, IdentificationError
 from satmotor_ros.identify.parts import loss_parts, LossParts
-from satmotor_ros.identify.pipeline import Mode, Options, read_rows
+from satmotor_ros.identify.pipeline import is_series, Mode, Options, read_rows
 from satmotor_ros.identify.selection import Errors
 from satmotor_ros.identify.steady import SteadyTolerance
 from satmotor_ros.identify.table import BenchTable
@@ -63,6 +64,7 @@ class Validation:
     flagged: np.ndarray | None = None  # which of the points are flagged EXTRAPOLATED [-]
     transient: dict[str, Any] | None = None  # how the transient terms entered `error`
     in_sample: Errors | None = None  # the error after fitting them on these data (2nd figure)
+    delay: dict[str, Any] | None = None  # the calibration's speed delay, as applied
 
     def describe_effects(self) -> str:
         """Return the effects' names, comma-separated, or ``'none'``."""
@@ -84,10 +86,13 @@ class Validation:
             of, share; null figures when the motor file holds no envelope); on a time
             series read with every sample also transient_terms (how they entered
             ``error``: the calibration's, or none) and error_transient_fitted_in_sample
-            (the error after fitting them on these data: in sample, not the headline).
+            (the error after fitting them on these data: in sample, not the headline), and
+            speed_delay when the motor file's delay of the speed reading was applied.
 
         """
         transient = {} if self.transient is None else {'transient_terms': self.transient}
+        if self.delay is not None:
+            transient['speed_delay'] = self.delay
         if self.in_sample is not None:
             transient['error_transient_fitted_in_sample'] = self.in_sample.as_dict()
         return {'n_points': len(self.parts), 'error': self.error.as_dict(), **transient,
@@ -115,7 +120,8 @@ def _with(model: MotorModel, effects: tuple[Effect, ...]) -> MotorModel:
 def validate(table: BenchTable, model: MotorModel, liquid: str, mode: Mode = 'auto',
              tol: SteadyTolerance | None = None,
              calibrated: dict[str, Any] | None = None,
-             dynamics: dict[str, float] | None = None) -> Validation:
+             dynamics: dict[str, float] | None = None,
+             speed_delay: float | None = None) -> Validation:
     """
     Compute the error of `model` on `table` without fitting anything.
 
@@ -141,6 +147,11 @@ def validate(table: BenchTable, model: MotorModel, liquid: str, mode: Mode = 'au
         (:attr:`~satmotor_ros.identify.calibrated.Calibrated.dynamics`), applied unchanged
         when the rows are samples; without them the headline error has no transient terms,
         [-]
+    speed_delay : float, optional
+        The calibration's delay of the speed reading behind the flow reading
+        (:attr:`~satmotor_ros.identify.calibrated.Calibrated.speed_delay`): on a time series
+        the speed is read that much later (:func:`~satmotor_ros.identify.delay.shifted`),
+        as the calibration read it, [s]
 
     Returns
     -------
@@ -157,11 +168,17 @@ def validate(table: BenchTable, model: MotorModel, liquid: str, mode: Mode = 'au
     """
     options = Options(mode=mode, steady=tol or SteadyTolerance(),
                       transient=TransientOptions(screen_volumes=False))
+    delay = None
+    if (speed_delay is not None and mode not in ('points', 'series') and 'time' in table.channels
+            and is_series(table)):
+        table, lost = shifted(table, speed_delay, options.transient.gap)
+        delay = {'seconds': speed_delay, 'samples_unserved': lost,
+                 'note': "the calibration's delay of the speed reading, applied unchanged"}
     read = read_rows(_bare(model), table, options, check=False)
     beyond = _outside(calibrated, table)
     if read.samples is not None:
         return replace(_validate_samples(read.samples, model, liquid, dynamics),
-                       coverage=read.coverage, outside=beyond)
+                       coverage=read.coverage, outside=beyond, delay=delay)
     points = read.table
     parts, usable = loss_parts(_bare(model), points)
     if not usable.all():
