@@ -55,7 +55,7 @@ from satmotor_ros.identify.transient import (END_SAMPLES, flow_per_speed, Sample
 from satmotor_ros.model import MotorModel
 from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.units import LPM
-from scipy import optimize, stats
+from scipy import optimize, signal, stats
 
 ALPHA = 0.01
 """Level at which a fitted delay must beat none, over the range's independent delays, [-]."""
@@ -93,6 +93,7 @@ class DelayFit:
     rmse_at_zero: float = math.nan  # the base's residual at d = 0 (profile rows) [m^3/s]
     rmse_at_delay: float = math.nan  # the base's residual at d [m^3/s]
     span: float = 0.0  # the range profiled, +-span [s]
+    gain_over_lag: float = math.nan  # the delay's chi2 gain over the best first-order lag [-]
     unserved: int = 0  # samples at stretch ends the shift could not serve, left out [-]
 
     def as_dict(self) -> dict[str, Any]:
@@ -104,6 +105,8 @@ class DelayFit:
         if math.isfinite(self.gain):
             out.update(gain=_round(self.gain), limit=_round(self.limit),
                        range_s=[-_round(self.span), _round(self.span)])
+        if math.isfinite(self.gain_over_lag):
+            out['gain_over_lag'] = _round(self.gain_over_lag)
         if math.isfinite(self.rmse_at_zero):
             out.update(rmse_at_zero_lpm=_round(self.rmse_at_zero / LPM),
                        rmse_at_delay_lpm=_round(self.rmse_at_delay / LPM))
@@ -198,9 +201,13 @@ class _Profile:
         self.sign = np.asarray(parts.sign * np.ones(len(parts)))[self.rows]
         speed = np.where(np.isfinite(raw.speed), raw.speed, 0.0)
         self.time = time
-        self.area = np.concatenate(([0.0], np.cumsum(0.5 * (speed[1:] + speed[:-1])
-                                                     * np.diff(time))))
+        self.area = _area(time, speed)
+        self.area_flow = _area(time, np.where(np.isfinite(raw.flow), raw.flow, 0.0))
         self.smooth = smooth(speed, first, END_SAMPLES)
+        self.speed, self.step = speed, samples.step
+        self.raw_flow = np.where(np.isfinite(raw.flow), raw.flow, 0.0)
+        self.starts = np.append(starts, time.size)
+        self.filtered: dict[float, tuple[FloatArray, FloatArray]] = {}
         self.qt = model.geometry.displacement
         self.mean0 = self._mean(0.0)
         self.displacement = parts.displacement[self.rows]
@@ -211,17 +218,43 @@ class _Profile:
                          if lags or k not in RATE_TERMS}
         self.dq_dn = flow_per_speed(parts, self.qt)[self.rows]
         self.scale = 0.0
-        self.seen: dict[float, float] = {}
+        self.seen: dict[tuple[float, float], float] = {}
 
     def _mean(self, d: float) -> FloatArray:
         # the trapezoid mean of the piecewise-linear speed over [t_a + d, t_b + d]
         f = np.interp(np.concatenate((self.ta, self.tb)) + d, self.time, self.area)
         return np.asarray((f[self.ta.size:] - f[:self.ta.size]) / (self.tb - self.ta))
 
-    def residual(self, d: float) -> FloatArray:
-        """Return the base's residual at delay `d` (Huber IRLS at the fixed scale), [m^3/s]."""
-        loss = self.flow - (self.displacement + self.sign * self.qt * (self._mean(d)
-                                                                        - self.mean0))
+    def _lagged(self, lag: float) -> tuple[FloatArray, FloatArray]:
+        """Return the running areas of the speed and the flow, one of them lagged by |lag|."""
+        if lag not in self.filtered:
+            speed, flow = self.speed, self.raw_flow
+            if lag > 0.0:  # the flow reading lags: the model's flow (~ q_t n) seen through it
+                speed = _first_order(speed, self.starts, self.step, lag)
+            else:  # the speed reading lags: the flow seen through the same lag matches it
+                flow = _first_order(flow, self.starts, self.step, -lag)
+            self.filtered[lag] = (_area(self.time, speed), _area(self.time, flow))
+        return self.filtered[lag]
+
+    def _row_means(self, area: FloatArray, d: float) -> FloatArray:
+        f = np.interp(np.concatenate((self.ta, self.tb)) + d, self.time, area)
+        return np.asarray((f[self.ta.size:] - f[:self.ta.size]) / (self.tb - self.ta))
+
+    def residual(self, d: float, lag: float = 0.0) -> FloatArray:
+        """
+        Return the base's residual at delay `d` (Huber IRLS at the fixed scale), [m^3/s].
+
+        With `lag` the lag terms are out and a first-order lag of |lag| is applied
+        instead, on the speed (> 0: the flow reading lags) or the flow reading (< 0: the
+        speed reading lags): the lag's own shape, without a derivative's noise.
+        """
+        mean, flow = self._mean(d), self.flow
+        if lag:
+            speed_area, flow_area = self._lagged(lag)
+            mean = self._row_means(speed_area, d)
+            flow = flow + self.sign * (self._row_means(flow_area, 0.0)
+                                       - self._row_means(self.area_flow, 0.0))
+        loss = flow - (self.displacement + self.sign * self.qt * (mean - self.mean0))
         nuisance = dict(self.nuisance)
         if 'speed_lag' in nuisance:
             ends = np.interp(np.concatenate((self.ta, self.tb)) + d, self.time, self.smooth)
@@ -238,12 +271,27 @@ class _Profile:
                 weight = np.where(z <= HUBER, 1.0, HUBER / np.maximum(z, 1e-300))
         return np.asarray(r, dtype=float)
 
-    def __call__(self, d: float) -> float:
-        """Return the Huber objective (2 rho of the scaled residuals) at `d`."""
-        d = float(d)
-        if d not in self.seen:
-            self.seen[d] = float(np.sum(huber_rho(self.residual(d) / self.scale)))
-        return self.seen[d]
+    def __call__(self, d: float, lag: float = 0.0) -> float:
+        """Return the Huber objective (2 rho of the scaled residuals) at `d` (and `lag`)."""
+        key = (float(d), float(lag))
+        if key not in self.seen:
+            self.seen[key] = float(np.sum(huber_rho(self.residual(*key) / self.scale)))
+        return self.seen[key]
+
+
+def _area(time: FloatArray, x: FloatArray) -> FloatArray:
+    """Return the running trapezoid integral of `x` over `time`, 0 at the first sample."""
+    return np.concatenate(([0.0], np.cumsum(0.5 * (x[1:] + x[:-1]) * np.diff(time))))
+
+
+def _first_order(x: FloatArray, starts: np.ndarray, step: float, tau: float) -> FloatArray:
+    """Return `x` through a first-order lag of `tau` (per stretch, from its first value)."""
+    keep = float(np.exp(-step / tau))
+    out = np.empty_like(x)
+    for lo, hi in zip(starts[:-1], starts[1:]):
+        out[lo:hi], _ = signal.lfilter([1.0 - keep], [1.0, -keep], x[lo:hi],
+                                       zi=[keep * x[lo]])
+    return out
 
 
 def fit_delay(samples: Samples, model: MotorModel, gap: float = 3.0) -> DelayFit:
@@ -311,11 +359,24 @@ def fit_delay(samples: Samples, model: MotorModel, gap: float = 3.0) -> DelayFit
     if abs(best) >= span - EDGE * grid_step:
         return replace(kept(f'the profile is least at the end of the range ({profiled}): '
                             'a bound, not an estimate'), **said)
+    # a first-order lag of either reading (its own shape, :meth:`_Profile.residual`) is the
+    # lag terms' job: the delay must fit better than the best of them by the same limit
     _scaled(pure, best)
-    level = pure(best) + variance_inflation(pure.residual(best)) * float(stats.chi2.ppf(0.95, 1))
+    pure_inflation = variance_inflation(pure.residual(best))
+    lags = [float(v) for v in grid if v]
+    lag = lags[int(np.argmin([pure(0.0, v) for v in lags]))]
+    over = (pure(0.0, lag) - pure(best)) / pure_inflation
+    said['gain_over_lag'] = over
+    if over <= limit:
+        return replace(kept(f'a first-order lag of the {"flow" if lag > 0 else "speed"} '
+                            f'reading ({abs(lag):.3g} s) fits as well ({profiled}; chi2 gain '
+                            f'of the delay over the lag {over:.3g} <= {limit:.3g}): the lag '
+                            'terms take it'), **said)
+    level = pure(best) + pure_inflation * float(stats.chi2.ppf(0.95, 1))
     ci95 = (_crossing(pure, best, -span, level), _crossing(pure, best, span, level))
     note = (f'speed delay fitted: the speed reading lags the flow reading by {best:.3g} s '
-            f'(95 % {ci95[0]:.3g} to {ci95[1]:.3g} s; {profiled} > {limit:.3g}); the base '
+            f'(95 % {ci95[0]:.3g} to {ci95[1]:.3g} s; {profiled} > {limit:.3g}, over the best '
+            f'first-order lag {over:.3g}); the base '
             f'error {rms0 / LPM:.3g} -> {rms / LPM:.3g} l/min on the profile rows')
     return DelayFit(best, True, note, ci95, **said)
 
