@@ -20,6 +20,7 @@ from satmotor_ros.identify.table import BenchTable
 from satmotor_ros.model import MotorModel
 from satmotor_ros.model.families.defaults import default_motor
 from vendored_data import data_path
+import yaml
 
 STEPPED = '2021.07.26T10.51.44.exp'
 SPAN = (230.0, 400.0)  # the high-load part of the log, where its valve acts [s]
@@ -120,8 +121,9 @@ def test_the_loop_reads_the_speed_at_the_fitted_delay_finds_the_valve_and_valida
           '--motor', str(out / 'coefficients.yaml'), '--out', str(tmp_path / 'val')])
     val = json.loads((tmp_path / 'val' / 'validation.json').read_text())
     assert val['speed_delay']['seconds'] == pytest.approx(delay['seconds'])
-    text = (out / 'coefficients.yaml').read_text()
-    (tmp_path / 'no_delay.yaml').write_text(text.split('speed_delay:')[0], encoding='utf-8')
+    motor = yaml.safe_load((out / 'coefficients.yaml').read_text())
+    del motor['speed_delay']
+    (tmp_path / 'no_delay.yaml').write_text(yaml.safe_dump(motor), encoding='utf-8')
     _cli(['validate', str(path), '--columns', 'mbari_pto', '--liquid', 'oil',
           '--motor', str(tmp_path / 'no_delay.yaml'), '--out', str(tmp_path / 'val0')])
     unshifted = json.loads((tmp_path / 'val0' / 'validation.json').read_text())

@@ -249,6 +249,8 @@ VALVES = [('steady', STEPPED, -1), ('real', STEPPED, -1)]
 def test_a_clean_case_names_no_effect(work, noise, name):
     _, result = _calibrated(work, noise, name, (), 11)
     assert result['effect'] == 'none' and _names(result) == []
+    # the readings are not delayed: the base keeps the speed delay at 0 (identify.delay)
+    assert not result['speed_delay']['fitted'] and result['speed_delay']['seconds'] == 0.0
     assert abs(_lags(result)[1]) < 0.03  # no flow lag beyond the speed's
     # the fast moves' timing noise is noise (the rows' noise grows with the rates of change):
     # no region missed, no transient term the data do not have
@@ -266,6 +268,8 @@ def test_the_loop_names_each_injected_effect_and_nothing_else(work, noise, name,
     allowed = set().union(*(_spelled(kind) for kind in kinds))
     stray = [n for n in _names(result) if n not in allowed]
     assert stray == [], f'{kinds} named as {_names(result)}'
+    # no reading is delayed: a first-order lag stays the lag terms' job, not a delay's
+    assert not result['speed_delay']['fitted'], result['speed_delay']['note']
 
 
 @pytest.mark.slow

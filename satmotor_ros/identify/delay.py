@@ -14,25 +14,30 @@ is no first-order lag: the lag terms (T2, T3 of :mod:`.transient`) take its firs
 :math:`d\,\dot n` only, and on fast moves the rest is left to the effects (a valve that
 seems to open at the starts of moves, a leak, an impossible line volume). So the base
 profiles the fit over :math:`d` (both signs; the speed read at :math:`t + d`) before any
-effect is tried, with the lag terms in the base: the delay takes only what a first-order
-lag cannot, the lags stay what they are.
+effect is tried. The delay takes only what a first-order lag cannot: the lags stay the lag
+terms' job.
 
 The profile is that of the base's Huber objective on the rows the recording gives at
-:math:`d = 0` (:func:`~.transient.transient_samples`): at each :math:`d` the rows' mean
-speed is the shifted signal's exact trapezoid mean, the displacement flow :math:`q_t
-\bar n` and the speed lag's regressor follow it, the model's components and the
-other regressors stay (the losses are small against :math:`q_t n`, so the profile's
-location does not hinge on them), and the linear factors are refitted (IRLS, a robust scale
-of the residuals at the least, fixed across :math:`d`). The rows whose bins come within the
-range of their stretch's ends are left out of the profile, so every :math:`d` is judged on
-the same rows. A grid of :data:`GRID_SECONDS` over :math:`\pm` :data:`MAX_SECONDS` (at most
+:math:`d = 0` (:func:`~.transient.transient_samples`), without the lag terms: at each
+:math:`d` the rows' mean speed is the shifted signal's exact trapezoid mean and the
+displacement flow :math:`q_t \bar n` follows it; the model's components and the line
+volumes stay (the losses are small against :math:`q_t n`, so the profile's location does
+not hinge on them), and the linear factors are refitted (IRLS at a robust scale of the
+residuals, fixed across :math:`d`). The rows whose bins come within the range of their
+stretch's ends are left out of the profile, so every :math:`d` is judged on the same rows.
+A grid of :data:`GRID_SECONDS` over :math:`\pm` :data:`MAX_SECONDS` (at most
 :data:`MAX_SHARE` of the recording) finds the least, a bounded search refines it below the
-sample step. The delay is *fitted* only where the data pin it: the gain of the least over
+sample step. The delay is *fitted* only where the data pin it: (1) the base *with* its lag
+terms (the speed lag's regressor following :math:`d`) must gain more at the least than at
 :math:`d = 0`, divided by the variance inflation of the correlated residuals
-(:func:`~.transient.variance_inflation`), must beat chi2(1) at :data:`ALPHA` over the number of
+(:func:`~.transient.variance_inflation`), than chi2(1) at :data:`ALPHA` over the number of
 independent delays the range holds (one per bin length: a search over the range, not one
-test), and the least must lie inside the range (at its end the data ask for a delay at least
-that large, no estimate). Otherwise :math:`d = 0` is *kept*, and said why.
+test); (2) the delay must beat the best first-order lag of either reading, applied in its
+own shape (a filter, without the derivatives whose noise shrinks the lag terms), by the same
+limit; (3) the least must lie inside the range (at its end the data ask for a delay at least
+that large, no estimate) and (4) one sample step or more from 0 (a shorter shift is within
+the samples' own timing, whose jitter the real logs show). Otherwise :math:`d = 0` is
+*kept*, and said why.
 
 A fitted delay is applied to every sample (:func:`shifted`) before the rows are read for the
 effects, the errors and the report; the samples at a stretch's end the shift cannot serve
@@ -359,6 +364,9 @@ def fit_delay(samples: Samples, model: MotorModel, gap: float = 3.0) -> DelayFit
     if abs(best) >= span - EDGE * grid_step:
         return replace(kept(f'the profile is least at the end of the range ({profiled}): '
                             'a bound, not an estimate'), **said)
+    if abs(best) < samples.step:
+        return replace(kept(f'the least is within one sample step ({samples.step:.3g} s) of 0 '
+                            f'({profiled}): the samples\' own timing, not a delay'), **said)
     # a first-order lag of either reading (its own shape, :meth:`_Profile.residual`) is the
     # lag terms' job: the delay must fit better than the best of them by the same limit
     _scaled(pure, best)
