@@ -128,6 +128,11 @@ def kept(why: str) -> DelayFit:
     return DelayFit(0.0, False, f'speed delay kept at 0: {why}')
 
 
+def _kept(measured: DelayFit, why: str) -> DelayFit:
+    """Return the delay kept at 0 with the profile's figures, saying why."""
+    return replace(measured, seconds=0.0, fitted=False, note=kept(why).note)
+
+
 def shifted(table: BenchTable, seconds: float, gap: float) -> tuple[BenchTable, int]:
     """
     Read the speed of each sample at t + `seconds`, eq. (D1), within its stretch.
@@ -355,18 +360,18 @@ def fit_delay(samples: Samples, model: MotorModel, gap: float = 3.0) -> DelayFit
     limit = float(stats.chi2.ppf(1.0 - ALPHA / independent, 1))
     rms0 = float(np.sqrt(np.mean(full.residual(0.0) ** 2)))
     rms = float(np.sqrt(np.mean(full.residual(best) ** 2)))
-    said = dict(gain=gain, limit=limit, rmse_at_zero=rms0, rmse_at_delay=rms, span=span)
+    said = DelayFit(0.0, False, '', None, gain, limit, rms0, rms, span)
     profiled = (f'profile over {-span:.3g} to {span:.3g} s on {rows} rows: least at '
                 f'{best:+.3g} s, chi2 gain {gain:.3g} with the lags')
     if gain <= limit:
-        return replace(kept(f'the data do not pin it ({profiled} <= {limit:.3g}, chi2(1) at '
-                            f'{ALPHA:g} over {independent} independent delays)'), **said)
+        return _kept(said, f'the data do not pin it ({profiled} <= {limit:.3g}, chi2(1) at '
+                     f'{ALPHA:g} over {independent} independent delays)')
     if abs(best) >= span - EDGE * grid_step:
-        return replace(kept(f'the profile is least at the end of the range ({profiled}): '
-                            'a bound, not an estimate'), **said)
+        return _kept(said, f'the profile is least at the end of the range ({profiled}): '
+                     'a bound, not an estimate')
     if abs(best) < samples.step:
-        return replace(kept(f'the least is within one sample step ({samples.step:.3g} s) of 0 '
-                            f'({profiled}): the samples\' own timing, not a delay'), **said)
+        return _kept(said, f'the least is within one sample step ({samples.step:.3g} s) of 0 '
+                     f"({profiled}): the samples' own timing, not a delay")
     # a first-order lag of either reading (its own shape, :meth:`_Profile.residual`) is the
     # lag terms' job: the delay must fit better than the best of them by the same limit
     _scaled(pure, best)
@@ -374,19 +379,19 @@ def fit_delay(samples: Samples, model: MotorModel, gap: float = 3.0) -> DelayFit
     lags = [float(v) for v in grid if v]
     lag = lags[int(np.argmin([pure(0.0, v) for v in lags]))]
     over = (pure(0.0, lag) - pure(best)) / pure_inflation
-    said['gain_over_lag'] = over
+    said = replace(said, gain_over_lag=over)
     if over <= limit:
-        return replace(kept(f'a first-order lag of the {"flow" if lag > 0 else "speed"} '
-                            f'reading ({abs(lag):.3g} s) fits as well ({profiled}; chi2 gain '
-                            f'of the delay over the lag {over:.3g} <= {limit:.3g}): the lag '
-                            'terms take it'), **said)
+        return _kept(said, f'a first-order lag of the {"flow" if lag > 0 else "speed"} '
+                     f'reading ({abs(lag):.3g} s) fits as well ({profiled}; chi2 gain '
+                     f'of the delay over the lag {over:.3g} <= {limit:.3g}): the lag '
+                     'terms take it')
     level = pure(best) + pure_inflation * float(stats.chi2.ppf(0.95, 1))
     ci95 = (_crossing(pure, best, -span, level), _crossing(pure, best, span, level))
     note = (f'speed delay fitted: the speed reading lags the flow reading by {best:.3g} s '
             f'(95 % {ci95[0]:.3g} to {ci95[1]:.3g} s; {profiled} > {limit:.3g}, over the best '
             f'first-order lag {over:.3g}); the base '
             f'error {rms0 / LPM:.3g} -> {rms / LPM:.3g} l/min on the profile rows')
-    return DelayFit(best, True, note, ci95, **said)
+    return replace(said, seconds=best, fitted=True, note=note, ci95=ci95)
 
 
 def _scaled(profile: _Profile, d: float) -> bool:

@@ -207,7 +207,7 @@ def write_yaml(cal: Calibration, path: str | Path) -> None:
                  'motor; SI,\n# doc/calibration.md); `satmotor validate` applies them '
                  'unchanged.\n')
     if 'speed_delay' in doc:
-        head += ('# speed_delay: seconds the speed reading lags the flow reading (the bench\'s '
+        head += ("# speed_delay: seconds the speed reading lags the flow reading (the bench's "
                  'sensors, eq. D1 of\n# satmotor_ros.identify.delay; 0 when kept); '
                  '`satmotor validate` reads the speed that much later.\n')
     body = yaml.safe_dump(doc, sort_keys=False, allow_unicode=True,

@@ -691,8 +691,8 @@ def _with_delay(spec: MotorSpec, liquid: str, table: BenchTable,
         The rows read, for the family comparison (None: to be read).
 
     """
-    if 'time' not in table.channels or not is_series(table) or options.mode in ('points',
-                                                                                 'series'):
+    steady = options.mode in ('points', 'series')
+    if 'time' not in table.channels or not is_series(table) or steady:
         return table, None, None
     try:
         read = read_rows(_open(spec, liquid), table, options)
