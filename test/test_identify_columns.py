@@ -9,7 +9,6 @@ import pytest
 from satmotor_ros.cli.main import main
 from satmotor_ros.identify import DataError
 from satmotor_ros.identify.columns import load_mapping, mapping_from_dict, read_log
-from satmotor_ros.identify.selection import ENDS_SEARCH
 from satmotor_ros.model import load_motor
 from satmotor_ros.model.families import FAMILY_NAMES
 from satmotor_ros.model.io.config import default_config_path
@@ -193,7 +192,12 @@ def test_calibrate_each_mbari_log_with_the_f11_displacement(mbari_calibrations, 
     assert coverage['envelope']['negative']['dp_mpa'][0] < -20.0
     before, after = result['error_before'], result['error_after']
     # an effect is kept only if the plain out-of-sample RMSE falls: never a rise
-    assert 0.5 < after['rmse_lpm'] <= before['rmse_lpm'] < 3.0
+    assert 0.2 < after['rmse_lpm'] <= before['rmse_lpm'] < 3.0
+    # the speed column lags the flow column by about 0.4 s on this rig: the base fits the
+    # delay before any effect (identify.delay) and says so
+    delay = result['speed_delay']
+    assert delay['fitted'] and 0.3 < delay['seconds'] < 0.5 and delay['unit'] == 's'
+    assert delay['ci95'][0] < delay['seconds'] < delay['ci95'][1]
     if result['effects']:
         assert after['rmse_lpm'] < before['rmse_lpm']
     assert result['error_after_with_outliers']['rmse_lpm'] >= 0.99 * after['rmse_lpm']
@@ -207,11 +211,9 @@ def test_calibrate_each_mbari_log_with_the_f11_displacement(mbari_calibrations, 
     assert after['rmse_lpm'] < 0.9 * before['rmse_lpm']
     report = (out / 'report.md').read_text()
     assert '## Model family' in report and 'columns mapped by' in report
-    if name == MBARI[0]:  # the valve alone: the 11 % flow gain a search after it would name
-        # does not recur across the recording's blocks (and predicts the other log worse).
-        # Over every row the fast moves' timing noise swamps it (a 1.9 % cut with a line
-        # volume on each port): it passes where it acts, in 5 of its 5 openings
-        assert len(result['effects']) == 1 and ENDS_SEARCH in report
+    if name == MBARI[0]:  # the valve alone (with the speed delay fitted it passes over
+        # every row; before, where the fast moves' timing noise swamped it, where it acts)
+        assert len(result['effects']) == 1
     assert load_motor(out / 'coefficients.yaml').family == result['family']
 
 
@@ -236,7 +238,12 @@ def test_validate_one_mbari_logs_calibration_on_the_other(mbari_calibrations, tm
     in_sample = validation['error_transient_fitted_in_sample']['rmse_lpm']
     assert in_sample <= validation['error']['rmse_lpm']
     beyond = validation['outside_calibrated_envelope']
-    assert 0.0 < beyond['share'] < 0.5 and beyond['of'] > 10000
+    # the bias log's calibration holds 72 samples of a positive drop (the channel drop left
+    # out the rest: 'a direction emptied'), so half of the 2021 log lies outside its envelope
+    assert 0.0 < beyond['share'] < 0.6 and beyond['of'] > 10000
+    # same rig, same sensors: the calibration's speed delay is applied
+    assert validation['speed_delay']['seconds'] == yaml.safe_load(
+        (out / 'coefficients.yaml').read_text())['speed_delay']['seconds']
 
 
 @pytest.mark.slow  # mbari_calibrations: both real logs calibrated
@@ -254,7 +261,9 @@ def test_a_valve_calibration_validated_on_its_own_log_gives_its_own_error(mbari_
     assert any(e['effect'].startswith('threshold:') for e in own['effects'])
     validation = json.loads((tmp_path / 'val' / 'validation.json').read_text())
     in_sample = validation['error']['rmse_lpm']
-    assert in_sample == pytest.approx(own['error_after_with_outliers']['rmse_lpm'], rel=0.1)
+    # in sample against the calibration's out-of-sample figure (0.80 against 0.90 l/min with
+    # the speed delay fitted; 1.23 against 1.30 before it)
+    assert in_sample == pytest.approx(own['error_after_with_outliers']['rmse_lpm'], rel=0.15)
 
 
 def test_an_older_log_of_the_rig_with_fewer_columns_reads_through_the_same_mapping(tmp_path):
