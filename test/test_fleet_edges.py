@@ -2,6 +2,7 @@
 """The fleet on what its main tests do not use: correlated points, calendar time, edge fleets."""
 
 from datetime import datetime, timezone
+import json
 
 import numpy as np
 import pytest
@@ -396,6 +397,7 @@ def test_the_outputs_of_a_deleted_recording_or_motor_go_where_wholly_ours(tmp_pa
     from satmotor_ros.fleet.config import FleetConfig, RESERVED
     from satmotor_ros.fleet.discover import discover
     from satmotor_ros.fleet.prune import prune
+    from satmotor_ros.fleet.resume import options_key
     _csv(tmp_path / 'root' / 'm' / 'kept.csv')
     out = tmp_path / 'out'
 
@@ -412,9 +414,50 @@ def test_the_outputs_of_a_deleted_recording_or_motor_go_where_wholly_ours(tmp_pa
     made(out / 'm' / 'gone.csv')
     made(out / 'm' / 'noted.csv', extra='notes.txt')
     made(out / 'old' / 'r.csv')
-    (out / 'old' / 'baseline.json').write_text('{}')
+    ours = {'recording': 'old/r.csv', 'reason': None}
+    (out / 'old' / 'baseline.json').write_text(json.dumps({**ours, 'key': options_key(ours)}))
     (out / 'plots').mkdir()
-    removed = prune(out, discover(tmp_path / 'root', FleetConfig()), RESERVED)
+    root = tmp_path / 'root'
+    removed = prune(out, root, discover(root, FleetConfig()), RESERVED)
     assert sorted(removed) == ['m/gone.csv', 'old', 'old/r.csv']
     assert sorted(p.name for p in (out / 'm').iterdir()) == ['kept.csv', 'noted.csv']
     assert (out / 'plots').is_dir() and not (out / 'old').exists()
+
+
+def test_prune_keeps_a_users_directory_that_holds_no_baseline_of_ours(tmp_path):
+    """Cold review of issue 24: a user's columns.yaml, an empty directory were pruned."""
+    from satmotor_ros.fleet.config import FleetConfig, RESERVED
+    from satmotor_ros.fleet.discover import discover
+    from satmotor_ros.fleet.prune import prune
+    _csv(tmp_path / 'root' / 'm' / 'kept.csv')
+    out = tmp_path / 'out'
+    (out / 'mapping').mkdir(parents=True)
+    (out / 'mapping' / 'columns.yaml').write_text('time: t\n')
+    (out / 'empty_for_later').mkdir()
+    (out / 'cfg').mkdir()
+    theirs = {'recording': 'r.csv', 'key': 'mine'}  # a baseline.json whose key is no hash
+    (out / 'cfg' / 'baseline.json').write_text(json.dumps(theirs))
+    root = tmp_path / 'root'
+    assert prune(out, root, discover(root, FleetConfig()), RESERVED) == []
+    assert (out / 'mapping' / 'columns.yaml').read_text() == 'time: t\n'
+    assert (out / 'empty_for_later').is_dir() and (out / 'cfg' / 'baseline.json').is_file()
+
+
+def test_a_fleet_run_on_another_root_removes_nothing_of_the_first(tmp_path):
+    """Cold review of issue 24: --out pointed at another ROOT wiped the first fleet's outputs."""
+    from satmotor_ros.fleet.config import FleetConfig, RESERVED
+    from satmotor_ros.fleet.discover import discover
+    from satmotor_ros.fleet.prune import prune, root_of
+    _csv(tmp_path / 'one' / 'm' / 'a.csv')
+    _csv(tmp_path / 'two' / 'n' / 'b.csv')
+    out = tmp_path / 'out'
+    gone = out / 'm' / 'old.csv'
+    gone.mkdir(parents=True)
+    (gone / '.fleet-done.json').write_text('{}')
+    (out / 'fleet.json').write_text(json.dumps({'root': str((tmp_path / 'one').resolve())}))
+    two = tmp_path / 'two'
+    assert root_of(out) == str((tmp_path / 'one').resolve())
+    assert prune(out, two, discover(two, FleetConfig()), RESERVED) == []
+    assert gone.is_dir()
+    one = tmp_path / 'one'
+    assert prune(out, one, discover(one, FleetConfig()), RESERVED) == ['m/old.csv']

@@ -23,14 +23,18 @@ MOTOR_FILES = ('baseline.json', 'columns.yaml')
 """The files a fleet run writes in a motor's directory."""
 
 
-def prune(out: Path, motors: list[Motor], report: tuple[str, ...]) -> list[str]:
+def prune(out: Path, root: Path, motors: list[Motor], report: tuple[str, ...]) -> list[str]:
     """
     Remove the directories of recordings and motors that are gone, where wholly ours.
+
+    Nothing is removed from a DIR whose last report was of another ROOT.
 
     Parameters
     ----------
     out : pathlib.Path
         DIR, [-]
+    root : pathlib.Path
+        ROOT, [-]
     motors : list of Motor
         The fleet as discovered now, [-]
     report : tuple of str
@@ -42,6 +46,8 @@ def prune(out: Path, motors: list[Motor], report: tuple[str, ...]) -> list[str]:
         What was removed, relative to DIR.
 
     """
+    if root_of(out) not in (None, str(root.resolve())):
+        return []
     current = {m.motor: {r.name for r in m.recordings} for m in motors}
     removed = []
     for motor in sorted(p for p in out.iterdir() if p.is_dir() and not p.is_symlink()):
@@ -53,11 +59,36 @@ def prune(out: Path, motors: list[Motor], report: tuple[str, ...]) -> list[str]:
             if _ours(recording):
                 shutil.rmtree(recording)
                 removed.append(f'{motor.name}/{recording.name}')
-        if motor.name not in current and all(
-                p.is_file() and p.name in MOTOR_FILES for p in motor.iterdir()):
+        if motor.name not in current and _our_motor(motor):
             shutil.rmtree(motor)
             removed.append(motor.name)
     return removed
+
+
+def root_of(out: Path) -> str | None:
+    """Return the ROOT of DIR's last fleet report, or None (no report)."""
+    from satmotor_ros.fleet.config import REPORT_JSON
+    from satmotor_ros.fleet.resume import read_marker
+    root = (read_marker(out / REPORT_JSON) or {}).get('root')
+    return root if isinstance(root, str) else None
+
+
+def _our_motor(directory: Path) -> bool:
+    """
+    Whether a motor's directory holds a baseline a fleet run wrote, and only our files.
+
+    The baseline proves it: its ``key`` hashes the rest of it, as the run wrote it. A directory
+    without one (empty, a user's ``columns.yaml`` or ``baseline.json``) is kept.
+    """
+    from satmotor_ros.fleet.resume import options_key, read_marker
+    entries = list(directory.iterdir())
+    if any(not p.is_file() or p.is_symlink() or p.name not in MOTOR_FILES for p in entries):
+        return False
+    baseline = read_marker(directory / MOTOR_FILES[0])
+    if baseline is None or 'key' not in baseline:
+        return False
+    hashed = {k: v for k, v in baseline.items() if k not in ('key', 'stats')}
+    return bool(baseline['key'] == options_key(hashed))
 
 
 def _ours(directory: Path) -> bool:
@@ -79,4 +110,4 @@ def _ours(directory: Path) -> bool:
     return True
 
 
-__all__ = ['MOTOR_FILES', 'OWN_FILES', 'prune']
+__all__ = ['MOTOR_FILES', 'OWN_FILES', 'prune', 'root_of']

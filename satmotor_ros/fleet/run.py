@@ -17,7 +17,7 @@ from satmotor_ros.fleet.engine import check_address, execute, plan
 from satmotor_ros.fleet.errors import FleetError
 from satmotor_ros.fleet.explain import explain_alarms
 from satmotor_ros.fleet.health import ESTIMATOR
-from satmotor_ros.fleet.prune import prune
+from satmotor_ros.fleet.prune import prune, root_of
 from satmotor_ros.fleet.report import not_ours, write_report
 from satmotor_ros.fleet.resume import read_marker
 from satmotor_ros.fleet.summary import iso_now, LIMIT, motor_view, rank
@@ -115,7 +115,10 @@ def run_fleet(root: str, out: str, fleet: str = '', workers: int = 0, scheduler:
     else:
         say(f'fleet: all {len(markers)} recordings already done for these inputs and options; '
             'no cluster started')
-    gone = prune(target, motors, RESERVED)  # recordings and motors no longer under ROOT
+    before = root_of(target)
+    if before not in (None, str(base.resolve())):
+        say(f'fleet: --out {out!r} holds the outputs of ROOT {before!r}; none removed')
+    gone = prune(target, base, motors, RESERVED)  # recordings and motors no longer under ROOT
     if gone:
         more = ' ...' if len(gone) > 5 else ''
         say(f'fleet: removed the outputs of {len(gone)} recording(s) or motor(s) no longer '
