@@ -8,7 +8,8 @@ and ``fluid_temperature`` (names and types from :mod:`satmotor_ros.interface`);
 publishes ``health/leakage_factor``, ``health/volumetric_efficiency`` (at the current
 operating point), ``health/hours_to_limit`` (std_msgs/Float64; inf when not drifting)
 and ``/diagnostics``: OK; WARN when the trend reaches the limit within ``warn_hours``
-or an input is missing or bad; ERROR on a detected change or a crossed limit, until
+or an input is missing or bad, or most samples of the last ``window_s`` are skipped
+(the node sees nothing); ERROR on a detected change or a crossed limit, until
 acknowledged (``acknowledged_alarms``: the alarms stay in the history).
 
 A sample is taken on every ``joint_states`` message (its header stamp is the sample's
@@ -25,6 +26,7 @@ a health state is reported and never written over.
 from __future__ import annotations
 
 from array import array
+from collections import deque
 import math
 from pathlib import Path
 from typing import Any
@@ -41,6 +43,7 @@ from satmotor_ros.identify.errors import DataError
 from satmotor_ros.identify.health import (Baseline, HealthMonitor, HealthSamples,
                                           HealthSettings, HealthSnapshot)
 from satmotor_ros.identify.health.records import hours_note
+from satmotor_ros.identify.health.run import clock_shift, EPOCH_S
 from satmotor_ros.interface import CHANNELS, DIAGNOSTICS, HEALTH_TOPICS, JOINT_NAME
 from satmotor_ros.model import ModelError
 from satmotor_ros.model.units import gauge
@@ -98,6 +101,9 @@ PARAMETERS = (
               'beyond, counted)', '-', 10, 10000000, read_only=True),
 )
 """The node's parameters: name, default, description, unit and accepted values."""
+
+SKIPPED_SHARE = 0.5
+"""WARN when more than this share of the samples of the last ``window_s`` was skipped."""
 
 _SPECS = {spec.name: spec for spec in PARAMETERS}
 _REBUILD = {*params.MOTOR_KEYS, *(s.name for s in SETTINGS)}
@@ -181,9 +187,16 @@ class MotorMonitorNode(Node):
         self._heard = {name: -math.inf for name in INPUTS}  # node clock at reception [s]
         self._block: dict[str, array[float]] = {c: array('d') for c in _COLUMNS}
         self._optional = {'p_case': False, 'temperature': False}  # ever heard
-        self._last_time = -math.inf  # of the last sample, on the data's clock [s]
+        self._last_time = -math.inf  # of the last sample, on the monitor's clock [s]
+        if self.monitor is not None and math.isfinite(self.monitor.t_last):
+            self._last_time = self.monitor.t_last  # a resumed state's
+        self._resumed = math.isfinite(self._last_time)  # the next sample is the first since
+        self._shift = 0.0  # added to the stamps: their clock started again (clock_shift) [s]
+        self._recent: deque[tuple[float, int, dict[str, int]]] = deque()  # per update:
+        # (last time, samples, skipped by reason) over the last window_s
         self._last_heard_joint = -math.inf  # node clock [s]
         self.taken = self.dropped = self.out_of_order = self.bad = self.no_joint = 0
+        self.clock_restarts = 0
         self.received = 0  # messages of the held topics taken
         self.last_bad = ''
         self._alarms_seen = 0
@@ -311,11 +324,33 @@ class MotorMonitorNode(Node):
         stamp = msg.header.stamp
         now = self._last_heard_joint = self._now()
         t = stamp.sec + 1.0e-9 * stamp.nanosec if (stamp.sec or stamp.nanosec) else now
-        if not t > self._last_time:
-            self.out_of_order += 1  # the estimator takes samples in time order only
-            return
-        self._last_time = t
         self.take(t, speed, now)
+
+    def _in_order(self, t: float) -> float:
+        """
+        Return a stamp on the monitor's clock, or NaN for a sample out of order.
+
+        A stamp that goes back by more than ``input_timeout`` (or at all, the first after a
+        resumed state) on a clock that is not an epoch clock is a clock that started again (a
+        simulation restarted, a replay): shifted as ``satmotor monitor`` shifts a recording
+        (:func:`~satmotor_ros.identify.health.run.clock_shift`), never skipped as stale.
+        """
+        shifted = t + self._shift
+        resumed, self._resumed = self._resumed, False
+        if shifted > self._last_time:
+            return shifted
+        back = self._last_time - shifted
+        if (resumed or back > self._values['input_timeout']) and \
+                self._last_time - self._shift <= EPOCH_S:
+            shift = clock_shift(self._last_time, t)
+            if shift:
+                self._shift = shift
+                self.clock_restarts += 1
+                self.get_logger().warning(f'the stamps went back {back:.1f} s: their clock '
+                                          f'started again; shifted by {shift:.1f} s')
+                return t + shift
+        self.out_of_order += 1  # the estimator takes samples in time order only
+        return math.nan
 
     def take(self, t: float, speed: float, now: float) -> None:
         """
@@ -324,13 +359,17 @@ class MotorMonitorNode(Node):
         Parameters
         ----------
         t : float
-            The sample's time on the data's clock, [s]
+            The sample's time on the data's clock (out of order: counted, not taken), [s]
         speed : float
             Shaft speed, [rad/s]
         now : float
             The node clock, for the inputs' ages, [s]
 
         """
+        t = self._in_order(t)
+        if math.isnan(t):
+            return
+        self._last_time = t
         timeout = self._values['input_timeout']
         fresh = {name: now - heard <= timeout for name, heard in self._heard.items()}
         flow = self._flow_source()
@@ -373,6 +412,7 @@ class MotorMonitorNode(Node):
             arrays['p_case'] if self._optional['p_case'] else None,
             arrays['temperature'] if self._optional['temperature'] else None,
             arrays['stale'] > 0.0)
+        skipped = dict(self.monitor.skipped)
         try:
             alarms = self.monitor.update(samples)
         except DataError as err:  # the estimator refused the block: say so, keep running
@@ -380,11 +420,36 @@ class MotorMonitorNode(Node):
             self.get_logger().error(self._error, throttle_duration_sec=5.0)
             return
         self.monitor.pop_points()  # the per-bin series is the CLI's; the node keeps no list
+        self._note_skipped(float(arrays['time'][-1]), len(samples),
+                           {k: v - skipped[k] for k, v in self.monitor.skipped.items()})
         for alarm in alarms:
             self.get_logger().error(f'{alarm.kind} alarm at {alarm.time_s:.1f} s: '
                                     f'{alarm.what} (statistic {alarm.statistic:.3g})')
         if publish:
             self.publish(self.monitor.snapshot())
+
+    def _note_skipped(self, last: float, n: int, skipped: dict[str, int]) -> None:
+        """Keep the counts of the updates of the last ``window_s`` (of the data's time)."""
+        recent = self._recent
+        recent.append((last, n, skipped))
+        while len(recent) > 1 and recent[0][0] < last - self._values['window_s']:
+            recent.popleft()
+
+    def recent_skipped(self) -> tuple[int, dict[str, int]]:
+        """
+        Return the samples of the last ``window_s`` handed to the estimator, and those skipped.
+
+        Returns
+        -------
+        tuple of (int, dict)
+            The samples, and the skipped ones by reason (samples the estimator still holds
+            to learn their step count as neither), [-]
+
+        """
+        total = sum(n for _, n, _ in self._recent)
+        skipped = {k: sum(s[k] for _, _, s in self._recent) for k in self.monitor.skipped} \
+            if self.monitor is not None else {}
+        return total, skipped
 
     def publish(self, snap: HealthSnapshot) -> None:
         """
@@ -455,6 +520,11 @@ class MotorMonitorNode(Node):
         quiet = self.quiet()
         if quiet:
             return 1, f'no recent message on {", ".join(quiet)}'
+        total, skipped = self.recent_skipped()
+        if total and sum(skipped.values()) > SKIPPED_SHARE * total:
+            why = ', '.join(f'{v} {k.replace("_", " ")}' for k, v in skipped.items() if v)
+            return 1, (f'not monitoring: {sum(skipped.values())} of the last {total} samples '
+                       f'skipped ({why})')
         if not self._may_save:
             return 1, self._state_note
         if self.bad or self.out_of_order or self.no_joint:
@@ -495,10 +565,16 @@ class MotorMonitorNode(Node):
         for name in INPUTS:
             values[f'{CHANNELS[name].topic} age [s]'] = diag.human(now - self._heard[name],
                                                                    's')[1]
+        recent, skipped = self.recent_skipped()
         values.update({'samples taken': self.taken, 'samples dropped': self.dropped,
                        'joint_states out of order': self.out_of_order,
                        'joint_states without joint': self.no_joint,
+                       'clock restarts': self.clock_restarts,
                        'inputs refused': self.bad, 'last refused': self.last_bad,
+                       'recent samples': recent, 'recent skipped': sum(skipped.values()),
+                       'recent skipped share [-]':
+                           f'{sum(skipped.values()) / recent:.3g}' if recent else 'none',
+                       **{f'recent skipped {k}': v for k, v in skipped.items()},
                        'state_file': self._values['state_file'] or 'none',
                        'state': self._state_note})
         name = f'{self.get_fully_qualified_name()}: motor health'

@@ -83,6 +83,34 @@ def _in_time_order(tables: list[BenchTable], notes: list[str]) -> list[BenchTabl
     return [tables[i] for i in order]
 
 
+def clock_shift(last_s: float, first_s: float) -> float:
+    """
+    Return what to add to a clock that starts again, so it runs on after the samples before.
+
+    A time at or before the last one monitored, on a clock that is not an epoch clock (a
+    recording's own, a simulation clock that restarted, a replay), is placed :data:`GAP_S`
+    after the last one: no operation is counted across the gap, no sample goes back in
+    time. ``satmotor monitor`` applies it per recording, the ``motor_monitor`` node per
+    ``joint_states`` stamp that goes back.
+
+    Parameters
+    ----------
+    last_s : float
+        The last sample monitored, on the monitor's clock (NaN or -inf: none yet), [s]
+    first_s : float
+        The first sample of what comes next, on its own clock, [s]
+
+    Returns
+    -------
+    float
+        The shift; 0 when the clock runs on, or is an epoch clock (which is the time), [s]
+
+    """
+    if math.isfinite(last_s) and first_s <= last_s and first_s <= EPOCH_S:
+        return last_s + GAP_S - first_s
+    return 0.0
+
+
 def monitor_recordings(tables: Sequence[BenchTable], baseline: Baseline,
                        settings: HealthSettings | None = None,
                        monitor: HealthMonitor | None = None) -> MonitorRun:
@@ -130,8 +158,7 @@ def monitor_recordings(tables: Sequence[BenchTable], baseline: Baseline,
             samples = samples.take(newer)
             time = samples.time
             finite = time[np.isfinite(time)]
-        elif math.isfinite(last) and finite[0] <= last:
-            shift = last + GAP_S - float(finite[0])
+        elif shift := clock_shift(last, float(finite[0])):
             notes.append(f'{table.source}: its clock starts again; placed {GAP_S:.0f} s after '
                          'the recording before it')
         if shift:
@@ -158,4 +185,5 @@ def monitor_recordings(tables: Sequence[BenchTable], baseline: Baseline,
                       baseline.source, epoch, monitor.t0, tuple(notes))
 
 
-__all__ = ['BLOCK', 'EPOCH_S', 'GAP_S', 'monitor_recordings', 'MonitorRun', 'Recording']
+__all__ = ['BLOCK', 'clock_shift', 'EPOCH_S', 'GAP_S', 'monitor_recordings', 'MonitorRun',
+           'Recording']
