@@ -121,11 +121,9 @@ def _settings(values: dict[str, float | None], explain: bool) -> HealthSettings:
 
 def _same_settings(saved: HealthSettings, given: HealthSettings, state: str) -> None:
     """Refuse settings that differ from those a resumed state was judged with."""
-    for field, flag in SETTING_FLAGS.items():
-        was, now = getattr(saved, field), getattr(given, field)
-        if was != now:
-            raise CliError(f'{flag} {now!r}: the state {state} was made with {was!r}; give '
-                           'the same, or start a new --state')
+    for field, (was, now) in saved.differences(given, SETTING_FLAGS).items():
+        raise CliError(f'{SETTING_FLAGS[field]} {now!r}: the state {state} was made with '
+                       f'{was!r}; give the same, or start a new --state')
 
 
 def _monitor(data: list[str], out: str, options: MotorOptions, columns: str, force: bool,

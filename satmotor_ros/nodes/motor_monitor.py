@@ -20,7 +20,8 @@ The node holds no physics and no statistics: the estimator is
 :class:`satmotor_ros.identify.health.HealthMonitor`, the one ``satmotor monitor`` runs.
 With ``state_file`` its state is resumed at start and saved every ``save_period`` and at
 shutdown, whole or not at all, so hours of history survive a restart; a file that is not
-a health state is reported and never written over.
+a health state, or a state made with other settings than the parameters, is reported and
+never written over, nor is ``state_file`` by a parameter change that starts a new estimator.
 """
 
 from __future__ import annotations
@@ -106,6 +107,7 @@ SKIPPED_SHARE = 0.5
 """WARN when more than this share of the samples of the last ``window_s`` was skipped."""
 
 _SPECS = {spec.name: spec for spec in PARAMETERS}
+_SETTING_NAMES = tuple(s.name for s in SETTINGS)
 _REBUILD = {*params.MOTOR_KEYS, *(s.name for s in SETTINGS)}
 _QUIET = PublisherEventCallbacks(use_default_callbacks=False)
 _QUIET_SUBSCRIPTION = SubscriptionEventCallbacks(use_default_callbacks=False)
@@ -181,6 +183,7 @@ class MotorMonitorNode(Node):
         self._error = ''  # why there is no estimator, or why it failed
         self._state_note = ''  # what happened to the state file
         self._may_save = True  # False: the state file is someone else's
+        self._mismatch = ''  # the resumed state's settings that differ from the parameters
         self._build(values, resume=True)
         self._acknowledge()
         self._held = {name: math.nan for name in INPUTS}
@@ -235,10 +238,20 @@ class MotorMonitorNode(Node):
         path = values['state_file']
         if resume and path and Path(path).exists():
             try:
-                self.monitor = HealthMonitor.resume(path, baseline)
-                self._state_note = f'resumed from {path}'
-                self.get_logger().info(self._state_note)
-                return
+                resumed = HealthMonitor.resume(path, baseline)
+                differ = resumed.settings.differences(settings, _SETTING_NAMES)
+                if not differ:
+                    self.monitor = resumed
+                    self._state_note = f'resumed from {path}'
+                    self.get_logger().info(self._state_note)
+                    return
+                self._may_save = False
+                self._mismatch = '; '.join(f'{k}: state {was!r}, parameter {now!r}'
+                                           for k, (was, now) in differ.items())
+                self._state_note = (f'{path} was made with other settings ({self._mismatch}): '
+                                    'not resumed, not written over; starting afresh; give '
+                                    'the same parameters or a new state_file')
+                self.get_logger().error(self._state_note)
             except DataError as err:
                 self._may_save = False
                 self._state_note = f'{err}; starting afresh and not saving over it'
@@ -250,8 +263,34 @@ class MotorMonitorNode(Node):
             settings_from(proposed)
             if changed & set(params.MOTOR_KEYS):
                 baseline_from(proposed)
+            self._protect_state(proposed, changed)
         return params.check_proposed(_SPECS, request, self._values, build,
                                      (ModelError, DataError, OSError, ValueError))
+
+    def _protect_state(self, proposed: dict[str, Any], changed: set[str]) -> None:
+        """
+        Refuse a change that would write over a state the node did not start from.
+
+        Raises
+        ------
+        ValueError
+            A new ``state_file`` that exists, or a change that starts a new estimator while
+            ``state_file`` holds the history of this one (give a new ``state_file`` with it).
+
+        """
+        path, now = proposed['state_file'], self._values['state_file']
+        if 'state_file' in changed and path and path != now and Path(path).exists():
+            msg = (f'state_file {path!r} exists: the node writes only a state it started '
+                   'from; give a new path, or restart the node to resume it')
+            raise ValueError(msg)
+        rebuild = sorted(changed & _REBUILD)
+        if rebuild and path and path == now and self._may_save and self.monitor is not None:
+            held = self.monitor.snapshot().n_samples
+            if held:
+                msg = (f'{", ".join(rebuild)}: a new estimator would write over the history '
+                       f'of {held} samples in state_file {path!r}; set a new state_file (or '
+                       "'') in the same call")
+                raise ValueError(msg)
 
     def _apply_parameters(self, changed: list[RosParameter]) -> None:
         names = {p.name for p in changed}
@@ -270,7 +309,7 @@ class MotorMonitorNode(Node):
                 setattr(self, f'_{key.split("_")[0]}_timer',
                         self.create_timer(values[key], callback))
         if 'state_file' in names:
-            self._may_save, self._state_note = True, ''
+            self._may_save, self._state_note, self._mismatch = True, '', ''
         if 'acknowledged_alarms' in names:
             self._acknowledge()
 
@@ -506,6 +545,8 @@ class MotorMonitorNode(Node):
             return 2, self._error or 'no estimator'
         if self._problems:
             return 2, f'parameter {"; ".join(self._problems.values())}'
+        if self._mismatch:
+            return 2, self._state_note
         new = snap.unacknowledged
         if new and new[-1].kind == 'change':
             last = new[-1]
@@ -576,7 +617,8 @@ class MotorMonitorNode(Node):
                            f'{sum(skipped.values()) / recent:.3g}' if recent else 'none',
                        **{f'recent skipped {k}': v for k, v in skipped.items()},
                        'state_file': self._values['state_file'] or 'none',
-                       'state': self._state_note})
+                       'state': self._state_note,
+                       'state settings differ': self._mismatch or 'none'})
         name = f'{self.get_fully_qualified_name()}: motor health'
         hardware = self.monitor.baseline.source if self.monitor is not None else 'motor'
         self._pub_diag.publish(diag.array(Time(nanoseconds=int(now * 1e9)), [diag.status(

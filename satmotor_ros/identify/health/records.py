@@ -3,9 +3,11 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 import math
 import sys
+from typing import Any
 
 import numpy as np
 
@@ -184,6 +186,30 @@ class HealthSettings:
                    f'trend_point_s = {self.trend_point_s!r}: need min_speed >= 0 and windows '
                    f'of at least bin_s = {self.bin_s!r}')
             raise DataError(msg)
+
+    def differences(self, other: HealthSettings,
+                    names: Iterable[str]) -> dict[str, tuple[Any, Any]]:
+        """
+        Name the settings among `names` that differ from `other`'s.
+
+        A resumed state keeps the settings its history was judged with; ``satmotor monitor``
+        and the ``motor_monitor`` node both refuse to carry it on under others (this rule).
+
+        Parameters
+        ----------
+        other : HealthSettings
+            The settings given now, [-]
+        names : iterable of str
+            The fields to compare (those the caller lets a user set), [-]
+
+        Returns
+        -------
+        dict
+            Field -> (this one's value, `other`'s), in the order of `names`; empty if alike.
+
+        """
+        return {name: (getattr(self, name), getattr(other, name)) for name in names
+                if getattr(self, name) != getattr(other, name)}
 
 
 @dataclass(frozen=True)
