@@ -233,8 +233,8 @@ def test_the_monitors_figure_is_taken_only_where_it_is_the_recordings_own():
     get their ratios, each point says which, and the monitor's alarm raised on the slow log is
     not the fleet's. Its trend is then the line through the points, not the monitor's own.
     """
-    raised = {'time_s': EPOCH + DAY + 60.0, 'kind': 'change', 'what': 'wear: leakage x1.35'}
-    later = {'time_s': EPOCH + 3 * DAY + 60.0, 'kind': 'change', 'what': 'wear: c x1.05'}
+    raised = {'time_s': DAY + 60.0, 'kind': 'change', 'what': 'wear: leakage x1.35'}
+    later = {'time_s': 3 * DAY + 60.0, 'kind': 'change', 'what': 'wear: c x1.05'}
     steps = [_step(0, 1.0, 3001, 600.0), _step(1, 1.35, 30, 1800.0, alarms=[raised]),
              _step(2, 1.30, 3001, 600.0, skipped=2900, alarms=[raised]),
              _step(3, 1.05, 3001, 600.0, alarms=[raised, later])]

@@ -527,7 +527,7 @@ def test_a_monitored_motors_view_is_the_monitors_figures_and_named_alarms():
         'trend_per_hour': 0.05, 'trend_per_day': 0.24, 'hours_to_limit': 48.0,
         'recording_samples': 451, 'recording_skipped': 0,
         'span_s': [EPOCH + i * 100.0, EPOCH + i * 100.0 + 90],
-        'alarms': [{'time_s': EPOCH + 150.0, 'kind': 'change', 'what': 'wear: leakage x1.3'}]
+        'alarms': [{'time_s': 150.0, 'kind': 'change', 'what': 'wear: leakage x1.3'}]
         if i else []}} for i, v in enumerate((1.0, 1.3))]
     markers = _markers([1.0, 1.0])
     view = motor_view('m', 'water', markers, None, steps=steps)
@@ -624,3 +624,64 @@ def test_a_mapping_or_motor_file_edited_in_place_is_a_new_key(tmp_path):
     assert after_mapping[0] != before[0] and after_mapping[1] != before[1]
     motor.write_text('name: m2\n')
     assert keys()[0] != after_mapping[0]
+
+
+def test_a_monitor_alarm_on_an_epoch_clock_is_the_recordings_it_was_raised_in(tmp_path):
+    """
+    Cold review of issue 24 (finding 1): on epoch times every monitor alarm was dropped.
+
+    The chain's alarm ``time_s`` is on the monitor's clock (from its first sample) and a
+    step's ``span_s`` on the data's (epoch): compared as they were, the alarm fell before
+    every span, was pinned to the learning recording and discarded. Two healthy days, then a
+    leak x1.6: the change is the third recording's, as the real chain writes it.
+    """
+    from satmotor_ros.fleet.chain import monitor_step
+    from satmotor_ros.fleet.synthetic import _scaled
+    from satmotor_ros.fleet.tasks import RunOptions
+    from satmotor_ros.identify.synthetic import generate_series, Injection, Plan, to_columns
+    from satmotor_ros.identify.table import write_csv
+    from satmotor_ros.model.io.config import default_config_path
+    for day in range(3):
+        table = generate_series(Plan(liquid='water', n_points=20, duration_s=600.0),
+                                Injection(), 101 + day, samples=3000, rate=5.0)
+        columns = to_columns(_scaled(table, 1.6 if day == 2 else 1.0))
+        columns['time'] = ('s', columns['time'][1] + EPOCH + day * DAY)
+        (tmp_path / 'root' / 'm1').mkdir(parents=True, exist_ok=True)
+        write_csv(tmp_path / 'root' / 'm1' / f'r{day}.csv', columns)
+    motor = discover(tmp_path / 'root', FleetConfig())[0]
+    run = RunOptions(str(tmp_path / 'out'), liquid='water')
+    baseline = {'coefficients': str(default_config_path('sm075_25.yaml')), 'liquid': 'water',
+                'key': 'b'}
+    steps = []
+    for rec in motor.recordings:
+        steps.append(monitor_step(rec, motor.rule, baseline, run, steps[-1] if steps else None))
+    (alarm,) = steps[-1]['result']['alarms']
+    assert alarm['kind'] == 'change' and alarm['time_s'] < 3 * DAY  # the monitor's clock
+    markers = [{'status': 'done', 'recording': rec.relative, 'date': f'd{i}', 'time': rec.time,
+                'time_source': rec.time_source, 'result': {'leakage_factor': v, 'ci95':
+                                                           [v - 0.01, v + 0.01]}}
+               for i, (rec, v) in enumerate(zip(motor.recordings, (1.0, 1.0, 1.6)))]
+    view = motor_view('m1', 'water', markers, None, steps=steps)
+    assert [(a['kind'], a['recording']) for a in view['alarms']] == [('change', 'm1/r2.csv')]
+
+
+def test_a_monitor_without_a_trend_leaves_the_motor_the_calendar_line():
+    """
+    Cold review of issue 24 (finding 1): a monitor with no trend left the motor none.
+
+    The monitor's own trend is None when each day's wear is a change to it; the motor then
+    gets the line through the figures against the recordings' times, not "not drifting".
+    """
+    values = 1.0 + 0.06 * np.arange(8)
+    steps = [{'recording': f'r{i}.csv', 'status': 'done', 'result': {
+        'leakage_factor': {'value': v, 'ci95': [v - 0.03, v + 0.03]}, 'learning': False,
+        'trend_per_hour': None, 'trend_per_day': None, 'hours_to_limit': None,
+        'recording_samples': 3000, 'recording_skipped': 0,
+        'span_s': [EPOCH + i * DAY, EPOCH + i * DAY + 600.0],
+        'alarms': [{'time_s': 3 * DAY + 30.0, 'kind': 'change', 'what': 'wear'}]}}
+        for i, v in enumerate(values)]
+    view = motor_view('m', 'water', _markers(values), None, steps=steps)
+    assert view['trend_per_day'] == pytest.approx(0.06)
+    assert view['days_to_limit'] == pytest.approx((2.0 - values[-1]) / 0.06)
+    assert view['trend_clock'] != MONITOR_EPOCH
+    assert [a['recording'] for a in view['alarms']] == ['r3.csv']

@@ -241,21 +241,20 @@ def _monitored(motor: str, liquid: str, markers: list[dict[str, Any]],
     last = watched[-1]['result']
     alarms = []
     for alarm in last.get('alarms', []):  # the snapshot's: each with its final name
-        at = alarm.get('time_s') or 0.0
-        where = [s for s in watched if s['result'].get('span_s')
-                 and s['result']['span_s'][0] <= at] or watched[:1]
-        recording = where[-1]['recording']
+        recording = raised_in(alarm, watched)
         if recording not in fit:  # raised on figures the fleet does not take
             continue
         alarms.append({'date': dates.get(recording, ''), 'kind': alarm.get('kind', 'change'),
                        'what': f"{alarm.get('what', 'unexplained')} (in {recording})",
                        'recording': recording, 'source': 'monitor'})
-    if _monitor_trend_holds(series, watched):
+    holds = _monitor_trend_holds(series, watched)
+    if holds and last.get('trend_per_day') is not None:
         hours = last.get('hours_to_limit')  # calendar hours; the trend per calendar day
         return _view(motor, liquid, markers, series, last.get('trend_per_day'),
                      None if hours is None else hours / 24.0, alarms, baseline, limit,
                      BY_MONITOR, MONITOR_EPOCH)
-    if len(fit) < len(series):  # the ratios' steps and limit, on the recordings they hold
+    # no trend of the monitor's (each day's jump a change to it): the calendar line below
+    if not holds and len(fit) < len(series):  # the ratios' steps and limit where they hold
         timed = [p for p in series if times.get(p['recording'], {}).get('time') is not None]
         ratio_alarms, _, _ = _ratio_alarms_and_trend(
             timed, np.array([float(times[p['recording']]['time']) for p in timed]), limit)
@@ -264,7 +263,39 @@ def _monitored(motor: str, liquid: str, markers: list[dict[str, Any]],
         alarms.sort(key=lambda a: a['date'])
     trend, days = _calendar_trend(series, times, limit)
     return _view(motor, liquid, markers, series, trend, days, alarms, baseline, limit,
-                 BY_MONITOR if len(fit) == len(series) else MIXED, RECORDING_TIMES)
+                 BY_MONITOR if holds or len(fit) == len(series) else MIXED, RECORDING_TIMES)
+
+
+def raised_in(alarm: dict[str, Any], watched: list[dict[str, Any]]) -> str:
+    """
+    Return the recording the monitor raised an alarm in, on one clock.
+
+    An alarm's ``time_s`` is on the monitor's own clock, seconds from its first sample; a
+    step's ``span_s`` is its recording's first and last sample on the data's clock (epoch
+    seconds where the data give them). The monitor's first sample is the first step's first:
+    the steps before it (refused, steady) gave it no sample. An alarm before every span (or
+    with no time) is the first recording's.
+
+    Parameters
+    ----------
+    alarm : dict
+        One of the monitor's alarms (``Alarm.as_dict``), [-]
+    watched : list of dict
+        The motor's done monitor steps in time order, [-]
+
+    Returns
+    -------
+    str
+        The recording the alarm was raised in, [-]
+
+    """
+    spans = [(s['result'].get('span_s'), s['recording']) for s in watched]
+    spans = [(float(span[0]), recording) for span, recording in spans if span]
+    if not spans:
+        return str(watched[0]['recording'])
+    at = spans[0][0] + float(alarm.get('time_s') or 0.0)  # the data's clock
+    where = [recording for start, recording in spans if start <= at]
+    return str(where[-1] if where else spans[0][1])
 
 
 def _monitor_trend_holds(series: list[dict[str, Any]], watched: list[dict[str, Any]]) -> bool:
@@ -448,4 +479,4 @@ def iso_now() -> str:
 __all__ = ['BY_MONITOR', 'BY_RATIO', 'CHANGE_SIGMAS', 'DAY', 'EPOCH_S', 'LIMIT', 'MIN_STEP',
            'LEARNING', 'MIN_TREND_POINTS', 'MIXED', 'MONITOR_EPOCH', 'MONITOR_MIN_RATE',
            'MONITOR_MIN_SAMPLES', 'NEAR', 'RECORDING_TIMES', 'iso_now', 'monitor_unfit',
-           'motor_view', 'rank']
+           'motor_view', 'raised_in', 'rank']
