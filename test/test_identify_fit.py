@@ -8,8 +8,12 @@ import pytest
 
 from satmotor_ros.identify import (calibrate, check_identifiable, IdentificationError,
                                    loss_parts, LossFit)
+from satmotor_ros.identify.candidates import build_library
+from satmotor_ros.identify.fit import HUBER
 from satmotor_ros.identify.synthetic import generate, Injection, Plan
 from satmotor_ros.model import load_motor, MotorModel
+from satmotor_ros.model.viscosity import standard_law
+from scipy.optimize._numdiff import approx_derivative
 
 
 @pytest.mark.parametrize('liquid', ['oil', 'water'])
@@ -66,3 +70,42 @@ def test_fit_names_a_coefficient_the_points_cannot_move():
     zero = replace(parts, components=(leakage, c, dead))
     with pytest.raises(IdentificationError, match='c_id_scale is not determined'):
         LossFit().fit(zero).report()
+
+
+def _fit_cases():
+    """Return parts with a nuisance regressor and candidates of each shape: a valve, a gain."""
+    table = generate(Plan(liquid='oil', n_points=120), Injection('flow_sensor_gain', 0.1, 'flow'),
+                     seed=5)
+    model = MotorModel.default('oil')
+    parts, _ = loss_parts(model, table)
+    parts = parts.with_nuisance({'drift': np.linspace(-1.0, 1.0, len(parts))})
+    channels = {**table.channels, 'p_out': table.p_out}
+    candidates, _ = build_library(parts, channels, standard_law(model.liquid, 'oil'))
+    chosen = [next(c for c in candidates if c.effect.startswith(kind))
+              for kind in ('threshold:', 'flow_sensor_gain')]
+    return parts, chosen
+
+
+@pytest.mark.parametrize('robust', ['plain', 'huber', 'tukey'])
+def test_the_fits_jacobian_is_scipys_forward_differences_to_the_bit(robust, monkeypatch):
+    parts, chosen = _fit_cases()
+    sigma = np.full(len(parts), 0.05 * float(np.std(parts.loss)))
+    index = np.arange(0, len(parts), 2)
+    options = {'plain': {}, 'huber': {'robust': HUBER}, 'tukey': {'redescending': True}}[robust]
+    for effects in ((), chosen[:1], chosen):
+        fit = LossFit(effects, sigma, **options)
+        fit._layout(parts)
+        lower, upper, starts = fit._starts(parts, None)
+        residual, jacobian = fit._problem(parts, index, lower, upper)
+        u = np.clip(starts[-1] + 0.1, lower, upper)
+        u[0] = upper[0]  # a step turned back at the bound
+        expected = approx_derivative(residual, u, method='2-point', bounds=(lower, upper))
+        assert np.array_equal(jacobian(u), expected)
+        ours = LossFit(effects, sigma, **options).fit(parts, index)
+        problem = LossFit._problem
+        monkeypatch.setattr(LossFit, '_problem', lambda self, *a: (problem(self, *a)[0],
+                                                                   '2-point'))
+        theirs = LossFit(effects, sigma, **options).fit(parts, index)
+        monkeypatch.undo()
+        assert np.array_equal(ours.u_, theirs.u_)
+        assert np.array_equal(ours.jac_, theirs.jac_)

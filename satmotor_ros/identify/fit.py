@@ -27,7 +27,7 @@ a gross outlier pulls the fit by a bounded amount instead of its square.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 import itertools
 import math
@@ -62,6 +62,9 @@ HUBER = 1.345
 
 TUKEY = 4.685
 """Tukey's biweight constant in noise standard deviations (95 % efficiency), [-]."""
+
+_EPS_ROOT = float(np.finfo(np.float64).eps ** 0.5)
+"""Relative forward-difference step, scipy's '2-point' default, [-]."""
 
 
 def written(x: float) -> float:
@@ -140,6 +143,32 @@ def robust_root(z: FloatArray, c: float, redescending: bool = False) -> FloatArr
     return out
 
 
+def _forward_steps(x0: FloatArray, bounds: tuple[FloatArray, FloatArray]
+                   ) -> FloatArray:
+    """
+    Return scipy's forward-difference steps at `x0` (``least_squares``' '2-point').
+
+    sqrt(eps) sign(x0) max(1, |x0|), turned back where it would cross a bound and fits
+    the other way, else the distance to the farther bound.
+    """
+    sign = (x0 >= 0).astype(float) * 2 - 1
+    h = _EPS_ROOT * sign * np.maximum(1.0, np.abs(x0))
+    lb, ub = bounds
+    if np.all((lb == -np.inf) & (ub == np.inf)):
+        return h
+    out = h.copy()
+    lower_dist, upper_dist = x0 - lb, ub - x0
+    x = x0 + h
+    violated = (x < lb) | (x > ub)
+    fitting = np.abs(h) <= np.maximum(lower_dist, upper_dist)
+    out[violated & fitting] *= -1
+    forward = (upper_dist >= lower_dist) & ~fitting
+    out[forward] = upper_dist[forward]
+    backward = (upper_dist < lower_dist) & ~fitting
+    out[backward] = -lower_dist[backward]
+    return np.asarray(out, dtype=float)
+
+
 @dataclass(frozen=True)
 class FitReport:
     """Fitted parameters with 95 % confidence intervals and their correlations."""
@@ -216,10 +245,11 @@ class LossFit:
             mod = c.modify(k, *theta) if mod is NO_EFFECT else mod + c.modify(k, *theta)
         return mod
 
-    def _predict(self, parts: LossParts, u: FloatArray) -> FloatArray:
+    def _predict(self, parts: LossParts, u: FloatArray, mod: Modifier | None = None,
+                 flows: list[FloatArray] | None = None) -> FloatArray:
         q = self.typical_.size
-        return predict_flow(parts, u[:self.m_], self._modifier(u),
-                            u[self.m_:self.m_ + q] * self.typical_ if q else None)
+        return predict_flow(parts, u[:self.m_], self._modifier(u) if mod is None else mod,
+                            u[self.m_:self.m_ + q] * self.typical_ if q else None, flows)
 
     def _starts(self, parts: LossParts, start: FloatArray | None
                 ) -> tuple[list[float], list[float], list[FloatArray]]:
@@ -245,6 +275,52 @@ class LossFit:
             if k == len(lower):
                 starts = starts[:1]
         return lower, upper, starts
+
+    def _problem(self, parts: LossParts, index: np.ndarray, lower: Sequence[float],
+                 upper: Sequence[float]
+                 ) -> tuple[Callable[..., FloatArray], Callable[[FloatArray], FloatArray]]:
+        """
+        Return the fit's residual at parameters u and its Jacobian (after :meth:`_layout`).
+
+        The Jacobian is scipy's forward differences ('2-point' of ``least_squares``),
+        column for column and to the bit, but the effects' modifier and the components
+        under it, which the factors and nuisance coefficients leave as they are, are
+        computed once per Jacobian instead of once per column.
+        """
+        flow = parts.flow[index]
+        prior = self.sigma is not None
+        sigma = np.broadcast_to(np.asarray(LPM if self.sigma is None else self.sigma,
+                                           dtype=float), parts.flow.shape)[index]
+        m, c, tukey = self.m_, self.robust, self.redescending
+        every = index.size == len(parts) and bool(np.all(index == np.arange(index.size)))
+
+        def residual(u: FloatArray, mod: Modifier | None = None,
+                     flows: list[FloatArray] | None = None) -> FloatArray:
+            predicted = self._predict(parts, u, mod, flows)
+            z = (flow - (predicted if every else predicted[index])) / sigma
+            if tukey or c:
+                z = robust_root(z, TUKEY if tukey else c, tukey)
+            return np.concatenate((z, (u[:m] - 1.0) / PRIOR_SD)) if prior else z
+
+        bounds = (np.array(lower, dtype=float), np.array(upper, dtype=float))
+        linear = m + self.typical_.size
+
+        def jacobian(u: FloatArray) -> FloatArray:
+            u = np.asarray(u, dtype=float)
+            mod = self._modifier(u)
+            flows = [component.flow(mod) for component in parts.components]
+            f0 = residual(u, mod, flows)
+            h = _forward_steps(u, bounds)
+            out = np.empty((u.size, f0.size))
+            for i in range(u.size):
+                v = u.copy()
+                v[i] = u[i] + h[i]
+                out[i] = ((residual(v, mod, flows) if i < linear else residual(v)) - f0) \
+                    / ((u[i] + h[i]) - u[i])
+            transposed: FloatArray = out.T  # as scipy's own: a view, no copy
+            return transposed
+
+        return residual, jacobian
 
     def fit(self, parts: LossParts, index: np.ndarray | None = None,
             start: FloatArray | None = None) -> Self:
@@ -272,25 +348,12 @@ class LossFit:
         self._layout(parts)
         index = np.arange(len(parts)) if index is None else index
         flow = parts.flow[index]
-        prior = self.sigma is not None
-        sigma = np.broadcast_to(np.asarray(LPM if self.sigma is None else self.sigma,
-                                           dtype=float), parts.flow.shape)[index]
         lower, upper, starts = self._starts(parts, start)
-        m, c, tukey = self.m_, self.robust, self.redescending
-
-        every = index.size == len(parts) and bool(np.all(index == np.arange(index.size)))
-
-        def residual(u: FloatArray) -> FloatArray:
-            predicted = self._predict(parts, u)
-            z = (flow - (predicted if every else predicted[index])) / sigma
-            if tukey or c:
-                z = robust_root(z, TUKEY if tukey else c, tukey)
-            return np.concatenate((z, (u[:m] - 1.0) / PRIOR_SD)) if prior else z
-
+        residual, jacobian = self._problem(parts, index, lower, upper)
         best = None
         with np.errstate(all='ignore'):
             for u0 in starts:
-                result = optimize.least_squares(residual, u0, bounds=(lower, upper),
+                result = optimize.least_squares(residual, u0, jac=jacobian, bounds=(lower, upper),
                                                 method='trf', x_scale=1.0, xtol=1e-6,
                                                 ftol=1e-6)
                 if np.all(np.isfinite(result.fun)) and (best is None or result.cost < best.cost):

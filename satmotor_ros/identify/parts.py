@@ -16,7 +16,7 @@ multiplied by s = sign(dp), and the components are the model's at |n| and
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -119,7 +119,8 @@ NO_EFFECT = Modifier()
 
 
 def predict_flow(parts: LossParts, scales: FloatArray, mod: Modifier = NO_EFFECT,
-                 nuisance: FloatArray | None = None) -> FloatArray:
+                 nuisance: FloatArray | None = None,
+                 flows: Sequence[FloatArray] | None = None) -> FloatArray:
     r"""
     Predict the measured flow from the scaled components and the effects, eq. (36).
 
@@ -139,6 +140,9 @@ def predict_flow(parts: LossParts, scales: FloatArray, mod: Modifier = NO_EFFECT
         The effects' gains, factors and extra terms, [-]
     nuisance : ndarray, optional
         Coefficients beta of the nuisance regressors, in their order, [SI]
+    flows : sequence of ndarray, optional
+        The components under `mod` (:meth:`Component.flow`), when already known: the sums
+        are the same, term for term, [m^3/s]
 
     Returns
     -------
@@ -150,8 +154,10 @@ def predict_flow(parts: LossParts, scales: FloatArray, mod: Modifier = NO_EFFECT
     inner = parts.displacement if _one(mod.speed_gain) else parts.displacement / mod.speed_gain
     if not _zero(mod.additive):
         inner = inner + mod.additive
-    for scale, component in zip(scales, parts.components):
-        inner = inner + scale * component.flow(mod)
+    if flows is None:
+        flows = [component.flow(mod) for component in parts.components]
+    for scale, column in zip(scales, flows):
+        inner = inner + scale * column
     if nuisance is not None:
         for beta, x in zip(nuisance, parts.nuisance.values()):
             inner = inner + beta * x
