@@ -5,7 +5,8 @@ The motor_monitor node never says OK while it sees nothing (review of issue 23, 
 A resumed state followed by stamps whose clock starts again at 0 (a simulation restarted,
 a replay) is shifted as ``satmotor monitor`` shifts a recording, so a +50 % leak is seen;
 samples the estimator skips (a dead speed sensor: speed 0 while the flow passes) make the
-status WARN with the skipped share, not OK "healthy".
+status WARN with the skipped share, not OK "healthy"; so does a leakage factor the data
+cannot identify (review F1, :func:`~satmotor_ros.identify.health.records.unresolved`).
 """
 
 import os
@@ -91,3 +92,18 @@ def test_a_dead_speed_sensor_warns_with_the_skipped_share(ros):
     assert total >= VALUES['window_s'] * 2 * 0.9 and skipped['stalled'] == total
     executor.remove_node(node)
     node.destroy_node()
+
+
+def test_a_factor_lost_in_the_noise_warns_not_identifiable(ros):
+    """A flowmeter whose noise swamps the baseline's losses: WARN, not OK 'healthy'."""
+    context, executor, _ = ros
+    baseline = baseline_from(VALUES)
+    for noise_lpm, level in ((0.05, 0), (3.0, 1)):
+        node = _node(context, executor)
+        _feed(node, recording(0.4, seed=7, rate_hz=2, baseline=baseline, noise_lpm=noise_lpm))
+        snap = node.monitor.snapshot()
+        assert not snap.learning
+        got, message = node.level(snap)
+        assert got == level and ('not identifiable' in message) is bool(level), message
+        executor.remove_node(node)
+        node.destroy_node()

@@ -43,7 +43,7 @@ from satmotor_ros.identify.calibrated import Calibrated
 from satmotor_ros.identify.errors import DataError
 from satmotor_ros.identify.health import (Baseline, HealthMonitor, HealthSamples,
                                           HealthSettings, HealthSnapshot)
-from satmotor_ros.identify.health.records import hours_note
+from satmotor_ros.identify.health.records import hours_note, unresolved
 from satmotor_ros.identify.health.run import clock_shift, EPOCH_S
 from satmotor_ros.interface import CHANNELS, DIAGNOSTICS, HEALTH_TOPICS, JOINT_NAME
 from satmotor_ros.model import ModelError
@@ -570,6 +570,10 @@ class MotorMonitorNode(Node):
             return 1, self._state_note
         if self.bad or self.out_of_order or self.no_joint:
             return 1, f'inputs refused: {self.last_bad or "joint_states out of order"}'
+        why = unresolved(snap.leakage_factor, self.monitor.settings.change_fraction) \
+            if self.monitor is not None else ''
+        if why:
+            return 1, why
         state = 'learning' if snap.learning else 'healthy'
         return 0, state + (f' ({snap.acknowledged} alarms acknowledged)'
                            if snap.acknowledged else '')
@@ -619,6 +623,9 @@ class MotorMonitorNode(Node):
                        'state_file': self._values['state_file'] or 'none',
                        'state': self._state_note,
                        'state settings differ': self._mismatch or 'none'})
+        if snap is not None and self.monitor is not None:
+            values['leakage_factor identifiable'] = not unresolved(
+                snap.leakage_factor, self.monitor.settings.change_fraction)
         name = f'{self.get_fully_qualified_name()}: motor health'
         hardware = self.monitor.baseline.source if self.monitor is not None else 'motor'
         self._pub_diag.publish(diag.array(Time(nanoseconds=int(now * 1e9)), [diag.status(

@@ -212,6 +212,39 @@ class HealthSettings:
                 if getattr(self, name) != getattr(other, name)}
 
 
+def unresolved(factor: Estimate, change_fraction: float) -> str:
+    """
+    Say why the windowed leakage factor is not identifiable, or '' when it is.
+
+    The factor is the measured loss over the baseline's, by least squares over the window:
+    its 95 % half-width is 1.96 times the residual noise over the baseline's loss (summed over
+    the window, the bins' correlation counted). Where that half-width exceeds
+    ``change_fraction``, the window cannot tell the baseline from a change of the size the
+    detector is tuned to: the baseline's losses are small against the residual noise, and
+    the value depends on how the samples are weighted more than on the motor.
+
+    Parameters
+    ----------
+    factor : Estimate
+        The windowed leakage factor with its 95 % interval (NaN while learning), [-]
+    change_fraction : float
+        The relative change the detector is tuned to, [-]
+
+    Returns
+    -------
+    str
+        The reason with the numbers, or '' (identifiable, or no interval yet).
+
+    """
+    half = (factor.high - factor.low) / 2.0
+    if not (math.isfinite(half) and half > change_fraction):
+        return ''
+    return (f'the leakage factor is not identifiable: its 95 % interval '
+            f'[{factor.low:.3g}, {factor.high:.3g}] (half-width {half:.3g}) is wider than the '
+            f"change the detector is tuned to ({change_fraction:g}): the baseline's losses "
+            'are small against the residual noise, the value says little about the motor')
+
+
 @dataclass(frozen=True)
 class Estimate:
     """A figure with its 95 % interval (NaN where the data do not give one)."""
@@ -304,4 +337,5 @@ class HealthSnapshot:
 
 
 __all__ = ['Alarm', 'Estimate', 'HealthPoint', 'HealthSamples', 'HealthSettings',
-           'HealthSnapshot', 'hours_json', 'hours_note', 'NEVER_HOURS', 'SKIP_REASONS']
+           'HealthSnapshot', 'hours_json', 'hours_note', 'NEVER_HOURS', 'SKIP_REASONS',
+           'unresolved']

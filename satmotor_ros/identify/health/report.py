@@ -10,7 +10,8 @@ from typing import Any
 
 import numpy as np
 
-from satmotor_ros.identify.health.records import Estimate, HealthPoint, hours_json, hours_note
+from satmotor_ros.identify.health.records import (Estimate, HealthPoint, hours_json, hours_note,
+                                                  unresolved)
 from satmotor_ros.identify.health.run import MonitorRun
 from satmotor_ros.identify.plot_tools import portable
 from satmotor_ros.identify.report import pyplot
@@ -84,6 +85,8 @@ def summary(run: MonitorRun) -> dict[str, Any]:
         'recordings': [{'data': portable(r.source), 'samples': r.samples,
                         'start_s': _num(r.start_s, 9), 'end_s': _num(r.end_s, 9),
                         'shifted_s': _num(r.shifted_s, 9)} for r in run.recordings],
+        'leakage_factor_identifiable': not unresolved(snap.leakage_factor,
+                                                      run.settings.change_fraction),
         'notes': list(run.notes), 'flags': _flags(run), 't0_s': _num(run.t0_s, 12)}
     if run.t0_epoch is not None:
         out['t0_epoch'] = run.t0_epoch
@@ -98,6 +101,9 @@ def _flags(run: MonitorRun) -> list[str]:
         flags.append(f"the leakage factor's interval reaches below 0 ({factor.low:.3g}): "
                      "the baseline's losses do not describe these data (check --motor, "
                      '--displacement, the units and the flow sign)')
+    why = unresolved(factor, run.settings.change_fraction)
+    if why:
+        flags.append(why)
     return flags
 
 
