@@ -685,3 +685,27 @@ def test_a_monitor_without_a_trend_leaves_the_motor_the_calendar_line():
     assert view['days_to_limit'] == pytest.approx((2.0 - values[-1]) / 0.06)
     assert view['trend_clock'] != MONITOR_EPOCH
     assert [a['recording'] for a in view['alarms']] == ['r3.csv']
+
+
+def test_a_bag_with_garbage_metadata_is_refused_whole_in_one_line(tmp_path):
+    """
+    Cold review of issue 24 (finding 3): a garbage metadata.yaml was a failed task.
+
+    Reading the bag's liquid raised its BagError out of the task (worker tracebacks, and a
+    failed task is redone by every rerun): it is a damaged recording, refused in one line.
+    """
+    from satmotor_ros.fleet.synthetic import make_fleet
+    from satmotor_ros.fleet.tasks import (calibrate_baseline, load_screened, motor_options,
+                                          Refused, RunOptions)
+    root = make_fleet(tmp_path / 'root', days=1, points=20, bags=True, motors=())
+    (bag,) = [p.parent for p in root.rglob('metadata.yaml')]
+    (bag / 'metadata.yaml').write_text('garbage: [\n')
+    (motor,) = discover(root, FleetConfig())
+    (rec,) = motor.recordings
+    for liquid in ('water', ''):
+        run = RunOptions(str(tmp_path / 'out'), liquid=liquid)
+        with pytest.raises(Refused, match='metadata.yaml: cannot read it') as err:
+            load_screened(rec, motor_options(motor.rule, run), '')
+        assert '\n' not in str(err.value)
+        baseline = calibrate_baseline(motor, run)  # the first recording: refused, said
+        assert baseline.get('recording') is None and 'metadata.yaml' in str(baseline), baseline

@@ -143,6 +143,8 @@ def load_screened(rec: Recording, options: MotorOptions, columns: str) -> tuple[
         if options.liquid:
             raise
         settled, unsettled = options, True
+    except BagError as err:  # its metadata unreadable: a damaged bag, refused whole
+        raise Refused(_first_line(err)) from None
     try:
         table = load_data(rec.path, columns, _displacement(settled))
     except (BagError, CliError, IdentificationError, ModelError, OptionError) as err:
@@ -161,6 +163,12 @@ def load_screened(rec: Recording, options: MotorOptions, columns: str) -> tuple[
     if unsettled:
         raise MotorRefused(NO_LIQUID)
     return table, settled
+
+
+def _first_line(err: Exception) -> str:
+    """Return an error's first line (its type's name if it says nothing)."""
+    text = str(err).strip().splitlines()
+    return text[0] if text else type(err).__name__
 
 
 def _displacement(options: MotorOptions) -> float:
