@@ -156,6 +156,9 @@ def test_a_mapped_log_is_timed_by_its_epoch_column_and_roots_own_date_is_not_one
 def test_path_date_takes_the_last_date_of_the_path():
     assert path_date('2025-01-01/run_20260301_120000.csv') == EPOCH + 12 * 3600
     assert path_date('unit7/run_99.csv') is None
+    assert path_date('log_2026.03.01T10.51.44.exp') == EPOCH + 10 * 3600 + 51 * 60 + 44
+    assert path_date('x/2026.03.01.csv') == EPOCH  # review 24 finding 4: dotted dates
+    assert path_date('v2026.03-01.csv') is None  # mixed separators: not a date
     assert path_date('2026-13-45.csv') is None
 
 

@@ -42,9 +42,11 @@ BAG_FILES = ('.mcap', '.db3')
 reader, with the reason, not passed over)."""
 
 _HEAD_BYTES = 1 << 16
-_DATE = re.compile(r'(?<![0-9])(?P<y>(?:19|20)[0-9]{2})-?(?P<m>[01][0-9])-?(?P<d>[0-3][0-9])'
-                   r'(?:[T_ -]?(?P<H>[0-2][0-9])[:-]?(?P<M>[0-5][0-9])'
-                   r'(?:[:-]?(?P<S>[0-5][0-9]))?)?(?![0-9])')
+_DATE = re.compile(r'(?<![0-9])(?P<y>(?:19|20)[0-9]{2})(?P<ds>[-.]?)(?P<m>[01][0-9])(?P=ds)'
+                   r'(?P<d>[0-3][0-9])(?:[T_ -]?(?P<H>[0-2][0-9])(?P<ts>[:.-]?)(?P<M>[0-5][0-9])'
+                   r'(?:(?P=ts)(?P<S>[0-5][0-9]))?)?(?![0-9])')
+"""A date, its parts apart by '-', '.' or nothing (the same between all three), and a time
+(':', '-', '.' or nothing between its parts): 2026-03-01, 2021.07.26T10.51.44, 20260301T0830."""
 
 
 @dataclass(frozen=True)
