@@ -712,3 +712,14 @@ def test_a_bag_with_garbage_metadata_is_refused_whole_in_one_line(tmp_path):
         assert '\n' not in str(err.value)
         baseline = calibrate_baseline(motor, run)  # the first recording: refused, said
         assert baseline.get('recording') is None and 'metadata.yaml' in str(baseline), baseline
+
+
+def test_a_motor_without_a_trend_says_why():
+    """Cold review of issue 24 (finding 9): 'fewer than 3 recordings' on eight of them."""
+    from satmotor_ros.fleet.report import trend_text
+    points = [{'value': 1.0}] * 8
+    assert 'since the last step' in trend_text({'trend_per_day': None,
+                                                'leakage_factor': points})
+    assert trend_text({'trend_per_day': None, 'leakage_factor': points[:2]}) == \
+        'n/a (2 recording(s) with a figure, fewer than 3)'
+    assert trend_text({'trend_per_day': 0.06, 'leakage_factor': points}) == '+0.0600'

@@ -14,7 +14,7 @@ import numpy as np
 from satmotor_ros.cli._output import png_metadata
 from satmotor_ros.fleet.config import FLEET_PLOT, PLOTS, REPORT_JSON, REPORT_MD
 from satmotor_ros.fleet.health import RATIO
-from satmotor_ros.fleet.summary import BY_MONITOR, MIXED
+from satmotor_ros.fleet.summary import BY_MONITOR, MIN_TREND_POINTS, MIXED
 
 
 def _replace(path: Path, text: str) -> None:
@@ -111,8 +111,16 @@ def _days(value: float | None) -> str:
     return 'not drifting to it' if value is None else f'{value:.1f}'
 
 
-def _trend(value: float | None) -> str:
-    return 'n/a (fewer than 3 recordings)' if value is None else f'{value:+.4f}'
+def trend_text(motor: dict[str, Any]) -> str:
+    """Return a motor's trend per day for fleet.md, or why it has none."""
+    value = motor.get('trend_per_day')
+    if value is not None:
+        return f'{value:+.4f}'
+    n = len(motor.get('leakage_factor') or [])
+    if n < MIN_TREND_POINTS:
+        return f'n/a ({n} recording(s) with a figure, fewer than {MIN_TREND_POINTS})'
+    return (f'n/a (fewer than {MIN_TREND_POINTS} recordings since the last step, or all '
+            'at one time)')
 
 
 def markdown(motors: list[dict[str, Any]], header: dict[str, Any]) -> str:
@@ -148,7 +156,7 @@ def markdown(motors: list[dict[str, Any]], header: dict[str, Any]) -> str:
         shown = (f"{last['value']:.3f} [{last['ci95'][0]:.3f}, {last['ci95'][1]:.3f}]"
                  if last else 'none')
         lines.append(f"| {i} | {m['motor']} | {m['recordings']} | {len(m['refused'])} | "
-                     f"{shown} | {_trend(m['trend_per_day'])} | {_days(m['days_to_limit'])} | "
+                     f"{shown} | {trend_text(m)} | {_days(m['days_to_limit'])} | "
                      f"{len(m['alarms'])} |")
     for m in motors:
         lines += ['', f"## {m['motor']}", '',
@@ -321,4 +329,5 @@ def plot_fleet(path: Path, motors: list[dict[str, Any]]) -> None:
         plt.close(fig)
 
 
-__all__ = ['not_ours', 'PLOTS', 'markdown', 'plot_fleet', 'plot_motor', 'write_report']
+__all__ = ['not_ours', 'PLOTS', 'markdown', 'plot_fleet', 'plot_motor', 'trend_text',
+           'write_report']
