@@ -49,3 +49,17 @@ def recording(hours: float, seed: int = 0, rate_hz: float = 5.0, noise_lpm: floa
 def blocks(samples: HealthSamples, size: int) -> list[HealthSamples]:
     """Cut samples into blocks of `size`."""
     return [samples.take(slice(i, i + size)) for i in range(0, len(samples), size)]
+
+
+def series_csv(path, seed: int, start: float, factor: float | None = None,
+               duration_s: float = 600.0, samples: int = 3000, rate: float = 5.0) -> None:
+    """Write a water motor's synthetic time series from epoch `start`, its losses x `factor`."""
+    from satmotor_ros.fleet.synthetic import _scaled
+    from satmotor_ros.identify.synthetic import generate_series, Injection, Plan, to_columns
+    from satmotor_ros.identify.table import write_csv
+    table = generate_series(Plan(liquid='water', n_points=20, duration_s=duration_s),
+                            Injection(), seed, samples=samples, rate=rate)
+    columns = to_columns(table if factor is None else _scaled(table, factor))
+    columns['time'] = ('s', columns['time'][1] + start)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    write_csv(path, columns)

@@ -4,6 +4,7 @@
 from datetime import datetime, timezone
 import json
 
+from health_data import series_csv
 import numpy as np
 import pytest
 
@@ -295,17 +296,6 @@ def test_a_monitor_alarm_is_explained_like_the_ratios(tmp_path):
     assert alarm['what'].endswith(f"what changed: {kept['what']}")
 
 
-def _series(path, seed, start):
-    from satmotor_ros.identify.synthetic import generate_series, Injection, Plan, to_columns
-    from satmotor_ros.identify.table import write_csv
-    table = generate_series(Plan(liquid='water', n_points=20, duration_s=600.0), Injection(),
-                            seed, samples=3000, rate=5.0)
-    columns = to_columns(table)
-    columns['time'] = ('s', columns['time'][1] + start)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    write_csv(path, columns)
-
-
 def test_a_refused_monitor_step_is_reported_and_a_rerun_starts_no_cluster(tmp_path):
     """
     Cold review F4 of issue 24: monitor/ holding a user's file made the step a failed task.
@@ -324,7 +314,7 @@ def test_a_refused_monitor_step_is_reported_and_a_rerun_starts_no_cluster(tmp_pa
     from satmotor_ros.model.io.config import default_config_path
     root, out = tmp_path / 'root', tmp_path / 'out'
     for i in range(2):
-        _series(root / 'm' / f'r{i}.csv', 60 + i, EPOCH + i * DAY)
+        series_csv(root / 'm' / f'r{i}.csv', 60 + i, EPOCH + i * DAY)
     (root / 'fleet.yaml').write_text(
         f"motors: [{{pattern: 'm/**', motor: m, liquid: water, "
         f"motor_file: '{default_config_path('sm075_25.yaml')}'}}]\n")

@@ -4,6 +4,7 @@
 from datetime import datetime, timezone
 import os
 
+from health_data import series_csv
 import numpy as np
 import pytest
 
@@ -447,24 +448,13 @@ def test_a_bag_recording_is_timed_by_its_start_and_watched_by_the_health_monitor
     assert json.loads((monitor / 'monitor.json').read_text())['n_samples'] > 1000
 
 
-def _series_csv(path, seed, start):
-    from satmotor_ros.identify.synthetic import generate_series, Injection, Plan, to_columns
-    from satmotor_ros.identify.table import write_csv
-    table = generate_series(Plan(liquid='water', n_points=20, duration_s=600.0), Injection(),
-                            seed, samples=3000, rate=5.0)
-    columns = to_columns(table)
-    columns['time'] = ('s', columns['time'][1] + start)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    write_csv(path, columns)
-
-
 def test_one_monitor_runs_through_the_motors_recordings_in_time_order(tmp_path):
     from satmotor_ros.fleet.chain import monitor_step, valid_steps
     from satmotor_ros.fleet.tasks import RunOptions
     from satmotor_ros.identify.health.report import FILES
     from satmotor_ros.model.io.config import default_config_path
     for day in range(2):  # 10 min each: one alone never leaves learn_hours (0.25 h)
-        _series_csv(tmp_path / 'root' / 'm1' / f'r{day}.csv', day, EPOCH + day * 660.0)
+        series_csv(tmp_path / 'root' / 'm1' / f'r{day}.csv', day, EPOCH + day * 660.0)
     motor = discover(tmp_path / 'root', FleetConfig())[0]
     run = RunOptions(str(tmp_path / 'out'), liquid='water')
     baseline = {'coefficients': str(default_config_path('sm075_25.yaml')), 'liquid': 'water',
@@ -497,16 +487,10 @@ def test_the_monitors_trend_per_operating_hour_is_made_per_calendar_day(tmp_path
     """
     from satmotor_ros.fleet.chain import monitor_step
     from satmotor_ros.fleet.tasks import RunOptions
-    from satmotor_ros.identify.synthetic import generate_series, Injection, Plan, to_columns
-    from satmotor_ros.identify.table import write_csv
     from satmotor_ros.model.io.config import default_config_path
     for i in range(4):
-        table = generate_series(Plan(liquid='water', n_points=20, duration_s=1200.0),
-                                Injection(), 50 + i, samples=1200, rate=1.0)
-        columns = to_columns(table)
-        columns['time'] = ('s', columns['time'][1] + EPOCH + i * 7200.0)
-        (tmp_path / 'root' / 'm1').mkdir(parents=True, exist_ok=True)
-        write_csv(tmp_path / 'root' / 'm1' / f'r{i}.csv', columns)
+        series_csv(tmp_path / 'root' / 'm1' / f'r{i}.csv', 50 + i, EPOCH + i * 7200.0,
+                   duration_s=1200.0, samples=1200, rate=1.0)
     motor = discover(tmp_path / 'root', FleetConfig())[0]
     run = RunOptions(str(tmp_path / 'out'), liquid='water')
     baseline = {'coefficients': str(default_config_path('sm075_25.yaml')), 'liquid': 'water',
@@ -639,18 +623,11 @@ def test_a_monitor_alarm_on_an_epoch_clock_is_the_recordings_it_was_raised_in(tm
     leak x1.6: the change is the third recording's, as the real chain writes it.
     """
     from satmotor_ros.fleet.chain import monitor_step
-    from satmotor_ros.fleet.synthetic import _scaled
     from satmotor_ros.fleet.tasks import RunOptions
-    from satmotor_ros.identify.synthetic import generate_series, Injection, Plan, to_columns
-    from satmotor_ros.identify.table import write_csv
     from satmotor_ros.model.io.config import default_config_path
     for day in range(3):
-        table = generate_series(Plan(liquid='water', n_points=20, duration_s=600.0),
-                                Injection(), 101 + day, samples=3000, rate=5.0)
-        columns = to_columns(_scaled(table, 1.6 if day == 2 else 1.0))
-        columns['time'] = ('s', columns['time'][1] + EPOCH + day * DAY)
-        (tmp_path / 'root' / 'm1').mkdir(parents=True, exist_ok=True)
-        write_csv(tmp_path / 'root' / 'm1' / f'r{day}.csv', columns)
+        series_csv(tmp_path / 'root' / 'm1' / f'r{day}.csv', 101 + day, EPOCH + day * DAY,
+                   factor=1.6 if day == 2 else 1.0)
     motor = discover(tmp_path / 'root', FleetConfig())[0]
     run = RunOptions(str(tmp_path / 'out'), liquid='water')
     baseline = {'coefficients': str(default_config_path('sm075_25.yaml')), 'liquid': 'water',
