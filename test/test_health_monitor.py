@@ -171,12 +171,13 @@ def test_late_in_a_linear_wear_the_interval_still_holds_the_hours_to_limit() -> 
 
 
 def test_unusable_samples_are_counted_and_skipped() -> None:
-    """Non-finite, stalled and repeated samples are counted by reason, not folded in."""
+    """Non-finite, gross, stalled and repeated samples are counted by reason, not folded in."""
     samples = recording(0.2, seed=1, noise_lpm=0.0)
     flow, speed, time = samples.flow.copy(), samples.speed.copy(), samples.time.copy()
     flow[10:20] = np.nan
     flow[30:40] = 1.0  # absurd but finite: would move the factor if it were used
-    speed[30:40] = 0.0
+    speed[30:40] = 0.0  # a gross reading is implausible, stopped or not
+    speed[60:70] = 0.0
     time[50] = time[49]
     bad = dataclasses.replace(samples, flow=flow, speed=speed, time=time)
     monitor = HealthMonitor(Baseline.for_family('paszota', DISPLACEMENT),
@@ -184,9 +185,9 @@ def test_unusable_samples_are_counted_and_skipped() -> None:
     _run(bad, monitor)
     snap = monitor.snapshot()
     assert snap.skipped['non_finite'] == 10
-    assert snap.skipped['stalled'] == 10
+    assert snap.skipped['stalled'] == 10 and snap.skipped['implausible'] == 10
     assert snap.skipped['stale'] == 1
-    assert snap.n_skipped == 21 and snap.n_samples == len(samples)
+    assert snap.n_skipped == 31 and snap.n_samples == len(samples)
     assert snap.leakage_factor.value == pytest.approx(1.0, abs=1e-6)
 
 

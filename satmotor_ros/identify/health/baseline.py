@@ -37,8 +37,18 @@ within +-20 K of the reference), from the reading and three more evaluations of 
 NU_NODES = (0.25, 0.5, 1.0, 2.0)
 """Viscosity factors the model is evaluated at (1: the reading itself), [-]."""
 
-OK, STALLED, OUTSIDE_ENVELOPE, OUTSIDE_MODEL, STALE, NON_FINITE = range(6)
+OK, STALLED, OUTSIDE_ENVELOPE, OUTSIDE_MODEL, STALE, NON_FINITE, IMPLAUSIBLE = range(7)
 """Codes of :attr:`Losses.reason`, in the order of :data:`.records.SKIP_REASONS` plus OK."""
+
+GROSS = 10.0
+"""The physical envelope, in multiples of the model's validated range: a speed beyond GROSS
+times its ``speed_max``, a gauge pressure beyond GROSS times its ``dp_max``, a flow beyond
+the displacement flow at GROSS times ``speed_max`` is no reading of this motor (a broken
+message, a logger's 1e30 fill value): counted and skipped as ``implausible``, like a
+non-finite one. Real logs run to twice the range (the MBARI logs: 2x ``speed_max``), [-]."""
+
+TEMPERATURE_RANGE = (-100.0, 400.0)
+"""Oil temperatures a hydraulic liquid can have; a reading outside is implausible, [degC]."""
 
 
 @dataclass(frozen=True)
@@ -190,6 +200,35 @@ class Baseline:
         warm: FloatArray = np.einsum('ij,ji->i', weights, np.asarray(at))
         return warm
 
+    def physical(self, block: HealthSamples) -> np.ndarray:
+        """
+        Flag the samples inside the physical envelope (:data:`GROSS`), whatever their finiteness.
+
+        Parameters
+        ----------
+        block : HealthSamples
+            The samples, [-]
+
+        Returns
+        -------
+        ndarray of bool
+            False where a speed, a pressure, the flow or the temperature is gross.
+
+        """
+        valid = self.model.valid_range
+        speed_max, p_max = GROSS * valid.speed_max, GROSS * valid.dp_max
+        flow_max = speed_max * self.displacement
+        with np.errstate(invalid='ignore'):
+            inside = ((np.abs(block.speed) <= speed_max) & (np.abs(block.flow) <= flow_max)
+                      & (np.abs(block.p_in) <= p_max) & (np.abs(block.p_out) <= p_max))
+            if block.p_case is not None:
+                inside &= ~(np.abs(block.p_case) > p_max)  # a NaN case pressure: not gross
+            if block.temperature is not None:
+                low, high = TEMPERATURE_RANGE
+                inside &= ~((block.temperature < low) | (block.temperature > high))
+        result: np.ndarray = inside
+        return result
+
     def losses(self, block: HealthSamples, min_speed: float = 0.0) -> Losses:
         """
         Evaluate the measured and the baseline losses at every sample.
@@ -222,8 +261,9 @@ class Baseline:
             if self.uses_temperature:
                 finite &= np.isfinite(block.temperature)
         reason[~finite] = NON_FINITE
+        reason[finite & ~self.physical(block)] = IMPLAUSIBLE
         with np.errstate(invalid='ignore'):
-            reason[finite & (np.abs(block.speed) < min_speed)] = STALLED
+            reason[(reason == OK) & (np.abs(block.speed) < min_speed)] = STALLED
         if self.envelope is not None:
             out = outside(self.envelope, block.p_in - block.p_out, block.speed)
             reason[(reason == OK) & out] = OUTSIDE_ENVELOPE

@@ -39,7 +39,7 @@ from typing import Any
 import numpy as np
 
 from satmotor_ros.identify.errors import DataError
-from satmotor_ros.identify.health.baseline import Baseline, OK
+from satmotor_ros.identify.health.baseline import Baseline, IMPLAUSIBLE, NON_FINITE, OK
 from satmotor_ros.identify.health.detector import Cusum, DELTA_MAX, threshold_for
 from satmotor_ros.identify.health.noise import fit_variance
 from satmotor_ros.identify.health.records import (Alarm, Estimate, HealthPoint, HealthSamples,
@@ -250,7 +250,7 @@ class HealthMonitor:
         used = reason == OK
         dt = np.diff(np.concatenate([[self.t_last], time]))
         dt = np.where(np.isfinite(dt) & (dt > 0) & (dt <= self.timing.gap_s), dt, 0.0)
-        rate = self._rate(block, time)
+        rate = self._rate(block, time, np.isin(reason, (NON_FINITE, IMPLAUSIBLE)))
         if np.isfinite(time).any():
             self.t_last = float(np.nanmax(np.concatenate([[self.t_last], time])))
         alarms: list[Alarm] = []
@@ -301,9 +301,15 @@ class HealthMonitor:
         self._prune_recent()
         return alarms
 
-    def _rate(self, block: HealthSamples, time: FloatArray) -> FloatArray:
-        """Return |d(q_t n)/dt| per sample, the previous block's last sample carried, [m^3/s^2]."""
-        x = self.baseline.displacement * np.asarray(block.speed, dtype=float)
+    def _rate(self, block: HealthSamples, time: FloatArray, bad: np.ndarray) -> FloatArray:
+        """
+        Return |d(q_t n)/dt| per sample, the previous block's last sample carried, [m^3/s^2].
+
+        A `bad` sample's speed (non-finite or gross) is no speed: the rates beside it are 0,
+        as beside a NaN, so a 1e30 reading weighs on no neighbour.
+        """
+        x = self.baseline.displacement * np.where(bad, np.nan,
+                                                  np.asarray(block.speed, dtype=float))
         t_prev, x_prev = self.last_flow_rate_x
         dx = np.diff(np.concatenate([[x_prev], x]))
         dt = np.diff(np.concatenate([[t_prev], time]))
@@ -802,6 +808,8 @@ class HealthMonitor:
         state.setdefault('step_s', 0.0)  # a state saved before the bins followed the step
         for name in ('version', 'baseline'):
             state.pop(name)
+        # a state saved before a reason was counted has none of it
+        state['skipped'] = {**dict.fromkeys(SKIP_REASONS, 0), **state['skipped']}
         state['last_flow_rate_x'] = tuple(state['last_flow_rate_x'])
         state['open_bin'] = np.asarray(state['open_bin'], dtype=float)
         if 'carry' in state:

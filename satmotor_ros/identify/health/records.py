@@ -15,8 +15,10 @@ from satmotor_ros.identify.errors import DataError
 from satmotor_ros.identify.table import BenchTable
 from satmotor_ros.model._typing import FloatArray
 
-SKIP_REASONS = ('stalled', 'outside_envelope', 'outside_model', 'stale', 'non_finite')
-"""Why a sample is not used, as :attr:`HealthSnapshot.skipped` counts them."""
+SKIP_REASONS = ('stalled', 'outside_envelope', 'outside_model', 'stale', 'non_finite',
+                'implausible')
+"""Why a sample is not used, as :attr:`HealthSnapshot.skipped` counts them (``implausible``:
+a finite reading outside the physical envelope, :data:`.baseline.GROSS`)."""
 
 NEVER_HOURS = sys.float_info.max
 """``hours_to_limit`` in ``monitor.json`` when the trend does not rise towards the limit: the
