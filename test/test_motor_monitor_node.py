@@ -224,7 +224,7 @@ def test_a_state_file_that_is_not_ours_is_reported_and_never_written_over(ros, t
     executor.remove_node(node)
     node.destroy_node()
     assert foreign.read_text() == '{"mine": true}'
-    assert node.level(node.monitor.snapshot())[0] == 1
+    assert node.level(node.monitor.snapshot())[0] == 2
 
 
 def test_bad_input_and_missing_topics_are_counted_reported_and_survived(ros, recording):

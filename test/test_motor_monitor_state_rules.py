@@ -94,3 +94,32 @@ def test_a_change_that_needs_a_new_estimator_keeps_the_state_file(ros, tmp_path)
     assert json.loads(new.read_text())['settings']['trend_hours'] == 100.0
     executor.remove_node(node)
     node.destroy_node()
+
+
+def test_a_hand_edited_state_is_error_naming_the_field_and_kept(ros, tmp_path):
+    """
+    n_samples edited to text (review F7): ERROR naming it, a fresh estimator, the file kept.
+
+    It used to crash the node with a TypeError; the node now refuses to save any state over a
+    file it did not start from (doc/nodes.md), and runs on afresh.
+    """
+    context, executor, probe = ros
+    path = tmp_path / 'health.json'
+    _state(path)
+    doc = json.loads(path.read_text())
+    doc['n_samples'] = 'twelve'
+    path.write_text(json.dumps(doc))
+    before = path.read_bytes()
+    node = _node(context, executor, state_file=str(path))
+    assert node.monitor.snapshot().n_samples == 0
+    level, message = node.level(node.monitor.snapshot())
+    assert level == 2 and "n_samples = 'twelve'" in message and '\n' not in message, message
+    got = []
+    probe.create_subscription(DiagnosticArray, '/diagnostics', got.append, 10)
+    assert spin_until(executor, lambda: node.diagnose() or got)
+    assert got[-1].status[0].level == b'\x02' and 'n_samples' in got[-1].status[0].message
+    node.monitor.update(recording(0.01, seed=4, rate_hz=2, baseline=node.monitor.baseline))
+    node.save()
+    executor.remove_node(node)
+    node.destroy_node()  # saves at shutdown too
+    assert path.read_bytes() == before

@@ -20,8 +20,10 @@ The node holds no physics and no statistics: the estimator is
 :class:`satmotor_ros.identify.health.HealthMonitor`, the one ``satmotor monitor`` runs.
 With ``state_file`` its state is resumed at start and saved every ``save_period`` and at
 shutdown, whole or not at all, so hours of history survive a restart; a file that is not
-a health state, or a state made with other settings than the parameters, is reported and
-never written over, nor is ``state_file`` by a parameter change that starts a new estimator.
+a health state (edited by hand, cut short: the field is named), or a state made with other
+settings than the parameters, is ERROR, and never written over: the node runs on afresh and
+saves no state until ``state_file`` names a new file; nor is ``state_file`` written over by
+a parameter change that starts a new estimator.
 """
 
 from __future__ import annotations
@@ -184,6 +186,7 @@ class MotorMonitorNode(Node):
         self._state_note = ''  # what happened to the state file
         self._may_save = True  # False: the state file is someone else's
         self._mismatch = ''  # the resumed state's settings that differ from the parameters
+        self._refused = ''  # why the state file was not resumed (not a health state)
         self._build(values, resume=True)
         self._acknowledge()
         self._held = {name: math.nan for name in INPUTS}
@@ -252,9 +255,11 @@ class MotorMonitorNode(Node):
                                     'not resumed, not written over; starting afresh; give '
                                     'the same parameters or a new state_file')
                 self.get_logger().error(self._state_note)
-            except DataError as err:
+            except DataError as err:  # hand-edited, cut short, not ours: refused, kept
                 self._may_save = False
-                self._state_note = f'{err}; starting afresh and not saving over it'
+                self._refused = self._state_note = (
+                    f'{err}; starting afresh and saving no state (the file is kept as it is: '
+                    'give a new state_file, or mend or remove this one and restart)')
                 self.get_logger().error(self._state_note)
         self.monitor = HealthMonitor(baseline, settings)
 
@@ -309,7 +314,7 @@ class MotorMonitorNode(Node):
                 setattr(self, f'_{key.split("_")[0]}_timer',
                         self.create_timer(values[key], callback))
         if 'state_file' in names:
-            self._may_save, self._state_note, self._mismatch = True, '', ''
+            self._may_save, self._state_note, self._mismatch, self._refused = True, '', '', ''
         if 'acknowledged_alarms' in names:
             self._acknowledge()
 
@@ -545,7 +550,7 @@ class MotorMonitorNode(Node):
             return 2, self._error or 'no estimator'
         if self._problems:
             return 2, f'parameter {"; ".join(self._problems.values())}'
-        if self._mismatch:
+        if self._mismatch or self._refused:
             return 2, self._state_note
         new = snap.unacknowledged
         if new and new[-1].kind == 'change':
@@ -566,8 +571,6 @@ class MotorMonitorNode(Node):
             why = ', '.join(f'{v} {k.replace("_", " ")}' for k, v in skipped.items() if v)
             return 1, (f'not monitoring: {sum(skipped.values())} of the last {total} samples '
                        f'skipped ({why})')
-        if not self._may_save:
-            return 1, self._state_note
         if self.bad or self.out_of_order or self.no_joint:
             return 1, f'inputs refused: {self.last_bad or "joint_states out of order"}'
         why = unresolved(snap.leakage_factor, self.monitor.settings.change_fraction) \

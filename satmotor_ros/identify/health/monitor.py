@@ -44,6 +44,7 @@ from satmotor_ros.identify.health.detector import Cusum, DELTA_MAX, threshold_fo
 from satmotor_ros.identify.health.noise import fit_variance
 from satmotor_ros.identify.health.records import (Alarm, Estimate, HealthPoint, HealthSamples,
                                                   HealthSettings, HealthSnapshot, SKIP_REASONS)
+from satmotor_ros.identify.health.state import check_settings, check_state, compatible, template
 from satmotor_ros.identify.health.timing import median_step, Timing
 from satmotor_ros.identify.health.trend import Trend
 from satmotor_ros.model._typing import FloatArray
@@ -784,7 +785,7 @@ class HealthMonitor:
         try:
             state = _from_json(json.loads(Path(path).read_text(encoding='utf-8')))
         except (OSError, ValueError) as err:
-            msg = f'{path}: not a health state ({err})'
+            msg = f'{path}: not a health state (cut short, or not JSON: {err})'
             raise DataError(msg) from None
         if not isinstance(state, dict) or state.get('version') != STATE_VERSION:
             version = state.get('version') if isinstance(state, dict) else None
@@ -794,38 +795,38 @@ class HealthMonitor:
             msg = (f'{path}: baseline = {state.get("baseline")!r} in the state, '
                    f'{baseline.fingerprint!r} given: the state was made against another model')
             raise DataError(msg)
-        settings = HealthSettings(**state.pop('settings'))
+        settings = check_settings(state.pop('settings', None), str(path))
         monitor = cls(baseline, settings, explainer)
-        monitor.cusum = Cusum(**state.pop('cusum'))
+        like = template(monitor._state())
+        like.pop('settings')
+        check_state(compatible(state), like, str(path))  # names the field, or all is there
+        try:
+            monitor._restore(state)
+        except (KeyError, TypeError, ValueError, IndexError) as err:  # what the check missed
+            msg = f'{path}: not a health state ({type(err).__name__}: {err})'
+            raise DataError(msg) from None
+        return monitor
+
+    def _restore(self, state: dict[str, Any]) -> None:
+        """Take the fields of a checked state."""
+        settings = self.settings
+        self.cusum = Cusum(**state.pop('cusum'))
         trend = Trend(settings.trend_hours)
         for key, value in state.pop('trend').items():
             setattr(trend, key, value)
-        monitor.trend = trend
+        self.trend = trend
         window = [tuple(w) for w in state.pop('window')]
-        monitor.alarms = [Alarm(**a) for a in state.pop('alarms')]
-        monitor.recent.extend(_samples(b) for b in state.pop('recent'))
-        monitor.held = [_samples(b) for b in state.pop('held', [])]
-        state.setdefault('step_s', 0.0)  # a state saved before the bins followed the step
+        self.alarms = [Alarm(**a) for a in state.pop('alarms')]
+        self.recent.extend(_samples(b) for b in state.pop('recent'))
+        self.held = [_samples(b) for b in state.pop('held', [])]
         for name in ('version', 'baseline'):
             state.pop(name)
-        # a state saved before a reason was counted has none of it
-        state['skipped'] = {**dict.fromkeys(SKIP_REASONS, 0), **state['skipped']}
         state['last_flow_rate_x'] = tuple(state['last_flow_rate_x'])
-        state['open_bin'] = np.asarray(state['open_bin'], dtype=float)
-        if 'carry' in state:
-            state['carry'] = np.asarray(state['carry'], dtype=float)
-        state['trend_point'] = np.asarray(state['trend_point'], dtype=float)
-        state['noise_rate'] = [np.asarray(x, dtype=float) for x in state['noise_rate']]
-        state['noise_residual'] = [np.asarray(x, dtype=float) for x in state['noise_residual']]
         for key, value in state.items():
-            if not hasattr(monitor, key):
-                msg = f'{path}: {key}: not a field of the health state'
-                raise DataError(msg)
-            setattr(monitor, key, value)
-        if not math.isnan(monitor.step_s):
-            monitor.timing = Timing.for_step(settings, monitor.step_s)
-        monitor.window = deque(window, maxlen=monitor.timing.window_bins)
-        return monitor
+            setattr(self, key, value)
+        if not math.isnan(self.step_s):
+            self.timing = Timing.for_step(settings, self.step_s)
+        self.window = deque(window, maxlen=self.timing.window_bins)
 
 
 def _to_json(x: Any) -> Any:
