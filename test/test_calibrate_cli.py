@@ -16,8 +16,8 @@ from satmotor_ros.model.units import LPM, MPA, RPM
 FIELDS = ['liquid', 'family', 'n_points', 'effect', 'name', 'direction',
           'regressor', 'coefficient', 'ci95', 'unit',
           'error_before', 'error_after', 'error_before_with_outliers',
-          'error_after_with_outliers', 'coverage', 'effects', 'outliers', 'missed_regions',
-          'candidates', 'family_comparison', 'mode', 'mode_reason']
+          'error_after_with_outliers', 'error_over', 'coverage', 'effects', 'outliers',
+          'missed_regions', 'candidates', 'family_comparison', 'mode', 'mode_reason']
 
 
 def _csv(path, table, extra=()):

@@ -177,8 +177,10 @@ def test_a_spiked_speed_and_pressure_give_the_clean_figures_and_are_listed(tmp_p
         assert cal[key]['rmse_lpm'] == pytest.approx(clean[key]['rmse_lpm'], rel=0.02)
     listed = [(o['sample'], o['reading']) for o in cal['outliers'] if 'sample' in o]
     assert listed == [(at, 'speed'), (at + 40, 'p_in')]
-    # the summary line counts rows: a spike is of a sample, no row of this table is out
-    assert f'over {cal["n_points"]} rows of' in _errors(cal, True)
+    # the summary line counts samples: a mended speed or pressure spike leaves none out
+    assert cal['error_over'] == {'what': 'samples', 'n': cal['n_samples'],
+                                 'n_with_outliers': cal['n_samples']}
+    assert f'over {cal["n_samples"]} samples (' in _errors(cal, True)
     assert 'isolated outlier' not in _errors(cal, True)
 
 

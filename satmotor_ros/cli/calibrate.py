@@ -123,18 +123,23 @@ def calibrate_into(data: str, out: str, mode: Mode, alpha: float, folds: int,
 
 
 def _errors(summary: dict[str, Any], series: bool) -> str:
-    """Say the errors before and after and the rows they are over, outliers named apart."""
+    """Say the errors before and after and what they are over, outliers named apart."""
     before, after = summary['error_before']['rmse_lpm'], summary['error_after']['rmse_lpm']
-    n = summary['n_points']  # a spike of a reading is a sample left out before the rows
-    left_out = sum(1 for o in summary['outliers'] if 'sample' not in o)
-    unit = 'rows' if series else 'points'
-    rows = f'{n - left_out} of {n} {unit}' if left_out else f'{n} {unit}'
+    over = summary['error_over']
+    n, total = over['n'], over['n_with_outliers']
+    left_out = total - n
+    unit = over['what']
+    counted = f'{n} of {total} {unit}' if left_out else f'{n} {unit}'
+    text = f'out-of-sample RMSE of Q_vl {before:.4g} -> {after:.4g} l/min over {counted}'
     if series:
-        rows += (f' of {summary["n_samples"]} samples (mode transient: every usable sample, '
-                 'with the transient terms)')
-    text = f'out-of-sample RMSE of Q_vl {before:.4g} -> {after:.4g} l/min over {rows}'
-    if left_out:
-        text += (f'; {left_out} isolated outlier(s) left out of it, with them '
-                 f'{summary["error_before_with_outliers"]["rmse_lpm"]:.4g} -> '
+        bins = summary['error_over_bins']
+        text += (f' (mode transient: every usable sample, with the transient terms; over the '
+                 f"fit's {bins['n']} rows, means of {summary['bin_size']} sample steps, "
+                 f"{bins['error_before']['rmse_lpm']:.4g} -> "
+                 f"{bins['error_after']['rmse_lpm']:.4g} l/min)")
+    outliers = sum(1 for o in summary['outliers'] if 'sample' not in o)
+    if outliers:
+        text += (f'; {outliers} isolated outlier(s) ({left_out} {unit}) left out of it, with '
+                 f'them {summary["error_before_with_outliers"]["rmse_lpm"]:.4g} -> '
                  f'{summary["error_after_with_outliers"]["rmse_lpm"]:.4g} l/min')
     return text + samples_left_out(summary['coverage'])

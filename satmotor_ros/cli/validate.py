@@ -88,8 +88,18 @@ def validate_into(data: str, out: str, mode: Mode, options: MotorOptions, column
     return ((f'WARNING: {settled.warning}; ' if settled.warning else '')
             + f'{model.name}, set {settled.source}, effects: {result.describe_effects()}; '
             f'RMSE of Q_vl {error["rmse_lpm"]:.4g} l/min, mean {error["mean_abs_pct"]:.3g} %, '
-            f'max {error["max_abs_lpm"]:.4g} l/min over {summary["n_points"]} points{flagged}, '
+            f'max {error["max_abs_lpm"]:.4g} l/min over {_over(summary)}{flagged}, '
             f'{_refitted(summary)}; wrote {target}/validation.json, report.md, residuals.png')
+
+
+def _over(summary: Mapping[str, Any]) -> str:
+    """Say what the error is over: samples (the rows' figure beside it) or points."""
+    over = summary['error_over']
+    text = f'{over["n"]} {over["what"]}'
+    bins = summary.get('error_over_bins')
+    if bins is not None:
+        text += f' (over the {bins["n"]} rows\' means: RMSE {bins["error"]["rmse_lpm"]:.4g} l/min)'
+    return text
 
 
 def _refitted(summary: Mapping[str, Any]) -> str:

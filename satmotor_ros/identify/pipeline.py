@@ -25,6 +25,7 @@ from satmotor_ros.identify.families import compare_families, family_specs, Famil
 from satmotor_ros.identify.fit import check_identifiable, FitReport, MIN_POINTS, written
 from satmotor_ros.identify.parts import loss_parts, LossParts, predict_flow
 from satmotor_ros.identify.regions import describe, Space
+from satmotor_ros.identify.sample_error import sample_errors, SampleErrors
 from satmotor_ros.identify.selection import (at_bound, CrossValidatedSelector, Errors, Forward,
                                              Score, Selection)
 from satmotor_ros.identify.steady import (extract_steady, looks_like_series, steady_windows,
@@ -77,8 +78,9 @@ class Calibration:
     baseline: FitReport  # the model refitted without an effect
     final: FitReport  # the model refitted with every effect found (or the baseline)
     error_packaged: Errors  # the packaged model, in sample
-    error_before: Errors  # baseline, out of sample (outliers left out)
-    error_after: Errors  # with every effect, out of sample (outliers left out)
+    error_before: Errors  # baseline, out of sample (outliers left out); a time series' over
+    # every sample its rows hold (:mod:`.sample_error`)
+    error_after: Errors  # with every effect, out of sample (outliers left out), as error_before
     rows: np.ndarray | None  # row of the table each point came from (None: a time series)
     family: FamilyChoice | None = None  # the families compared (None: pinned by the user)
     mode: Mode = 'points'  # how the rows were read (never 'auto')
@@ -89,6 +91,7 @@ class Calibration:
     base: BaseFit | None = None  # the nonlinear coefficients the base fitted and kept
     coverage: dict[str, Any] = field(default_factory=dict)  # Rows.coverage
     delay: DelayFit | None = None  # the speed reading's delay (None: no time series)
+    over: SampleErrors | None = None  # the residuals at every sample (None: steady rows)
 
     @property
     def selection(self) -> Selection:
@@ -124,9 +127,46 @@ class Calibration:
         return ~self.forward.outliers
 
     def errors(self, score: Score) -> Errors:
-        """Return a score's out-of-sample errors at the points that are not outliers."""
+        """Return a score's out-of-sample errors at the points (or samples) not outliers."""
+        step = next((i for i, s in enumerate(self.found, 1) if s is score),
+                    0 if score is self.selection.baseline else None)
+        if self.over is not None and step is not None:
+            return self.over.errors(step, self.forward.outliers)
+        return self.row_errors(score)
+
+    def row_errors(self, score: Score) -> Errors:
+        """Return a score's out-of-sample errors over the rows the fit reads, outliers left out."""
         at = self.inliers
         return Errors.of(score.cv_error[at], self.parts.loss[at])
+
+    def error_over(self) -> dict[str, Any]:
+        """
+        Say what the errors are over; a time series' also gives the figures over its rows.
+
+        Returns
+        -------
+        dict
+            ``error_over``: ``what`` ('samples', 'steady windows' or 'points'), ``n``
+            (those the errors are over, outliers left out) and ``n_with_outliers``; in
+            transient mode also ``error_over_bins``: the same four errors over the rows
+            (the bins' means the fit reads), with ``n`` and ``n_with_outliers`` rows.
+
+        """
+        outliers = self.forward.outliers
+        if self.over is None:
+            what = 'steady windows' if self.mode == 'series' else 'points'
+            return {'error_over': {'what': what, 'n': int(np.count_nonzero(~outliers)),
+                                   'n_with_outliers': len(self.parts)}}
+        loss, at = self.parts.loss, self.inliers
+        before, after = self.selection.baseline.cv_error, self.forward.final.cv_error
+        return {'error_over': {'what': 'samples', 'n': int(self.over.kept(outliers).sum()),
+                               'n_with_outliers': int(self.over.kept().sum())},
+                'error_over_bins': {
+                    'n': int(at.sum()), 'n_with_outliers': len(self.parts),
+                    'error_before': Errors.of(before[at], loss[at]).as_dict(),
+                    'error_after': Errors.of(after[at], loss[at]).as_dict(),
+                    'error_before_with_outliers': Errors.of(before, loss).as_dict(),
+                    'error_after_with_outliers': Errors.of(after, loss).as_dict()}}
 
     def effect_rows(self) -> list[dict[str, Any]]:
         """
@@ -267,6 +307,7 @@ class Calibration:
             'error_before': self.error_before.as_dict(),
             'error_after': self.error_after.as_dict(),
             **self.with_outliers(),
+            **self.error_over(),
             'coverage': self.coverage,
             'effects': effects, 'outliers': self.outlier_rows(),
             'missed_regions': self.missed_regions(),
@@ -287,10 +328,14 @@ class Calibration:
         dict
             ``error_before_with_outliers`` and ``error_after_with_outliers``: out of
             sample as ``error_before`` and ``error_after``, over every row (every
-            steady point, window or bin of samples) instead of the rows that are not
-            outliers.
+            steady point or window; a time series' every sample) instead of those that
+            are not outliers (the samples of an outlier row included).
 
         """
+        if self.over is not None:
+            last = len(self.found)
+            return {'error_before_with_outliers': self.over.errors(0).as_dict(),
+                    'error_after_with_outliers': self.over.errors(last).as_dict()}
         loss = self.parts.loss
         return {'error_before_with_outliers':
                 Errors.of(self.selection.baseline.cv_error, loss).as_dict(),
@@ -661,14 +706,20 @@ def calibrate(table: BenchTable, liquid: str = 'oil', spec: MotorSpec | None = N
     index = np.flatnonzero(at)
     inflation = selector.inflation(parts, forward.final.fit, forward.sigma, index)
     base_inflation = selector.inflation(parts, first.baseline.fit, forward.sigma, index)
+    errors = (Errors.of(packaged_error[at], parts.loss[at]),
+              Errors.of(first.baseline.cv_error[at], parts.loss[at]),
+              Errors.of(forward.final.cv_error[at], parts.loss[at]))
+    over = None
+    if samples is not None:  # the figures over every sample, not over the bins (DESIGN.md)
+        over = sample_errors(model, samples, parts, (first.baseline, *forward.found))
+        last = len(forward.found)
+        errors = (over.errors(-1, forward.outliers), over.errors(0, forward.outliers),
+                  over.errors(last, forward.outliers))
     return Calibration(liquid, spec, model, points, parts, law, tuple(candidates),
                        tuple(skipped), forward, first.baseline.fit.report(base_inflation),
-                       forward.final.fit.report(inflation),
-                       Errors.of(packaged_error[at], parts.loss[at]),
-                       Errors.of(first.baseline.cv_error[at], parts.loss[at]),
-                       Errors.of(forward.final.cv_error[at], parts.loss[at]), rows, choice,
+                       forward.final.fit.report(inflation), *errors, rows, choice,
                        read.mode, read.reason, samples, inflation,
-                       options.n_folds, base, read.coverage, delay)
+                       options.n_folds, base, read.coverage, delay, over)
 
 
 def _with_delay(spec: MotorSpec, liquid: str, table: BenchTable,

@@ -375,7 +375,7 @@ def _refitted(cal: Calibration, step: int) -> str:
     if step < 2:
         return ''
     baseline, found = cal.forward.steps[step - 1].baseline, cal.found[:step - 1]
-    table = cal.errors(found[-1]).rmse_lpm
+    table = cal.row_errors(found[-1]).rmse_lpm  # the verdicts' figures are over the rows
     if abs(baseline.rmse / LPM - table) <= SAME_FIGURE * table:
         return ''
     left_out = cal.forward.steps[step - 1].left_out
@@ -385,8 +385,14 @@ def _refitted(cal: Calibration, step: int) -> str:
     return (f" **Not the table's figures:** this step refits {effects} under its own noise "
             f'weights and judges against that refit over its {rows} rows, plain RMSE '
             f"{baseline.rmse / LPM:.4g} l/min ({same_rows:.4g} over the table's rows), where "
-            f'the table gives {table:.4g} l/min for the same effects as fitted at step '
+            f'{"the rows give" if cal.over is not None else "the table gives"} {table:.4g} '
+            f'l/min for the same effects as fitted at step '
             f'{step - 1} (the model written)')
+
+
+def _samples(cal: Calibration) -> int:
+    """Return the samples the errors are over (a time series read with every sample)."""
+    return int(cal.over.kept(cal.forward.outliers).sum()) if cal.over is not None else 0
 
 
 def _steps(cal: Calibration) -> list[str]:
@@ -405,12 +411,18 @@ def _steps(cal: Calibration) -> list[str]:
     header = ['model', 'RMSE [l/min]', 'mean abs [% of mean Q_vl]', 'max abs [l/min]']
     return lines + ['', _table(rows, header), '',
                     'Errors are of the volumetric losses Q_vl = Q - q_t n, out of sample '
-                    f'({min(cal.n_folds, len(cal.parts))}-fold cross-validation), at the points '
-                    'that are not outliers: the plain figures a user reads. The selection '
+                    f'({min(cal.n_folds, len(cal.parts))}-fold cross-validation), '
+                    + (f'at every sample the rows hold ({_samples(cal)} samples, those of '
+                       'an outlier row left out; a sample takes the fit '
+                       "that did not see its row's fold)" if cal.over is not None else
+                       'at the points that are not outliers')
+                    + ': the plain figures a user reads. The selection '
                     'chooses by another figure, the cross-validated error of the residuals '
                     "weighted by the noise model and passed through Huber's loss (the "
                     "candidates' table below), and keeps an effect only if the plain RMSE "
-                    'falls too.']
+                    'falls too' + (" (both over the rows the fit reads, the bins' means: the "
+                                   "verdicts' figures are those of `error_over_bins`)"
+                                   if cal.over is not None else '') + '.']
 
 
 def _outliers(cal: Calibration, summary: dict[str, Any]) -> list[str]:

@@ -3,7 +3,8 @@
 Where the model misses: the residual over every row as a map of signed dp and speed.
 
 The report's ``residual_map.png`` shows, before and after the effects, the out-of-sample
-residual of every row (every steady point, window or bin of samples; outliers included)
+residual of every row (every steady point or window; a time series' every sample, outliers
+included, :mod:`.sample_error`)
 coloured on a map of the signed drop and the signed speed, so that a knee (a valve that
 opens at the top of the drop in one direction) or a corner shows at a glance; below,
 the residual's mean in bins of the signed drop and of the signed speed. The module also
@@ -73,6 +74,21 @@ def _profile(ax: Any, x: FloatArray, residuals: dict[str, FloatArray], label: st
     ax.legend(fontsize=7)
 
 
+def _residuals(cal: Calibration) -> tuple[FloatArray, ...]:
+    """Return dp [MPa], n [rpm], the residual before and after [m^3/s] and the outliers."""
+    if cal.over is None:
+        p = cal.parts
+        return (p.sign * p.dp / MPA, p.rotation * p.speed / RPM,
+                measured_frame(cal, cal.selection.baseline.cv_error),
+                measured_frame(cal, cal.forward.final.cv_error), cal.forward.outliers)
+    data = cal.over.data
+    p, at = data.parts, cal.over.kept()
+    sign = np.asarray(p.sign) * np.ones(len(data))
+    return ((sign * p.dp / MPA)[at], (p.rotation * p.speed / RPM)[at],
+            (sign * cal.over.residual[0])[at], (sign * cal.over.residual[-1])[at],
+            cal.forward.outliers[data.row][at])
+
+
 def plot_residual_map(cal: Calibration, path: Path) -> None:
     """
     Plot the residual over every row against signed dp and n, before and after the effects.
@@ -88,11 +104,7 @@ def plot_residual_map(cal: Calibration, path: Path) -> None:
     import matplotlib
     matplotlib.use('Agg')  # file only, as the report's other plots
     from matplotlib import pyplot as plt
-    p = cal.parts
-    dp = p.sign * p.dp / MPA
-    n = p.rotation * p.speed / RPM
-    before = measured_frame(cal, cal.selection.baseline.cv_error)
-    after = measured_frame(cal, cal.forward.final.cv_error)
+    dp, n, before, after, isolated = _residuals(cal)
     limit = float(np.quantile(np.abs(np.concatenate([before, after])), 0.98)) / LPM
     limit = limit if limit > 0.0 else 1.0
     found = ' + '.join(s.label for s in cal.found) or 'no effect found'
@@ -100,7 +112,6 @@ def plot_residual_map(cal: Calibration, path: Path) -> None:
     drawn = _map(axes[0, 0], dp, n, before / LPM, limit, 'before: the model fitted without '
                  'an effect')
     _map(axes[0, 1], dp, n, after / LPM, limit, f'after: {found}'[:70])
-    isolated = cal.forward.outliers
     for ax in axes[0]:
         ax.plot(dp[isolated], n[isolated], 'x', color='k', ms=4, mew=0.8,
                 label='isolated outlier' if isolated.any() else None)
@@ -112,10 +123,10 @@ def plot_residual_map(cal: Calibration, path: Path) -> None:
     profiles = {'before': before, 'after': after} if cal.found else {'no effect': before}
     _profile(axes[1, 0], dp, profiles, 'dp = p_in - p_out [MPa]')
     _profile(axes[1, 1], n, profiles, 'n [rpm]')
-    what = (f'{len(p)} bins of {cal.samples.n_samples} samples' if cal.samples is not None
-            else f'{len(p)} rows')
-    fig.suptitle(f'Residual over every row ({what}, outliers included), by signed drop '
-                 'and speed', fontsize=11)
+    what = (f'{dp.size} samples, in {len(cal.parts)} rows' if cal.over is not None
+            else f'{dp.size} rows')
+    fig.suptitle(f'Residual over every {"sample" if cal.over is not None else "row"} ({what}, '
+                 'outliers included), by signed drop and speed', fontsize=11)
     fig.savefig(path, dpi=80)
     plt.close(fig)
 
@@ -138,7 +149,8 @@ def coverage_section(cal: Calibration, summary: dict[str, Any]) -> list[str]:
 
     """
     cov = summary['coverage']
-    lines = ['## Coverage and the error over every row', '',
+    over = summary['error_over']
+    lines = [f'## Coverage and the error over every {over["what"].removesuffix("s")}', '',
              f'Mode `{cal.mode}`: {cal.mode_reason}. The fit used {cov["samples_used"]} of '
              f'{cov["samples_total"]} samples ({100 * cov["fraction"]:.0f} %)'
              + (f', spanning {100 * cov["envelope_share"]:.0f} % of the operating envelope'
@@ -156,8 +168,10 @@ def coverage_section(cal: Calibration, summary: dict[str, Any]) -> list[str]:
               'max abs, outliers included |', '| --- | --- | --- | --- | --- |']
     lines += [f'| {name} | {a["rmse_lpm"]:.4g} | {a["max_abs_lpm"]:.4g} | {b["rmse_lpm"]:.4g} | '
               f'{b["max_abs_lpm"]:.4g} |' for name, a, b in rows]
-    lines += ['', 'Out of sample (cross-validated), over every row the fit used; the second '
-              'pair of figures includes the isolated outliers listed below.', '']
+    lines += ['', f'Out of sample (cross-validated), over the {over["n"]} {over["what"]} the '
+              f'fit used that are not in an outlier; the second pair of figures is over all '
+              f'{over["n_with_outliers"]}, the isolated outliers listed below included.', '']
+    lines += _bins_lines(summary)
     missed = summary['missed_regions']
     if not missed:
         return lines + ['No region of the operating space or of time where the final model '
@@ -176,6 +190,32 @@ def coverage_section(cal: Calibration, summary: dict[str, Any]) -> list[str]:
                      + f' | {r["mean_residual_lpm"]:+.4g} |')
     return lines + ['', 'See `residual_map.png`: where the map stays coloured after the '
                     'effects, the model lacks something.', '']
+
+
+def _bins_lines(summary: dict[str, Any]) -> list[str]:
+    """Give a time series' errors over the rows the fit reads (bins' means) beside the samples'."""
+    bins = summary.get('error_over_bins')
+    if bins is None:
+        return []
+    b, a = bins['error_before'], bins['error_after']
+    before, after = summary['error_before'], summary['error_after']
+    worse = []
+    if after['rmse_lpm'] >= before['rmse_lpm'] and summary['effects']:
+        worse = [f'**Over every sample the effects found do not lower the error** '
+                 f'({before["rmse_lpm"]:.4g} -> {after["rmse_lpm"]:.4g} l/min, max '
+                 f'{before["max_abs_lpm"]:.4g} -> {after["max_abs_lpm"]:.4g}): they were '
+                 "chosen over the rows (the bins' means), where they cut it; at single "
+                 'samples, which reach beyond the means, they miss by more than they gain '
+                 '(the map below shows where).', '']
+    ratio = after['rmse_lpm'] / max(a['rmse_lpm'], 1e-300)
+    return worse + [
+        f'The fit reads the samples as {bins["n_with_outliers"]} rows, each the mean over a '
+        f'short bin ({summary["bin_size"]} sample steps); over the {bins["n"]} rows that are '
+        f'not outliers the same errors are {b["rmse_lpm"]:.4g} -> {a["rmse_lpm"]:.4g} l/min '
+        f'(max {b["max_abs_lpm"]:.4g} -> {a["max_abs_lpm"]:.4g}; `error_over_bins`). A '
+        "row's mean averages out the sensors' noise and the fast motion within its bin, "
+        f'which the samples keep: the figures over every sample are {ratio:.3g} times those '
+        'over the rows after the effects.', '']
 
 
 REGIONS_SHOWN = 8

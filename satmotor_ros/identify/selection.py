@@ -125,6 +125,8 @@ class Score:
     cv_rmse: float  # noise-weighted, robust cross-validated error [m^3/s]
     p_value: float  # F-test against the step's baseline (1 for the baseline) [-]
     rmse: float = np.nan  # plain out-of-sample RMSE over the rows fitted [m^3/s]
+    folds: tuple[tuple[np.ndarray, FloatArray], ...] = ()  # each fold's test points and
+    # the parameters fitted without them (:meth:`LossFit.without`): what predicted them
 
     @property
     def label(self) -> str:
@@ -347,9 +349,11 @@ class CrossValidatedSelector:
                 parts, index, baseline.fit.u_)
             full = own if own.objective_ < full.objective_ else full
         error = parts.flow - full.predict(parts)  # out of sample where not fitted
+        tested = []
         for test in folds(index.size, self.n_folds, self.time_ordered, self.seed, self.block):
             u = full.without(_guarded(test, self.guard, index.size))
             error[index[test]] = parts.flow[index[test]] - full.predict(parts, index[test], u)
+            tested.append((index[test], u))
         z = error[index] / sigma[index]
         cv = float(np.sqrt(np.mean(huber_rho(z)) * np.mean(sigma[index] ** 2)))
         p_value = 1.0
@@ -369,7 +373,7 @@ class CrossValidatedSelector:
                 p_value = 0.0
         rmse = float(np.sqrt(np.mean(error[index] ** 2)))
         return Score(effects[-1] if baseline is not None else None, full, error, cv, p_value,
-                     rmse)
+                     rmse, tuple(tested))
 
     def inflation(self, parts: LossParts, fit: LossFit, sigma: FloatArray,
                   index: np.ndarray) -> float:

@@ -148,6 +148,7 @@ class Samples:
     spike_scale: np.ndarray = field(default_factory=lambda: np.zeros(0))  # the robust
     # scale of that reading's departures [SI unit of the reading]
     spike_channel: tuple[str, ...] = ()  # the reading of each: 'flow', 'speed', 'p_in', 'p_out'
+    first: np.ndarray | None = None  # the first raw sample of each stretch without a gap [-]
 
     guard = 1
     """Rows a test fold keeps out of training on each side: neighbours share a sample."""
@@ -617,7 +618,7 @@ def transient_samples(model: MotorModel, table: BenchTable,
     correlation = float(np.corrcoef(lags[0], lags[1])[0, 1]) if len(lags) == 2 else np.nan
     return Samples(rows, parts, n_samples, size, step, n_segments, tuple(left_out),
                    correlation, table, usable, (a, b), held, found.at, found.size,
-                   found.scale, found.channel)
+                   found.scale, found.channel, first)
 
 
 SPIKE_HALF = 3

@@ -14,7 +14,9 @@ Points the model flags invalid are left out; points it flags EXTRAPOLATED
 (outside its validated range, or an effect evaluated outside the data it was
 fitted on) are kept and counted.
 
-On a time series read with every sample, the bench's transient terms (line
+On a time series read with every sample the error is over every sample the rows hold
+(:mod:`.sample_error`), the error over the rows' means beside it (``error_over_bins``);
+the bench's transient terms (line
 compliance, sensor lags) are the calibration's own, read from the motor file's
 ``dynamics`` and applied unchanged, so the headline error stays out of sample;
 a file without them gives the error without transient terms as the headline and
@@ -32,18 +34,17 @@ import numpy as np
 from satmotor_ros.identify.coverage import outside
 from satmotor_ros.identify.delay import shifted
 from satmotor_ros.identify.effects import CalibratedModel
-from satmotor_ros.identify.errors import DataError, IdentificationError
+from satmotor_ros.identify.errors import IdentificationError
 from satmotor_ros.identify.parts import loss_parts, LossParts
 from satmotor_ros.identify.pipeline import is_series, Mode, Options, read_rows
+from satmotor_ros.identify.predicted import bare, predicted
+from satmotor_ros.identify.sample_error import sample_data, SampleData
 from satmotor_ros.identify.selection import Errors
 from satmotor_ros.identify.steady import SteadyTolerance
 from satmotor_ros.identify.table import BenchTable
 from satmotor_ros.identify.transient import averaged, parts_at, Samples, TransientOptions
 from satmotor_ros.model import MotorModel
 from satmotor_ros.model._typing import FloatArray
-from satmotor_ros.model.effects import Effect, flow_reading, kind_of
-from satmotor_ros.model.engine.valves import Valves
-from satmotor_ros.model.results import PointStatus
 
 
 @dataclass(frozen=True)
@@ -65,6 +66,7 @@ class Validation:
     transient: dict[str, Any] | None = None  # how the transient terms entered `error`
     in_sample: Errors | None = None  # the error after fitting them on these data (2nd figure)
     delay: dict[str, Any] | None = None  # the calibration's speed delay, as applied
+    over_bins: dict[str, Any] | None = None  # a time series': the error over its rows' means
 
     def describe_effects(self) -> str:
         """Return the effects' names, comma-separated, or ``'none'``."""
@@ -77,7 +79,9 @@ class Validation:
         Returns
         -------
         dict
-            n_points and error first, then the liquid, motor, effects, source,
+            n_points and error first (over every sample on a time series read with every
+            sample; ``error_over`` says what over, and ``error_over_bins`` gives the error
+            over the rows' means beside it), then the liquid, motor, effects, source,
             n_flagged (every point or row the model flags), n_invalid (those left
             out: the model flags them invalid) and n_extrapolated (those kept but
             flagged EXTRAPOLATED: outside the validated range or an effect's fitted
@@ -95,7 +99,11 @@ class Validation:
             transient['speed_delay'] = self.delay
         if self.in_sample is not None:
             transient['error_transient_fitted_in_sample'] = self.in_sample.as_dict()
-        return {'n_points': len(self.parts), 'error': self.error.as_dict(), **transient,
+        over = {'error_over': {'what': 'samples' if self.over_bins else 'points',
+                               'n': len(self.parts)}}
+        if self.over_bins is not None:
+            over['error_over_bins'] = self.over_bins
+        return {'n_points': len(self.parts), 'error': self.error.as_dict(), **over, **transient,
                 'liquid': self.liquid, 'motor': self.model.name,
                 'effects': list(self.effects), 'data': self.table.source,
                 'n_flagged': self.invalid + self.extrapolated, 'n_invalid': self.invalid,
@@ -103,18 +111,6 @@ class Validation:
                 'outside_calibrated_envelope': self.outside or {
                     'samples': None, 'of': None, 'share': None,
                     'note': 'the motor file holds no calibrated envelope (coverage)'}}
-
-
-def _bare(model: MotorModel) -> MotorModel:
-    """Return `model` without its effects: it only places the points (dp_i, usable rows)."""
-    return _with(model, ())
-
-
-def _with(model: MotorModel, effects: tuple[Effect, ...]) -> MotorModel:
-    """Return `model` with only `effects`."""
-    coefficient_set = replace(model.coefficient_set, effects=effects)
-    return MotorModel(model.geometry, coefficient_set, model.valid_range, model.liquid,
-                      model.displacement_law, model.name)
 
 
 def validate(table: BenchTable, model: MotorModel, liquid: str, mode: Mode = 'auto',
@@ -174,20 +170,20 @@ def validate(table: BenchTable, model: MotorModel, liquid: str, mode: Mode = 'au
         table, lost = shifted(table, speed_delay, options.transient.gap)
         delay = {'seconds': speed_delay, 'samples_unserved': lost,
                  'note': "the calibration's delay of the speed reading, applied unchanged"}
-    read = read_rows(_bare(model), table, options, check=False)
+    read = read_rows(bare(model), table, options, check=False)
     beyond = _outside(calibrated, table)
     if read.samples is not None:
         return replace(_validate_samples(read.samples, model, liquid, dynamics),
                        coverage=read.coverage, outside=beyond, delay=delay)
     points = read.table
-    parts, usable = loss_parts(_bare(model), points)
+    parts, usable = loss_parts(bare(model), points)
     if not usable.all():
         points = points.select(usable, f'left out {int((~usable).sum())} points outside the '
                                        'model (no flow the model can give, or a chamber '
                                        'drop out of range)')
     evaluated = CalibratedModel(model)
-    predicted, extrapolated = _predicted(evaluated, points, parts)
-    flagged = ~np.isfinite(predicted)
+    flow, extrapolated = predicted(evaluated, points, parts)
+    flagged = ~np.isfinite(flow)
     if flagged.all():
         msg = f'{points.source}: the model flags every point invalid'
         raise IdentificationError(msg)
@@ -195,10 +191,10 @@ def validate(table: BenchTable, model: MotorModel, liquid: str, mode: Mode = 'au
         keep = ~flagged
         points = points.select(keep, f'left out {int(flagged.sum())} points the model flags '
                                      'invalid (its status is not OK there)')
-        parts, _ = loss_parts(_bare(model), points)
-        predicted, extrapolated = predicted[keep], extrapolated[keep]
+        parts, _ = loss_parts(bare(model), points)
+        flow, extrapolated = flow[keep], extrapolated[keep]
     points = _note_extrapolated(points, int(extrapolated.sum()), 'points')
-    residual = parts.flow - predicted
+    residual = parts.flow - flow
     return Validation(liquid, model, points, parts, residual, Errors.of(residual, parts.loss),
                       tuple(evaluated.describe()), int(flagged.sum()), int(extrapolated.sum()),
                       read.coverage, beyond, flagged=extrapolated)
@@ -224,76 +220,52 @@ def _note_extrapolated(points: BenchTable, count: int, what: str) -> BenchTable:
         'data it was fitted on (its fitted_range)',))
 
 
-def _predicted(calibrated: CalibratedModel, points: BenchTable,
-               parts: LossParts) -> tuple[FloatArray, np.ndarray]:
-    """
-    Predict the flow reading in each row's frame (as ``parts.flow``); which are EXTRAPOLATED.
-
-    The motor is evaluated at the chamber drop the calibration uses; a valve across the
-    ports (:mod:`~satmotor_ros.model.engine.valves`) at the measured port drop, as the calibration
-    fitted it: through the chamber drop the model would place the valve at the port drop
-    of the motor's own flow, lower than the one measured by the channel drop of the valve's
-    flow, where a relief valve's steep law passes a fraction of what it passes.
-    """
-    channels = {**points.channels, 'p_in': points.p_in, 'p_out': points.p_out}
-    model = calibrated.model
-    missing = [name for name in model.channels if name not in channels]
-    if missing:
-        msg = (f'{points.source}: no {", ".join(missing)} column, which the effects of '
-               f'{model.name} need')
-        raise DataError(msg)
-    valves = Valves(model.effects)
-    if valves:
-        kept = tuple(e for e in model.effects if not kind_of(e).bypass)
-        calibrated = CalibratedModel(_with(model, kept))
-    # the model takes the signed row; the parts hold it where its loss runs forward
-    at = calibrated.points(model.true_speed(parts.rotation * parts.speed), channels,
-                           dp_i=parts.sign * parts.dp_i)
-    flow, extrapolated = at.flow, (at.status & int(PointStatus.EXTRAPOLATED)) != 0
-    if valves:
-        port = parts.sign * parts.dp
-        opened = [valves.flow(float(x)) for x in port]
-        flow = flow + np.array([v for v, _ in opened])
-        extrapolated = extrapolated | np.array([f for _, f in opened], dtype=bool)
-    return parts.sign * flow_reading(model.effects, flow), extrapolated
-
-
 def _validate_samples(samples: Samples, model: MotorModel, liquid: str,
                       dynamics: dict[str, float] | None) -> Validation:
     """
-    Hold the model against a time series' rows, as a calibration in transient mode reads them.
+    Hold the model against every sample a time series' rows hold (:mod:`.sample_error`).
 
-    The model is evaluated at every usable sample and averaged over the rows' bins; the
-    bench's transient terms (line compliance, sensor lags) are the calibration's
-    (`dynamics`), applied unchanged, or none; nothing is fitted for the headline error
-    (:func:`_transient_terms`).
+    The model is evaluated at every sample; the bench's transient terms (line compliance,
+    sensor lags) are the calibration's (`dynamics`), applied unchanged at each sample, or
+    none; nothing is fitted for the headline error (:func:`_transient_terms`). The same
+    error over the rows (the bins' means a calibration fits) is kept as ``over_bins``.
     """
-    raw = samples.samples
-    keep = raw.select(samples.usable)
-    at_samples, _ = loss_parts(_bare(model), keep)
+    data = sample_data(model, samples)
     calibrated = CalibratedModel(model)
-    predicted, extrapolated = np.full(len(raw), np.nan), np.zeros(len(raw))
-    predicted[samples.usable], flags = _predicted(calibrated, keep, at_samples)
-    extrapolated[samples.usable] = flags
-    residual = samples.parts.flow - averaged(samples, predicted)
-    good = np.isfinite(residual)
-    outside = averaged(samples, extrapolated) > 0.0  # a row with any sample flagged
+    predicted_flow, extrapolated = predicted(calibrated, data.table, data.parts)
+    good = np.isfinite(predicted_flow)
     if not good.any():
-        msg = f'{raw.source}: the model flags every sample invalid'
+        msg = f'{samples.samples.source}: the model flags every sample invalid'
         raise IdentificationError(msg)
-    points, parts = samples.table, samples.parts
+    bins = _over_bins(samples, data, predicted_flow, dynamics)
+    points, parts = data.table, data.parts
     if not good.all():
-        points = points.select(good, f'left out {int((~good).sum())} rows where the model '
-                                     'flags a sample invalid')
+        points = points.select(good, f'left out {int((~good).sum())} samples the model flags '
+                                     'invalid (its status is not OK there)')
         parts = parts_at(parts, good)
-    residual, outside = residual[good], outside[good]
-    points = _note_extrapolated(points, int(outside.sum()), 'rows')
+    residual, extrapolated = (parts.flow - predicted_flow[good]), extrapolated[good]
+    points = _note_extrapolated(points, int(extrapolated.sum()), 'samples')
     headline, transient, in_sample = _transient_terms(residual, parts, dynamics)
     points = replace(points, notes=points.notes + (transient['note'],))
     return Validation(liquid, model, points, parts, headline, Errors.of(headline, parts.loss),
-                      tuple(calibrated.describe()), int((~good).sum()), int(outside.sum()),
-                      flagged=outside, transient=transient,
-                      in_sample=None if in_sample is None else Errors.of(in_sample, parts.loss))
+                      tuple(calibrated.describe()), int((~good).sum()), int(extrapolated.sum()),
+                      flagged=extrapolated, transient=transient,
+                      in_sample=None if in_sample is None else Errors.of(in_sample, parts.loss),
+                      over_bins=bins)
+
+
+def _over_bins(samples: Samples, data: SampleData, predicted_flow: FloatArray,
+               dynamics: dict[str, float] | None) -> dict[str, Any]:
+    """Return the headline error over the rows: each row's mean of the predictions."""
+    full = np.full(len(samples.samples), np.nan)
+    full[data.index] = predicted_flow * data.parts.sign
+    residual = samples.parts.flow - averaged(samples, full) * samples.parts.sign
+    good = np.isfinite(residual)
+    for name, value in (dynamics or {}).items():
+        if name in samples.parts.nuisance:
+            residual = residual - value * samples.parts.nuisance[name]
+    return {'n': int(good.sum()),
+            'error': Errors.of(residual[good], samples.parts.loss[good]).as_dict()}
 
 
 def _transient_terms(residual: FloatArray, parts: LossParts,

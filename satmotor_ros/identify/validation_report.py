@@ -63,11 +63,31 @@ def _transient_lines(summary: dict[str, Any]) -> list[str]:
     return [' '.join(lines), '']
 
 
+def _over(summary: dict[str, Any]) -> str:
+    """Say what the error is over."""
+    over = summary['error_over']
+    if over['what'] == 'samples':
+        return f'{over["n"]} samples (every usable sample the rows hold)'
+    return f'{over["n"]} steady operating points'
+
+
+def _bins_line(summary: dict[str, Any]) -> str:
+    """Give the error over the rows' means of a time series, or ''."""
+    bins = summary.get('error_over_bins')
+    if bins is None:
+        return ''
+    e = bins['error']
+    return (f' Over the {bins["n"]} rows (the means over short bins of samples that a '
+            f'calibration fits) the same model gives RMSE {e["rmse_lpm"]:.4g} l/min, max '
+            f'{e["max_abs_lpm"]:.4g} l/min: the noise a row averages out is in the figure '
+            'above.')
+
+
 def _report(val: Validation, summary: dict[str, Any]) -> str:
     """Return ``report.md``'s text."""
     err = val.error
     lines = [f'# Validation of {val.model.name} on {val.liquid}', '',
-             f'Data: `{portable(val.table.source)}`, {len(val.parts)} steady operating points. '
+             f'Data: `{portable(val.table.source)}`, {_over(summary)}. '
              f'Effects in the model: {val.describe_effects()}.']
     lines += [f'- {note}' for note in val.table.notes]
     lines += ['', '## Error', '',
@@ -75,8 +95,9 @@ def _report(val: Validation, summary: dict[str, Any]) -> str:
               '| --- | --- | --- |',
               f'| {err.rmse_lpm:.4g} | {err.mean_abs_pct:.3g} | {err.max_abs_lpm:.4g} |', '',
               'Errors are of the volumetric losses Q_vl = Q - q_t n, measured minus predicted, '
-              'computed as `satmotor calibrate` computes them, with nothing refitted: the '
-              'whole table is out of sample for the model. Compare the RMSE with the '
+              f'over every {summary["error_over"]["what"][:-1]} used, computed as `satmotor '
+              'calibrate` computes them, with nothing refitted: the whole table is out of '
+              f'sample for the model.{_bins_line(summary)} Compare the RMSE with the '
               "calibration's `error_after` (and the sensor noise): much larger, or a trend "
               'in the plots below, means the calibration no longer holds.', '',
               *_transient_lines(summary),
