@@ -29,7 +29,7 @@ def _calibration(step_rmse, table_rmse, rows=10):
     found = (SimpleNamespace(),)
     return SimpleNamespace(
         forward=SimpleNamespace(steps=(first, second)), found=found,
-        errors=lambda score: SimpleNamespace(rmse_lpm=table_rmse),
+        row_errors=lambda score: SimpleNamespace(rmse_lpm=table_rmse), over=None,
         inliers=~left_out, effects=lambda: (VALVE,))
 
 
