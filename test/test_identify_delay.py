@@ -11,11 +11,14 @@ import numpy as np
 import pytest
 from satmotor_ros.cli.main import main
 from satmotor_ros.identify.calibrated import Calibrated
+from satmotor_ros.identify import delay
 from satmotor_ros.identify.delay import fit_delay, shifted
 from satmotor_ros.identify.errors import DataError
+from satmotor_ros.identify import pipeline
 from satmotor_ros.identify.pipeline import calibrate, Options, read_rows
 from satmotor_ros.identify.semireal import (build_case, estimate_noise, F11_5, FlowLag,
                                             load_trajectory, realistic, write_mbari_log)
+from satmotor_ros.identify.synthetic import first_order
 from satmotor_ros.identify.table import BenchTable
 from satmotor_ros.model import MotorModel
 from satmotor_ros.model.families.defaults import default_motor
@@ -33,12 +36,12 @@ def _trajectory():
     return load_trajectory(data_path('real', 'mbari_pto', STEPPED))
 
 
-def _case(effects=(), delay=0.0, seed=0, span=SPAN):
+def _case(effects=(), delay=0.0, seed=0, span=SPAN, bad_rows=0):
     whole = _trajectory()
     trajectory = whole.crop(*span, 2)
     case = build_case(trajectory, [realistic(k, trajectory) for k in effects]
                       if effects and isinstance(effects[0], str) else effects,
-                      noise=estimate_noise(whole), seed=seed)
+                      noise=estimate_noise(whole), seed=seed, bad_rows=bad_rows)
     if delay:  # the speed read `delay` late: n_read(t) = n(t - delay)
         case = replace(case, speed=np.interp(case.time - delay, case.time, case.speed))
     return case
@@ -88,6 +91,74 @@ def test_a_delayed_speed_reading_is_found_and_an_undelayed_one_kept_at_zero():
 def test_a_first_order_flow_lag_is_left_to_the_lag_term_not_taken_as_a_delay():
     lagged = _delay_of(_case([FlowLag(0.15)]))
     assert not lagged.fitted and lagged.seconds == 0.0
+
+
+def _profile(case):
+    """Return the delay's profile on a case's rows, one scale for all (delay._Profile)."""
+    model = MotorModel.from_spec(default_motor(displacement=F11_5), 'oil')
+    samples = read_rows(model, case.as_table(), Options(mode='transient')).samples
+    profile = delay._Profile(samples, model, 1.5, 3.0, lags=False)
+    assert delay._scaled(profile, 0.0)
+    return profile
+
+
+def test_a_lag_is_applied_in_its_own_shape_and_found_beside_a_delay():
+    # without noise the best lag is the injected one: a flow lag through the exact filter for
+    # samples linear in between (a zero-order hold had found 0.12 s for 0.1), a speed lag by
+    # the reading's exact inverse (the reading plus the lag times its rate)
+    grid = 0.05 * np.arange(-30, 31)
+    quiet = build_case(_trajectory().crop(*SPAN, 2), [FlowLag(0.1)], noise=None)
+    assert delay._best_lag(_profile(quiet), grid) == pytest.approx(0.1, abs=0.006)
+    step = float(np.median(np.diff(quiet.time)))
+    clean = build_case(_trajectory().crop(*SPAN, 2), [], noise=None)
+    slow = replace(clean, speed=first_order(clean.speed, step, 0.1))
+    assert delay._best_lag(_profile(slow), grid) == pytest.approx(-0.1, abs=0.006)
+    # the joint search finds the delay and the lag together, from the delay's least alone
+    late = replace(quiet, speed=np.interp(quiet.time - DELAY, quiet.time, quiet.speed))
+    both = delay._joint(_profile(late), [(0.25, 0.0), (0.0, 0.2)], 1.5, 0.05)
+    assert both == pytest.approx((DELAY, 0.1), abs=0.01)
+
+
+class _Fitted(Exception):
+    """Stops `calibrate` once the delay is fitted."""
+
+
+def _logged_delay_of(case, tmp_path, monkeypatch):
+    """Fit the delay as `satmotor calibrate` does on the case written as an MBARI log."""
+    found = []
+
+    def fitted(*args):
+        found.append(fit_delay(*args))
+        raise _Fitted
+
+    monkeypatch.setattr(pipeline, 'fit_delay', fitted)
+    path = write_mbari_log(tmp_path / 'case.exp', case)
+    with pytest.raises(_Fitted):
+        main(['calibrate', str(path), '--columns', 'mbari_pto', '--liquid', 'oil',
+              '--displacement', '0.30 in^3/rev', '--out', str(tmp_path / 'cal')])
+    return found[0]
+
+
+@pytest.mark.parametrize('seed', [100, 1100])
+def test_a_flow_lag_under_the_real_noise_keeps_the_delay_at_zero(tmp_path, monkeypatch, seed):
+    # the semi-real bench's 0.1 s flow lag on the stepped log (its seeds 0 and 1): a delay of
+    # -0.11 s and -0.07 s had beaten the best lag (applied half a step early, on a grid, each
+    # row weighed alike) and taken the lag's job; with the lag free beside it, weighed by
+    # the rows' noise, the delay gains nothing
+    lagged = _logged_delay_of(_case([FlowLag(0.1)], seed=seed, bad_rows=1), tmp_path,
+                              monkeypatch)
+    assert not lagged.fitted and lagged.seconds == 0.0
+    assert lagged.gain > lagged.limit  # the profile alone asks for a delay: the lag's twin
+    assert lagged.gain_over_lag <= lagged.limit
+    assert 'a first-order lag of the flow reading' in lagged.note
+
+
+def test_a_delay_beside_a_flow_lag_is_still_fitted(tmp_path, monkeypatch):
+    both = _logged_delay_of(_case([FlowLag(0.1)], delay=DELAY, seed=100, bad_rows=1), tmp_path,
+                            monkeypatch)
+    # a pure delay is no first-order lag: the lag free beside it, it still gains far more
+    assert both.fitted and both.gain_over_lag > 10.0 * both.limit
+    assert DELAY - 0.15 < both.seconds < DELAY + TOLERANCE  # the lag's 0.1 s shares it
 
 
 # -- the calibration and validation ----------------------------------------------------------

@@ -32,12 +32,17 @@ terms (the speed lag's regressor following :math:`d`) must gain more at the leas
 :math:`d = 0`, divided by the variance inflation of the correlated residuals
 (:func:`~.transient.variance_inflation`), than chi2(1) at :data:`ALPHA` over the number of
 independent delays the range holds (one per bin length: a search over the range, not one
-test); (2) the delay must beat the best first-order lag of either reading, applied in its
-own shape (a filter, without the derivatives whose noise shrinks the lag terms), by the same
-limit; (3) the least must lie inside the range (at its end the data ask for a delay at least
-that large, no estimate) and (4) one sample step or more from 0 (a shorter shift is within
-the samples' own timing, whose jitter the real logs show). Otherwise :math:`d = 0` is
-*kept*, and said why.
+test); (2) the delay must beat the best first-order lag of either reading, and the delay
+with a first-order lag free beside it (a joint search over both, nested models) must beat
+that lag alone, each by the same limit, the lag applied in its own shape
+(:meth:`_Profile.residual`: without the derivatives whose noise shrinks the lag terms) and
+each row weighed by its noise (:func:`~.noise.noise_model`: the timing jitter grows with
+how fast the flow changes); a negative delay, the speed read before the flow, is a flow
+lag's first-order twin and is kept only so; (3) the least must lie inside the range (at its
+end the data ask for a delay at least that large, no estimate) and (4) one sample step or
+more from 0, as the joint search's delay, on the same side (a shorter shift is within the
+samples' own timing, whose jitter the real logs show). Otherwise :math:`d = 0` is *kept*,
+and said why.
 
 A fitted delay is applied to every sample (:func:`shifted`) before the rows are read for the
 effects, the errors and the report; the samples at a stretch's end the shift cannot serve
@@ -52,7 +57,7 @@ from typing import Any
 
 import numpy as np
 from satmotor_ros.identify.fit import HUBER, huber_rho
-from satmotor_ros.identify.noise import MAD, RATE_TERMS
+from satmotor_ros.identify.noise import MAD, noise_model, RATE_TERMS, rates_of
 from satmotor_ros.identify.parts import NO_EFFECT
 from satmotor_ros.identify.table import BenchTable
 from satmotor_ros.identify.transient import (END_SAMPLES, flow_per_speed, Samples, segments,
@@ -80,6 +85,12 @@ MIN_ROWS = 20
 
 IRLS_STEPS = 6
 """Reweighted least-squares steps of the Huber fit at each delay, [-]."""
+
+LAGGED_KEPT = 8
+"""Lagged signals the profile keeps at once (each two running areas of the samples), [-]."""
+
+JOINT_EVALUATIONS = 60
+"""Most profile evaluations of each joint (delay, lag) search, [-]."""
 
 EDGE = 0.5
 """A least within this many grid steps of the range's end counts as at the end, [-]."""
@@ -212,12 +223,10 @@ class _Profile:
         speed = np.where(np.isfinite(raw.speed), raw.speed, 0.0)
         self.time = time
         self.area = _area(time, speed)
-        self.area_flow = _area(time, np.where(np.isfinite(raw.flow), raw.flow, 0.0))
         self.smooth = smooth(speed, first, END_SAMPLES)
         self.speed, self.step = speed, samples.step
-        self.raw_flow = np.where(np.isfinite(raw.flow), raw.flow, 0.0)
         self.starts = np.append(starts, time.size)
-        self.filtered: dict[float, tuple[FloatArray, FloatArray]] = {}
+        self.filtered: dict[float, FloatArray] = {}
         self.qt = model.geometry.displacement
         self.mean0 = self._mean(0.0)
         self.displacement = parts.displacement[self.rows]
@@ -227,7 +236,8 @@ class _Profile:
         self.nuisance = {k: np.asarray(v)[self.rows] for k, v in parts.nuisance.items()
                          if lags or k not in RATE_TERMS}
         self.dq_dn = flow_per_speed(parts, self.qt)[self.rows]
-        self.scale = 0.0
+        self.scale: FloatArray | float = 0.0  # each row's noise (or one for all) [m^3/s]
+        self.rates = rates_of({k: np.asarray(v)[self.rows] for k, v in parts.nuisance.items()})
         self.seen: dict[tuple[float, float], float] = {}
 
     def _mean(self, d: float) -> FloatArray:
@@ -235,16 +245,19 @@ class _Profile:
         f = np.interp(np.concatenate((self.ta, self.tb)) + d, self.time, self.area)
         return np.asarray((f[self.ta.size:] - f[:self.ta.size]) / (self.tb - self.ta))
 
-    def _lagged(self, lag: float) -> tuple[FloatArray, FloatArray]:
-        """Return the running areas of the speed and the flow, one of them lagged by |lag|."""
+    def _lagged(self, lag: float) -> FloatArray:
+        """Return the running area of the speed through a first-order lag of `lag`."""
         if lag not in self.filtered:
-            speed, flow = self.speed, self.raw_flow
-            if lag > 0.0:  # the flow reading lags: the model's flow (~ q_t n) seen through it
-                speed = _first_order(speed, self.starts, self.step, lag)
-            else:  # the speed reading lags: the flow seen through the same lag matches it
-                flow = _first_order(flow, self.starts, self.step, -lag)
-            self.filtered[lag] = (_area(self.time, speed), _area(self.time, flow))
+            if len(self.filtered) >= LAGGED_KEPT:  # each holds a signal's length: keep a few
+                del self.filtered[next(iter(self.filtered))]
+            self.filtered[lag] = _area(self.time, _first_order(self.speed, self.starts,
+                                                               self.step, lag))
         return self.filtered[lag]
+
+    def _rate(self, d: float) -> FloatArray:
+        """Return each row's mean rate of change of the (smoothed) speed read at `d`."""
+        ends = np.interp(np.concatenate((self.ta, self.tb)) + d, self.time, self.smooth)
+        return np.asarray((ends[self.ta.size:] - ends[:self.ta.size]) / (self.tb - self.ta))
 
     def _row_means(self, area: FloatArray, d: float) -> FloatArray:
         f = np.interp(np.concatenate((self.ta, self.tb)) + d, self.time, area)
@@ -254,31 +267,33 @@ class _Profile:
         """
         Return the base's residual at delay `d` (Huber IRLS at the fixed scale), [m^3/s].
 
-        With `lag` the lag terms are out and a first-order lag of |lag| is applied
-        instead, on the speed (> 0: the flow reading lags) or the flow reading (< 0: the
-        speed reading lags): the lag's own shape, without a derivative's noise.
+        With `lag` (the profile without the lag terms) a first-order lag of |lag| is
+        applied in its own shape: > 0, the flow reading lags, and the model's flow is seen
+        through the lag (the speed filtered, no derivative whose noise shrinks it); < 0, the
+        speed reading lags, and the speed is the reading plus |lag| times its rate (the
+        lag's exact inverse; the rate of a row is its ends' difference over its length).
         """
-        mean, flow = self._mean(d), self.flow
-        if lag:
-            speed_area, flow_area = self._lagged(lag)
-            mean = self._row_means(speed_area, d)
-            flow = flow + self.sign * (self._row_means(flow_area, 0.0)
-                                       - self._row_means(self.area_flow, 0.0))
-        loss = flow - (self.displacement + self.sign * self.qt * (mean - self.mean0))
+        if lag > 0.0:  # the flow reading lags: the model's flow (~ q_t n) seen through it
+            mean = self._row_means(self._lagged(lag), d)
+        elif lag < 0.0:  # the speed reading lags: the speed is the reading's lead, exactly
+            mean = self._mean(d) - lag * self._rate(d)
+        else:
+            mean = self._mean(d)
+        loss = self.flow - (self.displacement + self.sign * self.qt * (mean - self.mean0))
         nuisance = dict(self.nuisance)
         if 'speed_lag' in nuisance:
-            ends = np.interp(np.concatenate((self.ta, self.tb)) + d, self.time, self.smooth)
-            dn = self.sign * (ends[self.ta.size:] - ends[:self.ta.size]) / (self.tb - self.ta)
-            nuisance['speed_lag'] = self.dq_dn * dn
+            nuisance['speed_lag'] = self.dq_dn * self.sign * self._rate(d)
         x = np.column_stack(self.fixed + list(nuisance.values()))
-        weight = np.ones(loss.size)
-        for _ in range(IRLS_STEPS if self.scale > 0.0 else 1):
+        scaled = bool(np.all(self.scale > 0.0))
+        weight = np.ones(loss.size) / (self.scale ** 2 if scaled else 1.0)
+        for _ in range(IRLS_STEPS if scaled else 1):
             root = np.sqrt(weight)
             beta = np.linalg.lstsq(x * root[:, None], loss * root, rcond=None)[0]
             r = loss - x @ beta
-            if self.scale > 0.0:
+            if scaled:
                 z = np.abs(r) / self.scale
-                weight = np.where(z <= HUBER, 1.0, HUBER / np.maximum(z, 1e-300))
+                weight = np.where(z <= HUBER, 1.0, HUBER / np.maximum(z, 1e-300)) \
+                    / self.scale ** 2
         return np.asarray(r, dtype=float)
 
     def __call__(self, d: float, lag: float = 0.0) -> float:
@@ -295,12 +310,20 @@ def _area(time: FloatArray, x: FloatArray) -> FloatArray:
 
 
 def _first_order(x: FloatArray, starts: np.ndarray, step: float, tau: float) -> FloatArray:
-    """Return `x` through a first-order lag of `tau` (per stretch, from its first value)."""
+    r"""
+    Return `x` through a first-order lag of `tau`, per stretch, from rest on its first value.
+
+    Exact for an input linear between the samples (the rows' own trapezoid reading):
+    :math:`y_i = E y_{i-1} + (1 - E - c) x_{i-1} + c x_i`, :math:`E = e^{-h/\tau}`,
+    :math:`c = 1 - \tau (1 - E)/h`. (A zero-order hold, :math:`(1 - E) x_i`, would read the
+    lag half a step early: a delay of its own the profile would then ask for.)
+    """
     keep = float(np.exp(-step / tau))
+    now = 1.0 - tau / step * (1.0 - keep)
     out = np.empty_like(x)
     for lo, hi in zip(starts[:-1], starts[1:]):
-        out[lo:hi], _ = signal.lfilter([1.0 - keep], [1.0, -keep], x[lo:hi],
-                                       zi=[keep * x[lo]])
+        out[lo:hi], _ = signal.lfilter([now, 1.0 - keep - now], [1.0, -keep], x[lo:hi],
+                                       zi=[(1.0 - now) * x[lo]])
     return out
 
 
@@ -373,33 +396,85 @@ def fit_delay(samples: Samples, model: MotorModel, gap: float = 3.0) -> DelayFit
         return _kept(said, f'the least is within one sample step ({samples.step:.3g} s) of 0 '
                      f"({profiled}): the samples' own timing, not a delay")
     # a first-order lag of either reading (its own shape, :meth:`_Profile.residual`) is the
-    # lag terms' job: the delay must fit better than the best of them by the same limit
-    _scaled(pure, best)
-    pure_inflation = variance_inflation(pure.residual(best))
-    lags = [float(v) for v in grid if v]
-    lag = lags[int(np.argmin([pure(0.0, v) for v in lags]))]
-    over = (pure(0.0, lag) - pure(best)) / pure_inflation
-    said = replace(said, gain_over_lag=over)
-    if over <= limit:
-        return _kept(said, f'a first-order lag of the {"flow" if lag > 0 else "speed"} '
-                     f'reading ({abs(lag):.3g} s) fits as well ({profiled}; chi2 gain '
-                     f'of the delay over the lag {over:.3g} <= {limit:.3g}): the lag '
-                     'terms take it')
-    level = pure(best) + pure_inflation * float(stats.chi2.ppf(0.95, 1))
+    # lag terms' job: the delay is fitted jointly with the best such lag and must beat the
+    # best lag alone, on the same rows and scale, by the same limit (nested models)
+    _scaled(pure, best, noise=True)
+    lag = _best_lag(pure, grid)
+    joint, joint_lag = _joint(pure, [(best, 0.0), (0.0, lag)], span, grid_step)
+    pure_inflation = variance_inflation(pure.residual(joint, joint_lag))
+    over = (pure(0.0, lag) - pure(joint, joint_lag)) / pure_inflation
+    alone = (pure(0.0, lag) - pure(best)) / pure_inflation
+    said = replace(said, gain_over_lag=min(over, alone))
+    reading = f'{"flow" if lag > 0 else "speed"} reading ({abs(lag):.3g} s)'
+    if min(over, alone) <= limit:
+        return _kept(said, f'a first-order lag of the {reading} fits as well ({profiled}; '
+                     f'the delay gains {alone:.3g} over the lag alone, and with the lag free '
+                     f'{over:.3g} at {joint:+.3g} s; need > {limit:.3g} both): the lag terms '
+                     'take it')
+    if abs(joint) < samples.step or joint * best < 0.0:
+        return _kept(said, f'with a first-order lag of the {reading} free, the least is '
+                     f'at {joint:+.3g} s ({profiled}), within one sample step '
+                     f'({samples.step:.3g} s) of 0 or across it: the lag terms take it')
+    _scaled(pure, best)  # the interval on the profile that found the least
+    inflation = variance_inflation(pure.residual(best))
+    level = pure(best) + inflation * float(stats.chi2.ppf(0.95, 1))
     ci95 = (_crossing(pure, best, -span, level), _crossing(pure, best, span, level))
     note = (f'speed delay fitted: the speed reading lags the flow reading by {best:.3g} s '
-            f'(95 % {ci95[0]:.3g} to {ci95[1]:.3g} s; {profiled} > {limit:.3g}, over the best '
-            f'first-order lag {over:.3g}); the base '
-            f'error {rms0 / LPM:.3g} -> {rms / LPM:.3g} l/min on the profile rows')
+            f'(95 % {ci95[0]:.3g} to {ci95[1]:.3g} s; {profiled} > {limit:.3g}; over the '
+            f'best first-order lag alone, the {reading}, it gains {alone:.3g}, and with '
+            f'that lag free {over:.3g}); the base error {rms0 / LPM:.3g} -> '
+            f'{rms / LPM:.3g} l/min on the profile rows')
     return replace(said, seconds=best, fitted=True, note=note, ci95=ci95)
 
 
-def _scaled(profile: _Profile, d: float) -> bool:
-    """Fix the profile's scale at the robust spread of its least-squares residual at `d`."""
+def _best_lag(profile: _Profile, grid: np.ndarray) -> float:
+    """Return the first-order lag (> 0 of the flow reading, < 0 of the speed's) fitting best."""
+    lags = np.array([v for v in grid if v])
+    values = [profile(0.0, float(v)) for v in lags]
+    i = int(np.argmin(values))
+    lo = lags[i - 1] if i > 0 else lags[i]
+    hi = lags[i + 1] if i < lags.size - 1 else lags[i]
+    if lo * hi <= 0.0:  # the grid's neighbours across 0: refine on the best one's side
+        lo, hi = (lags[i] / 2.0, lags[i + 1]) if lags[i] > 0 else (lags[i - 1], lags[i] / 2.0)
+    found = optimize.minimize_scalar(lambda v: profile(0.0, v), bounds=(lo, hi),
+                                     method='bounded', options={'xatol': 1e-3, 'maxiter': 20})
+    return float(found.x) if profile(0.0, float(found.x)) < values[i] else float(lags[i])
+
+
+def _joint(profile: _Profile, starts: list[tuple[float, float]], span: float,
+           step: float) -> tuple[float, float]:
+    """Return the (delay, lag) of the least of the profile, searched from each of `starts`."""
+    def objective(x: FloatArray) -> float:
+        return profile(float(x[0]), float(x[1])) if x[1] else profile(float(x[0]))
+
+    best: tuple[float, tuple[float, float]] = (math.inf, starts[0])
+    for d, lag in starts:
+        simplex = np.array([(d, lag), (d + step, lag), (d, lag + step)])
+        found = optimize.minimize(objective, simplex[0], method='Nelder-Mead',
+                                  bounds=[(-span, span), (-span, span)],
+                                  options={'initial_simplex': simplex, 'xatol': 1e-3,
+                                           'fatol': 1e-2, 'maxfev': JOINT_EVALUATIONS})
+        if found.fun < best[0]:
+            best = (float(found.fun), (float(found.x[0]), float(found.x[1])))
+    return best[1]
+
+
+def _scaled(profile: _Profile, d: float, lag: float = 0.0, noise: bool = False) -> bool:
+    """
+    Fix the profile's scale from its least-squares residual at `d` (and `lag`).
+
+    One robust spread for every row; with `noise`, each row's noise (:mod:`.noise`: a
+    floor, and a part that grows with how fast the flow changes, the timing jitter of the
+    readings), so a recording's fast moves weigh by what they can tell.
+    """
     profile.scale, profile.seen = 0.0, {}
-    r = profile.residual(d)
-    profile.scale = MAD * float(np.median(np.abs(r - np.median(r))))
-    return profile.scale > 0.0
+    r = profile.residual(d, lag)
+    if noise:
+        profile.scale = noise_model(r, profile.flow, len(profile.fixed) + 1, 1e-6 * LPM,
+                                    profile.rates)
+    else:
+        profile.scale = MAD * float(np.median(np.abs(r - np.median(r))))
+    return bool(np.all(profile.scale > 0.0))
 
 
 def _crossing(profile: _Profile, best: float, end: float, level: float) -> float:
