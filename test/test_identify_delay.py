@@ -10,11 +10,10 @@ import json
 import numpy as np
 import pytest
 from satmotor_ros.cli.main import main
+from satmotor_ros.identify import delay, pipeline
 from satmotor_ros.identify.calibrated import Calibrated
-from satmotor_ros.identify import delay
 from satmotor_ros.identify.delay import fit_delay, shifted
 from satmotor_ros.identify.errors import DataError
-from satmotor_ros.identify import pipeline
 from satmotor_ros.identify.pipeline import calibrate, Options, read_rows
 from satmotor_ros.identify.semireal import (build_case, estimate_noise, F11_5, FlowLag,
                                             load_trajectory, realistic, write_mbari_log)
