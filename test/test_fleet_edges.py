@@ -433,21 +433,34 @@ def test_prune_keeps_a_users_directory_that_holds_no_baseline_of_ours(tmp_path):
     assert (out / 'empty_for_later').is_dir() and (out / 'cfg' / 'baseline.json').is_file()
 
 
-def test_a_fleet_run_on_another_root_removes_nothing_of_the_first(tmp_path):
-    """Cold review of issue 24: --out pointed at another ROOT wiped the first fleet's outputs."""
+def test_an_out_last_reported_of_another_root_is_refused_unless_forced(tmp_path, capsys):
+    """
+    Cold review of issue 24: --out of another ROOT pruned nothing but took that ROOT's place.
+
+    So a second run pruned the first fleet's outputs. It is refused in one line naming both
+    ROOTs, before any work; ``--force`` takes DIR over, and the first ROOT's outputs go then.
+    """
+    from satmotor_ros.cli.main import main
     from satmotor_ros.fleet.config import FleetConfig, RESERVED
     from satmotor_ros.fleet.discover import discover
-    from satmotor_ros.fleet.prune import prune, root_of
-    _csv(tmp_path / 'one' / 'm' / 'a.csv')
-    _csv(tmp_path / 'two' / 'n' / 'b.csv')
+    from satmotor_ros.fleet.prune import check_root, prune, root_of
+    one, two = tmp_path / 'one', tmp_path / 'two'
+    _csv(one / 'm' / 'a.csv')
+    _csv(two / 'n' / 'b.csv')
     out = tmp_path / 'out'
     gone = out / 'm' / 'old.csv'
     gone.mkdir(parents=True)
     (gone / '.fleet-done.json').write_text('{}')
-    (out / 'fleet.json').write_text(json.dumps({'root': str((tmp_path / 'one').resolve())}))
-    two = tmp_path / 'two'
-    assert root_of(out) == str((tmp_path / 'one').resolve())
-    assert prune(out, two, discover(two, FleetConfig()), RESERVED) == []
-    assert gone.is_dir()
-    one = tmp_path / 'one'
-    assert prune(out, one, discover(one, FleetConfig()), RESERVED) == ['m/old.csv']
+    (out / '.satmotor-output.json').write_text('{"command": "fleet"}\n')
+    report = json.dumps({'root': str(one.resolve())})
+    (out / 'fleet.json').write_text(report)
+    assert main(['fleet', str(two), '--out', str(out), '--no-progress']) == 1
+    err = capsys.readouterr().err
+    assert err.count('\n') == 1 and 'Traceback' not in err
+    assert f'ROOT {str(one.resolve())!r}, not {str(two.resolve())!r}' in err
+    assert gone.is_dir() and (out / 'fleet.json').read_text() == report  # nothing touched
+    assert root_of(out) == str(one.resolve())
+    assert check_root(out, one, False) is None  # its own ROOT: used
+    assert check_root(out, two, True) == str(one.resolve())  # forced: taken over, and
+    assert prune(out, two, discover(two, FleetConfig()), RESERVED) == ['m/old.csv']  # pruned
+    assert not gone.exists()

@@ -27,7 +27,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help='output directory (outside ROOT); an existing one is used only '
                              'if a fleet run wrote it')
     parser.add_argument('--force', action='store_true',
-                        help='use an existing --out that a fleet run did not write')
+                        help='use an existing --out that a fleet run did not write, or take '
+                             'over one whose last report was of another ROOT (the outputs of '
+                             'that ROOT go)')
     parser.add_argument('--fleet', default='', metavar='FILE',
                         help='fleet description (default: ROOT/fleet.yaml when present)')
     parser.add_argument('--workers', type=_workers, default=0, metavar='N',

@@ -27,7 +27,8 @@ def prune(out: Path, root: Path, motors: list[Motor], report: tuple[str, ...]) -
     """
     Remove the directories of recordings and motors that are gone, where wholly ours.
 
-    Nothing is removed from a DIR whose last report was of another ROOT.
+    A DIR whose last report was of another ROOT is refused before (:func:`check_root`), or
+    taken over with ``--force``: then the first ROOT's outputs go as a deleted recording's.
 
     Parameters
     ----------
@@ -46,8 +47,6 @@ def prune(out: Path, root: Path, motors: list[Motor], report: tuple[str, ...]) -
         What was removed, relative to DIR.
 
     """
-    if root_of(out) not in (None, str(root.resolve())):
-        return []
     current = {m.motor: {r.name for r in m.recordings} for m in motors}
     removed = []
     for motor in sorted(p for p in out.iterdir() if p.is_dir() and not p.is_symlink()):
@@ -63,6 +62,41 @@ def prune(out: Path, root: Path, motors: list[Motor], report: tuple[str, ...]) -
             shutil.rmtree(motor)
             removed.append(motor.name)
     return removed
+
+
+def check_root(out: Path, root: Path, force: bool) -> str | None:
+    """
+    Refuse a DIR whose last fleet report was of another ROOT, unless forced.
+
+    Parameters
+    ----------
+    out : pathlib.Path
+        DIR, [-]
+    root : pathlib.Path
+        ROOT of this run, [-]
+    force : bool
+        Take DIR over for this ROOT, [-]
+
+    Returns
+    -------
+    str or None
+        The other ROOT DIR is taken over from (with `force`), else None.
+
+    Raises
+    ------
+    FleetError
+        One line naming both ROOTs, without `force`.
+
+    """
+    from satmotor_ros.fleet.errors import FleetError
+    before, now = root_of(out), str(root.resolve())
+    if before in (None, now):
+        return None
+    if not force:
+        raise FleetError(f'--out {str(out)!r}: its last report is of ROOT {before!r}, not '
+                         f'{now!r} (another --out, or --force to take it over: the outputs '
+                         f'of {before!r} wholly written by satmotor fleet are removed)')
+    return before
 
 
 def root_of(out: Path) -> str | None:
@@ -110,4 +144,4 @@ def _ours(directory: Path) -> bool:
     return True
 
 
-__all__ = ['MOTOR_FILES', 'OWN_FILES', 'prune', 'root_of']
+__all__ = ['MOTOR_FILES', 'OWN_FILES', 'check_root', 'prune', 'root_of']

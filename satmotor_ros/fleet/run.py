@@ -17,7 +17,7 @@ from satmotor_ros.fleet.engine import check_address, execute, plan
 from satmotor_ros.fleet.errors import FleetError
 from satmotor_ros.fleet.explain import explain_alarms
 from satmotor_ros.fleet.health import ESTIMATOR
-from satmotor_ros.fleet.prune import prune, root_of
+from satmotor_ros.fleet.prune import check_root, prune
 from satmotor_ros.fleet.report import not_ours, write_report
 from satmotor_ros.fleet.resume import read_marker
 from satmotor_ros.fleet.summary import iso_now, LIMIT, motor_view, rank
@@ -63,7 +63,8 @@ def run_fleet(root: str, out: str, fleet: str = '', workers: int = 0, scheduler:
     limit : float
         Limit of the leakage factor, [-]
     force : bool
-        Use an existing DIR that a fleet run did not write, [-]
+        Use an existing DIR that a fleet run did not write, or one whose last report was of
+        another ROOT (taking it over: that ROOT's outputs go), [-]
     show_progress : bool
         Draw the progress bar, [-]
     say : callable
@@ -77,7 +78,8 @@ def run_fleet(root: str, out: str, fleet: str = '', workers: int = 0, scheduler:
     Raises
     ------
     FleetError
-        ROOT missing or empty of recordings, fleet.yaml invalid, DIR not ours, the cluster
+        ROOT missing or empty of recordings, fleet.yaml invalid, DIR not ours or (without
+        `force`) last reported of another ROOT, the cluster
         unreachable (one line naming the field and value).
 
     """
@@ -91,6 +93,7 @@ def run_fleet(root: str, out: str, fleet: str = '', workers: int = 0, scheduler:
         check_target('--out', target, [str(base)], force, written_by('fleet'), 'fleet')
     except CliError as err:
         raise FleetError(str(err)) from None
+    taken = check_root(target, base, force)  # before any work: a DIR of another ROOT
     check_address(scheduler)
     config = _config(base, fleet)
     motors = discover(base, config)
@@ -115,9 +118,8 @@ def run_fleet(root: str, out: str, fleet: str = '', workers: int = 0, scheduler:
     else:
         say(f'fleet: all {len(markers)} recordings already done for these inputs and options; '
             'no cluster started')
-    before = root_of(target)
-    if before not in (None, str(base.resolve())):
-        say(f'fleet: --out {out!r} holds the outputs of ROOT {before!r}; none removed')
+    if taken is not None:
+        say(f'fleet: --out {out!r} taken over from ROOT {taken!r} (--force)')
     gone = prune(target, base, motors, RESERVED)  # recordings and motors no longer under ROOT
     if gone:
         more = ' ...' if len(gone) > 5 else ''
