@@ -30,7 +30,7 @@ DAYS = 6
 def fleet(tmp_path_factory):
     """Run the synthetic fleet once on two local workers: (root, out, outcome, lines)."""
     base = tmp_path_factory.mktemp('fleet')
-    root = make_fleet(base / 'root', days=DAYS, points=30)
+    root = make_fleet(base / 'root', days=DAYS)  # README's fleet (its first days, its seeds)
     lines = []
     outcome = run_fleet(str(root), str(base / 'out'), workers=2, liquid='water',
                         show_progress=False, say=lines.append)
@@ -48,18 +48,18 @@ def test_fleet_ranks_the_wearing_motor_first_and_names_the_leak_and_the_bad_reco
     assert 0 < wearing['days_to_limit'] < 20 and not wearing['alarms']
     assert [a['kind'] for a in leak['alarms']] == ['change']
     assert leak['alarms'][0]['date'].startswith(f'2026-03-{1 + LEAK_DAY:02d}')
-    assert 'what changed: ' in leak['alarms'][0]['what']  # the monitor's explainer (30 points
-    # a recording may be too few for it to name the wear: 40 named it, doc/fleet.md)
+    assert 'what changed: ' in leak['alarms'][0]['what']  # the monitor's explainer (a recording
+    # may be too short for it to name the change, doc/fleet.md)
     assert leak['leakage_factor'][-1]['value'] == pytest.approx(1.6, rel=0.03)
     said = re.search(r'leakage factor ([\d.]+) -> ([\d.]+) \(\+(\d+) %\) since (\S+),',
-                     leak['alarms'][0]['what'])  # as README and doc/fleet.md give it
+                     leak['alarms'][0]['what'])
     assert said and float(said[1]) == pytest.approx(1.0, abs=0.02)
     assert float(said[2]) == pytest.approx(1.6, abs=0.04) and 55 <= int(said[3]) <= 65
     assert said[4] == f'2026-03-{LEAK_DAY:02d}'
-    readme = ' '.join((REPOSITORY / 'README.md').read_text().split())
-    assert "wearing first, the leak's change alarm (leakage factor 1 -> 1.6), 3 refused" in readme
+    readme = ' '.join((REPOSITORY / 'README.md').read_text().split())  # they quote this run
+    assert f"the leak's change alarm (leakage factor {said[1]} -> {said[2]}), 3 refused" in readme
     doc = ' '.join((REPOSITORY / 'doc' / 'fleet.md').read_text().split())
-    assert f'`leakage factor 1 -> 1.6 (+60 %) since 2026-03-{LEAK_DAY:02d}`' in doc
+    assert f'`{said[0][:-1]}`' in doc
     assert not healthy['alarms'] and healthy['days_to_limit'] is None
     for point in healthy['leakage_factor']:
         assert point['ci95'][0] <= point['value'] <= point['ci95'][1]
