@@ -526,6 +526,36 @@ def test_a_monitored_motors_view_is_the_monitors_figures_and_named_alarms():
     assert view['trend_clock'] == MONITOR_EPOCH
 
 
+def test_a_change_the_monitor_has_not_named_yet_says_what_it_waits_for():
+    """Cold review of issue 24 (finding 9): fleet.md said 'pending', and not what was."""
+    from satmotor_ros.identify.health import HealthSettings
+    from satmotor_ros.identify.health.monitor import PENDING
+    steps = [{'recording': f'r{i}.csv', 'status': 'done', 'result': {
+        'leakage_factor': {'value': v, 'ci95': [v - 0.01, v + 0.01]}, 'learning': False,
+        'trend_per_hour': None, 'trend_per_day': None, 'hours_to_limit': None,
+        'recording_samples': 451, 'recording_skipped': 0,
+        'span_s': [EPOCH + i * 100.0, EPOCH + i * 100.0 + 90],
+        'alarms': [{'time_s': 150.0, 'kind': 'change', 'what': PENDING}] if i else []}}
+        for i, v in enumerate((1.0, 1.3))]
+    view = motor_view('m', 'water', _markers([1.0, 1.3]), None, steps=steps)
+    (alarm,) = view['alarms']
+    assert alarm['what'] == ('not named yet by the monitor: it names a change once it has '
+                             f'learned {HealthSettings().learn_hours:g} h of operation after '
+                             'it, and the recordings since hold less (in r1.csv)')
+
+
+def test_an_empty_csv_is_refused_in_one_clear_line(tmp_path):
+    """Cold review of issue 24 (finding 9): a 0-byte CSV read 'truncated mid-row: ... empty'."""
+    from satmotor_ros.fleet.tasks import EMPTY, load_screened, motor_options, Refused, RunOptions
+    (tmp_path / 'root' / 'm').mkdir(parents=True)
+    (tmp_path / 'root' / 'm' / 'a.csv').write_bytes(b'')
+    (motor,) = discover(tmp_path / 'root', FleetConfig())
+    with pytest.raises(Refused) as err:
+        load_screened(motor.recordings[0], motor_options(motor.rule, RunOptions(
+            str(tmp_path / 'out'), liquid='water')), '')
+    assert str(err.value) == EMPTY
+
+
 def test_without_a_baseline_the_damaged_keep_their_reason_and_the_sound_say_why(tmp_path):
     from satmotor_ros.fleet.synthetic import make_fleet
     from satmotor_ros.fleet.tasks import calibrate_baseline, process_recording, RunOptions

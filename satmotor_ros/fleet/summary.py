@@ -245,7 +245,7 @@ def _monitored(motor: str, liquid: str, markers: list[dict[str, Any]],
         if recording not in fit:  # raised on figures the fleet does not take
             continue
         alarms.append({'date': dates.get(recording, ''), 'kind': alarm.get('kind', 'change'),
-                       'what': f"{alarm.get('what', 'unexplained')} (in {recording})",
+                       'what': f"{_named(alarm.get('what', 'unexplained'))} (in {recording})",
                        'recording': recording, 'source': 'monitor'})
     holds = _monitor_trend_holds(series, watched)
     if holds and last.get('trend_per_day') is not None:
@@ -264,6 +264,17 @@ def _monitored(motor: str, liquid: str, markers: list[dict[str, Any]],
     trend, days = _calendar_trend(series, times, limit)
     return _view(motor, liquid, markers, series, trend, days, alarms, baseline, limit,
                  BY_MONITOR if holds or len(fit) == len(series) else MIXED, RECORDING_TIMES)
+
+
+def _named(what: str) -> str:
+    """Return a monitor alarm's name; its 'pending' said as what it waits for."""
+    from satmotor_ros.identify.health import HealthSettings
+    from satmotor_ros.identify.health.monitor import PENDING
+    if what != PENDING:
+        return what
+    return ('not named yet by the monitor: it names a change once it has learned '
+            f'{HealthSettings().learn_hours:g} h of operation after it, and the recordings '
+            'since hold less')
 
 
 def raised_in(alarm: dict[str, Any], watched: list[dict[str, Any]]) -> str:

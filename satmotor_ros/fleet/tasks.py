@@ -31,6 +31,8 @@ CALIBRATE_DIR, VALIDATE_DIR = 'calibrate', 'validate'
 
 ZERO_PRESSURE = 'every pressure is zero'
 
+EMPTY = 'empty file (0 bytes): no header, no data'
+
 OUTPUTS = {CALIBRATE_DIR: 'calibrate', VALIDATE_DIR: 'validate', 'health': 'fleet-health'}
 """A recording's output directories, each with the command its marker names."""
 
@@ -148,6 +150,8 @@ def load_screened(rec: Recording, options: MotorOptions, columns: str) -> tuple[
     try:
         table = load_data(rec.path, columns, _displacement(settled))
     except (BagError, CliError, IdentificationError, ModelError, OptionError) as err:
+        if rec.kind != 'bag' and _size(rec.path) == 0:
+            raise Refused(EMPTY) from None
         cut = rec.kind != 'bag' and not _ends_a_line(rec.path) and 'UTF-8' not in str(err)
         raise Refused(('truncated mid-row (no end of line at the end): ' if cut else '')
                       + str(err)) from None
@@ -182,6 +186,14 @@ def _displacement(options: MotorOptions) -> float:
             if err.option != 'liquid':
                 raise
     return float(replace(options, liquid=LIQUIDS[-1]).spec().geometry.displacement)
+
+
+def _size(path: str) -> int:
+    """Return a file's size in bytes, -1 when it cannot be read."""
+    try:
+        return os.path.getsize(path)
+    except OSError:
+        return -1
 
 
 def _ends_a_line(path: str) -> bool:
@@ -480,7 +492,7 @@ def _line(err: BaseException) -> str:
     return text.splitlines()[0] if text else type(err).__name__
 
 
-__all__ = ['BASELINE', 'CALIBRATE_DIR', 'MONITOR_DIR', 'MotorRefused', 'NO_LIQUID', 'RunOptions',
+__all__ = ['BASELINE', 'CALIBRATE_DIR', 'EMPTY', 'MONITOR_DIR', 'MotorRefused', 'NO_LIQUID', 'RunOptions',
            'OUTPUTS', 'Refused', 'STATE', 'STEP', 'VALIDATE_DIR', 'ZERO_PRESSURE',
            'baseline_rule_key', 'drop_stale', 'file_digest',
            'calibrate_baseline', 'columns_of', 'given_baseline', 'input_of', 'load_screened',
