@@ -225,6 +225,53 @@ def test_a_rerun_on_other_options_leaves_no_earlier_output_behind(tmp_path):
     assert (out / 'mine' / 'notes.txt').read_text() == 'keep'
 
 
+def test_toggling_validate_redoes_validate_only(tmp_path, monkeypatch):
+    """
+    Cold review of issue 24 (finding 7): toggling --validate redid every output.
+
+    Each output has its own key: calibrate/ and health/ are kept when theirs are the same
+    (calibrate is not run again), validate/ is written, and dropped again without it; the
+    motor's monitor steps do not depend on it.
+    """
+    import satmotor_ros.cli.calibrate as calibrate_cli
+    from satmotor_ros.fleet.chain import monitor_step
+    from satmotor_ros.fleet.engine import plan
+    from satmotor_ros.fleet.resume import read_done
+    from satmotor_ros.fleet.synthetic import write_recording
+    from satmotor_ros.fleet.tasks import given_baseline, process_recording, RunOptions
+    from satmotor_ros.model.io.config import default_config_path
+    root, out = tmp_path / 'root', tmp_path / 'out'
+    write_recording(root / 'm1' / 'd00.csv', 1.2, 1, 20, EPOCH)
+    (root / 'fleet.yaml').write_text(
+        f"motors: [{{pattern: 'm1/**', motor: m1, liquid: water, "
+        f"motor_file: '{default_config_path('sm075_25.yaml')}'}}]\n")
+    (motor,) = discover(root, load_fleet(root / 'fleet.yaml'))
+    (rec,) = motor.recordings
+    first = RunOptions(str(out), calibrate=True)
+    baseline = given_baseline(motor, first)
+    done = process_recording(rec, motor.rule, baseline, first)
+    monitor_step(rec, motor.rule, baseline, first, None)
+    here = out / 'm1' / rec.name
+    stamps = {p: p.stat().st_mtime_ns for p in here.rglob('*') if p.is_file()
+              and p.parts[len(here.parts)] in ('calibrate', 'health', 'monitor')}
+    assert any('calibrate' in p.parts for p in stamps) and done['status'] == 'done'
+
+    def not_again(*args, **kwargs):
+        raise AssertionError('calibrate run again')
+
+    monkeypatch.setattr(calibrate_cli, 'calibrate_into', not_again)
+    for validate in (True, False):
+        run = RunOptions(str(out), calibrate=True, validate=validate)
+        assert plan([motor], run).todo == [rec] and not plan([motor], run).chain_from
+        marker = process_recording(rec, motor.rule, baseline, run)
+        assert marker['status'] == 'done', marker['reason']
+        assert marker['result'] == done['result']
+        assert {o.split('/')[0] for o in read_done(here)['outputs']} == \
+            {'calibrate', 'health', *(['validate'] if validate else [])}
+        assert (here / 'validate').is_dir() == validate
+        assert {p: p.stat().st_mtime_ns for p in stamps} == stamps  # kept as they were
+
+
 def test_a_report_drops_the_plots_of_motors_it_no_longer_has(tmp_path):
     """F6: a motor gone (renamed, removed) since the last report leaves no plot behind."""
     from satmotor_ros.fleet.report import write_report

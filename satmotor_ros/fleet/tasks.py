@@ -434,39 +434,93 @@ def process_recording(rec: Recording, rule: MotorRule, baseline: dict[str, Any],
     from satmotor_ros.model import ModelError
     out = Path(run.out) / rec.motor / rec.name
     options = options_key(recording_options(rule, run, baseline['key']))
+    steps = step_keys(rule, run, baseline['key'])
+    if rec.relative == baseline.get('recording'):
+        steps.pop(CALIBRATE_DIR, None)  # the baseline task's: calibrated once
     marker: dict[str, Any] = {'recording': rec.relative, 'motor': rec.motor, 'date': rec.date,
                               'time': rec.time, 'time_source': rec.time_source,
-                              'options': options, 'worker': f'{socket.gethostname()}:'
-                                                            f'{os.getpid()}', **input_of(rec)}
+                              'options': options, 'steps': steps,
+                              'worker': f'{socket.gethostname()}:{os.getpid()}',
+                              **input_of(rec)}
     done = is_done(out, rec.path, options)
     if done is not None:
         return done
+    kept = kept_steps(out, marker, steps)  # the steps whose own input and options held
     columns = columns_of(rule, run)
     written = [CALIBRATE_DIR] if rec.relative == baseline.get('recording') else []
     try:
         if baseline.get('recording') is None and not baseline.get('coefficients'):
             raise no_baseline(baseline, rec)
-        table, settled = load_screened(rec, motor_options(rule, run), columns)
-        base = MotorOptions(liquid=baseline['liquid'], motor_file=baseline['coefficients'])
-        if run.calibrate and rec.relative != baseline.get('recording'):
+        wanted = [name for name in steps if name not in kept]
+        if wanted:  # only what is not kept reads the data
+            table, settled = load_screened(rec, motor_options(rule, run), columns)
+            base = MotorOptions(liquid=baseline['liquid'], motor_file=baseline['coefficients'])
+        if CALIBRATE_DIR in wanted:
             calibrate_into(rec.path, str(out / CALIBRATE_DIR), 'auto', run.alpha, run.folds,
                            settled, columns, False, table)
-            written.append(CALIBRATE_DIR)
-        if run.validate:
+        if VALIDATE_DIR in wanted:
             validate_into(rec.path, str(out / VALIDATE_DIR), 'auto', base, columns, False,
                           table)
-            written.append(VALIDATE_DIR)
-        health = recording_health(rec.relative, table, base, out)
-        written.append(HEALTH_DIR)
+        result = (kept[HEALTH_DIR] if HEALTH_DIR in kept
+                  else recording_health(rec.relative, table, base, out).as_dict())
+        written += [name for name in steps if name not in written]
     except Refused as err:
         marker.update(status='refused', reason=str(err), result=None)
     except (CliError, IdentificationError, ModelError, OptionError, OSError) as err:
         marker.update(status='refused', reason=_line(err), result=None)
     else:
-        marker.update(status='done', reason='', result=health.as_dict())
+        marker.update(status='done', reason='', result=result)
     drop_stale(out, tuple(written))
     write_done(out, marker, only=tuple(written))
     return marker
+
+
+def step_keys(rule: MotorRule, run: RunOptions, baseline_key: str) -> dict[str, str]:
+    """
+    Return the key of each output a recording is asked for: what that output depends on.
+
+    Toggling ``--validate`` redoes ``validate/`` only: ``calibrate/`` depends on the entry,
+    the liquid and calibrate's settings, ``health/`` and ``validate/`` on the entry, the
+    liquid and the baseline. The baseline recording's ``calibrate/`` is the baseline task's.
+    """
+    from satmotor_ros.fleet.health import ESTIMATOR, HEALTH_DIR
+    common = {'rule': rule_identity(rule), 'liquid': run.liquid}
+    keys = {}
+    if run.calibrate:
+        keys[CALIBRATE_DIR] = options_key({**common, 'alpha': run.alpha, 'folds': run.folds})
+    if run.validate:
+        keys[VALIDATE_DIR] = options_key({**common, 'baseline': baseline_key})
+    keys[HEALTH_DIR] = options_key({**common, 'baseline': baseline_key, 'estimator': ESTIMATOR})
+    return keys
+
+
+def kept_steps(out: Path, marker: dict[str, Any], steps: dict[str, str]) -> dict[str, Any]:
+    """
+    Return the outputs an earlier run wrote that hold for this one (name -> its result).
+
+    An output holds when the earlier done-marker was for the same recording (the same stat,
+    or content), the output's key is the same, it was done (not refused), and every file it
+    listed under the output is still there, its command's marker saying it wrote them.
+    """
+    from satmotor_ros.cli._output import written_by
+    from satmotor_ros.fleet.health import HEALTH_DIR
+    from satmotor_ros.fleet.resume import read_done
+    old = read_done(out)
+    if old is None or old.get('status') != 'done' or not isinstance(old.get('steps'), dict):
+        return {}
+    if old.get('stat') != marker['stat'] and old.get('content') != marker['content']:
+        return {}
+    listed = [str(name) for name in old.get('outputs', [])]
+    kept: dict[str, Any] = {}
+    for name, key in steps.items():
+        files = [f for f in listed if f.split('/')[0] == name]
+        if old['steps'].get(name) != key or not files or not all(
+                (out / f).is_file() for f in files) or not written_by(OUTPUTS[name])(out / name):
+            continue
+        kept[name] = old.get('result') if name == HEALTH_DIR else None
+    if HEALTH_DIR in kept and not isinstance(kept[HEALTH_DIR], dict):
+        del kept[HEALTH_DIR]
+    return kept
 
 
 def drop_stale(out: Path, keep: tuple[str, ...]) -> None:
@@ -497,4 +551,4 @@ __all__ = ['BASELINE', 'CALIBRATE_DIR', 'EMPTY', 'MONITOR_DIR', 'MotorRefused', 
            'baseline_rule_key', 'drop_stale', 'file_digest',
            'calibrate_baseline', 'columns_of', 'given_baseline', 'input_of', 'load_screened',
            'motor_options', 'no_baseline', 'output_conflict', 'process_recording',
-           'recording_options']
+           'kept_steps', 'recording_options', 'step_keys']
