@@ -347,6 +347,40 @@ def test_a_refused_monitor_step_is_reported_and_a_rerun_starts_no_cluster(tmp_pa
     assert plan([motor], run).chain_from == {'m': 1}  # the step can run now
 
 
+def test_monitor_steps_that_read_nothing_start_no_cluster(tmp_path):
+    """
+    Cold review of issue 24 (finding 9): a rerun left only monitor steps started a cluster.
+
+    The steps of a motor without a baseline read no data (each is refused with the
+    baseline's reason and passes the state on): a rerun that has only those left (a
+    scheduler lost before them) writes them itself and starts no cluster.
+    """
+    from satmotor_ros.fleet import run_fleet
+    from satmotor_ros.fleet.chain import read_step
+    from satmotor_ros.fleet.config import FleetConfig
+    from satmotor_ros.fleet.discover import discover
+    from satmotor_ros.fleet.tasks import calibrate_baseline, process_recording, RunOptions
+    root, out = tmp_path / 'root', tmp_path / 'out'
+    for name in ('a.csv', 'b.csv'):
+        (root / 'm').mkdir(parents=True, exist_ok=True)
+        (root / 'm' / name).write_bytes(b'\xff\xfe garbage\n')
+    (motor,) = discover(root, FleetConfig())
+    run = RunOptions(str(out.resolve()), liquid='water')
+    out.mkdir()
+    (out / '.satmotor-output.json').write_text('{"command": "fleet"}\n')
+    baseline = calibrate_baseline(motor, run)  # what a first run's workers did, but the
+    assert baseline['recording'] is None  # monitor's steps: the scheduler went first
+    for rec in motor.recordings:
+        process_recording(rec, motor.rule, baseline, run)
+    lines = []
+    again = run_fleet(str(root), str(out), liquid='water', show_progress=False,
+                      say=lines.append)
+    assert again.cluster == '' and 'no cluster started' in lines[0]
+    steps = [read_step(out / 'm' / rec.name) for rec in motor.recordings]
+    assert [s['status'] for s in steps] == ['refused', 'refused']
+    assert steps[1]['prev'] == steps[0]['chain']  # one chain, passed on
+
+
 def test_a_users_calibrate_dir_does_not_move_the_baseline(tmp_path):
     """
     Cold review F5 of issue 24: a user's file in calibrate/ moved the baseline on.

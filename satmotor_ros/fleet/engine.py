@@ -117,6 +117,41 @@ def plan(motors: list[Motor], run: RunOptions) -> Plan:
     return result
 
 
+def settle_without_baseline(work: Plan, run: RunOptions) -> int:
+    """
+    Write the monitor steps left of motors without a baseline here, not on a cluster.
+
+    Such a step reads no data: it is refused with the baseline's reason and passes the state
+    on (:func:`~satmotor_ros.fleet.chain.monitor_step`), so a rerun left only those (a
+    scheduler lost before them) starts no cluster.
+
+    Parameters
+    ----------
+    work : Plan
+        From :func:`plan`; its steps and ``chain_from`` are updated, [-]
+    run : RunOptions
+        The run's options, [-]
+
+    Returns
+    -------
+    int
+        The steps written.
+
+    """
+    written = 0
+    for motor in work.motors:
+        baseline = work.baselines.get(motor.motor)
+        start = work.chain_from.get(motor.motor)
+        if start is None or baseline is None or baseline.get('coefficients'):
+            continue
+        step = work.steps[motor.recordings[start - 1].relative] if start else None
+        for rec in motor.recordings[start:]:
+            step = work.steps[rec.relative] = monitor_step(rec, motor.rule, baseline, run, step)
+            written += 1
+        del work.chain_from[motor.motor]
+    return written
+
+
 def _valid_baseline(motor: Motor, run: RunOptions,
                     hashes: HashCache) -> dict[str, Any] | None:
     """Return the motor's baseline when it still holds for the recordings as they are now."""
@@ -200,7 +235,10 @@ def execute(work: Plan, run: RunOptions, workers: int = 0, scheduler: str = '',
 
     """
     with connect(workers, scheduler) as (client, placed):
-        say(f'fleet: {len(work.todo)} recording(s) to do on {placed.workers} worker(s) '
+        steps = sum(len(m.recordings) - work.chain_from[m.motor] for m in work.motors
+                    if m.motor in work.chain_from)
+        say(f'fleet: {len(work.todo)} recording(s) and {steps} monitor step(s) to do on '
+            f'{placed.workers} worker(s) '
             f'at {placed.address}, one task per worker at a time, '
             f'memory per task {_size(placed.memory_per_task)}')
         return run_on(client, work, run, show_progress), placed
@@ -417,4 +455,5 @@ def _cancelled(err: BaseException) -> bool:
 
 
 __all__ = ['Cluster', 'MEMORY_CAP', 'MEMORY_FRACTION', 'Plan', 'WORKER_WAIT', 'check_address',
-           'connect', 'execute', 'machine_workers', 'memory_per_worker', 'plan', 'run_on']
+           'connect', 'execute', 'machine_workers', 'memory_per_worker', 'plan', 'run_on',
+           'settle_without_baseline']

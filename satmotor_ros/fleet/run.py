@@ -13,7 +13,7 @@ from typing import Any
 from satmotor_ros.cli._output import check_target, MARKER, written_by
 from satmotor_ros.fleet.config import FLEET_FILE, FleetConfig, load_fleet, RESERVED
 from satmotor_ros.fleet.discover import discover
-from satmotor_ros.fleet.engine import check_address, execute, plan
+from satmotor_ros.fleet.engine import check_address, execute, plan, settle_without_baseline
 from satmotor_ros.fleet.errors import FleetError
 from satmotor_ros.fleet.explain import explain_alarms
 from satmotor_ros.fleet.health import ESTIMATOR
@@ -109,6 +109,7 @@ def run_fleet(root: str, out: str, fleet: str = '', workers: int = 0, scheduler:
         (target / MARKER).write_text(json.dumps({'command': 'fleet'}) + '\n', encoding='utf-8')
     options = RunOptions(str(target), calibrate, validate, liquid)
     work = plan(motors, options)
+    settle_without_baseline(work, options)  # steps that read nothing: no cluster for them
     markers = dict(work.done)
     where = ''
     if not work.idle:
