@@ -3,6 +3,7 @@
 
 from datetime import datetime, timezone
 import json
+from pathlib import Path
 
 from health_data import series_csv
 import numpy as np
@@ -379,6 +380,79 @@ def test_monitor_steps_that_read_nothing_start_no_cluster(tmp_path):
     steps = [read_step(out / 'm' / rec.name) for rec in motor.recordings]
     assert [s['status'] for s in steps] == ['refused', 'refused']
     assert steps[1]['prev'] == steps[0]['chain']  # one chain, passed on
+
+
+def _mbari_fleet(root):
+    """Two motors, each with a stretch of both MBARI logs (rows below vacuum in each)."""
+    from vendored_data import data_path
+    stretches = {'2021.07.26T10.51.44.exp': (4000, 5500), 'FrictionIDMovesWithBiasCurr.exp':
+                 (2000, 3500)}  # data lines; the first below vacuum: 5086, 3352
+    for motor in ('buoy_a', 'buoy_b'):
+        for name, (first, last) in stretches.items():
+            lines = data_path('real', 'mbari_pto', name).read_text().splitlines(True)
+            (root / motor).mkdir(parents=True, exist_ok=True)
+            (root / motor / name).write_text(''.join([lines[0], *lines[1 + first:1 + last]]))
+    (root / 'fleet.yaml').write_text(''.join(
+        f"  - {{pattern: '{m}/**', motor: {m}, liquid: oil, family: paszota, displacement: "
+        "0.30 in^3/rev, columns: mbari_pto}\n" for m in ('buoy_a', 'buoy_b')))
+    (root / 'fleet.yaml').write_text('motors:\n' + (root / 'fleet.yaml').read_text())
+    return root
+
+
+def test_the_mbari_logs_are_read_as_calibrate_reads_them_rows_dropped_and_said(tmp_path,
+                                                                               capsys):
+    """
+    Cold review of issue 24 (finding 5): the fleet refused the real MBARI logs whole.
+
+    A gauge pressure below vacuum in some rows: ``satmotor calibrate`` drops those rows with
+    a warning, the fleet refused the recording. One rule now: calibrate's reader and its
+    row-level handling, the rows said in the marker and fleet.md; refused whole only when
+    damaged (one row too few cells, here).
+    """
+    from satmotor_ros.cli._bench import load_data
+    from satmotor_ros.fleet.config import load_fleet
+    from satmotor_ros.fleet.discover import discover
+    from satmotor_ros.fleet.report import write_report
+    from satmotor_ros.fleet.summary import motor_view
+    from satmotor_ros.fleet.tasks import (columns_of, given_baseline, load_screened,
+                                          motor_options, process_recording, Refused,
+                                          RunOptions, warnings_of)
+    from satmotor_ros.identify.table import IMPOSSIBLE
+    from satmotor_ros.model.io.config import default_config_path
+    root = _mbari_fleet(tmp_path / 'root')
+    motors = discover(root, load_fleet(root / 'fleet.yaml'))
+    assert [(m.motor, len(m.recordings)) for m in motors] == [('buoy_a', 2), ('buoy_b', 2)]
+    run = RunOptions(str(tmp_path / 'out'))
+    for motor in motors:
+        options = motor_options(motor.rule, run)
+        for rec in motor.recordings:
+            table, _ = load_screened(rec, options, columns_of(motor.rule, run))
+            capsys.readouterr()
+            same = load_data(rec.path, 'mbari_pto', options.spec().geometry.displacement)
+            said = capsys.readouterr().err  # what calibrate prints of it
+            assert len(table) == len(same) < 1500 and table.notes == same.notes
+            (note,) = warnings_of(table)
+            assert note.startswith(IMPOSSIBLE) and 'below vacuum' in note
+            assert said == f'warning: {rec.path}: {note}\n'
+    rec = motors[0].recordings[0]  # a marker says the rows, and fleet.md
+    options = motor_options(motors[0].rule, run)
+    motor_file = tmp_path / 'lab.yaml'
+    motor_file.write_text(default_config_path('sm075_25.yaml').read_text())
+    baseline = given_baseline(motors[0], run) | {'coefficients': str(motor_file),
+                                                 'liquid': 'oil'}
+    marker = process_recording(rec, motors[0].rule, baseline, run)
+    assert marker['status'] == 'done', marker
+    assert marker['warnings'] == warnings_of(load_screened(rec, options, 'mbari_pto')[0])
+    view = motor_view('buoy_a', 'oil', [marker], None)
+    assert view['warnings'] == [{'path': rec.relative, 'warning': marker['warnings'][0]}]
+    write_report(tmp_path / 'out', [view], {
+        'root': str(root), 'recordings': 1, 'refused': 0, 'ran': 1, 'reused': 0, 'written': '',
+        'estimator': 'x', 'limit': 2.0, 'cluster': '', 'fleet_file': ''})
+    assert marker['warnings'][0] in (tmp_path / 'out' / 'fleet.md').read_text()
+    lines = Path(rec.path).read_text().splitlines(True)
+    Path(rec.path).write_text(''.join([*lines[:50], '1.0 2.0 3.0\n', *lines[50:]]))
+    with pytest.raises(Refused, match='cells'):  # damaged: refused whole
+        load_screened(rec, motor_options(motors[0].rule, run), 'mbari_pto')
 
 
 def test_a_users_calibrate_dir_does_not_move_the_baseline(tmp_path):

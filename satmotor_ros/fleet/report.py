@@ -170,6 +170,10 @@ def markdown(motors: list[dict[str, Any]], header: dict[str, Any]) -> str:
         if m['refused']:
             lines += ['', 'Refused recordings (whole, not salvaged):']
             lines += [f"- `{r['path']}`: {r['reason']}" for r in m['refused']]
+        if m.get('warnings'):
+            lines += ['', 'Rows dropped from recordings used (as `satmotor calibrate` drops '
+                      'them, and warns):']
+            lines += [f"- `{w['path']}`: {w['warning']}" for w in m['warnings']]
         if m.get('monitor_refused'):
             lines += ['', "Recordings the health monitor's step refused or failed on (its state "
                       'passed on unchanged; their points are their ratios):']

@@ -101,7 +101,8 @@ def motor_view(motor: str, liquid: str, markers: list[dict[str, Any]],
         ``time_source``, its ``estimator`` and, for a ratio where the monitor gave a figure
         not taken, why (``monitor_unused``, :func:`monitor_unfit`); ``monitor_refused``
         lists the recordings (not refused whole) whose monitor step was refused or failed,
-        with the one-line reason.
+        with the one-line reason; ``warnings`` the rows a used recording's reader dropped
+        (``path``, ``warning``: what ``satmotor calibrate`` warns of).
 
     """
     view = _motor_view(motor, liquid, markers, baseline, limit, steps or [])
@@ -203,8 +204,10 @@ def _view(motor: str, liquid: str, markers: list[dict[str, Any]],
     sources = sorted({m.get('time_source', '') for m in markers})
     times = [float(m['time']) for m in markers
              if m.get('status') == 'done' and isinstance(m.get('time'), (int, float))]
+    warned = [{'path': m['recording'], 'warning': w} for m in markers
+              if m.get('status') == 'done' for w in m.get('warnings') or ()]
     return {'motor': motor, 'liquid': liquid, 'recordings': len(markers), 'refused': refused,
-            'leakage_factor': series, 'trend_per_day': trend, 'days_to_limit': days,
+            'warnings': warned, 'leakage_factor': series, 'trend_per_day': trend, 'days_to_limit': days,
             'alarms': alarms, 'limit': limit, 'last': series[-1]['value'] if series else None,
             'baseline': _baseline_line(baseline), 'time_sources': sources,
             'estimator': estimator, 'trend_clock': clock,

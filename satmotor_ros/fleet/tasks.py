@@ -20,7 +20,8 @@ from typing import Any
 
 from satmotor_ros.fleet.config import MotorRule
 from satmotor_ros.fleet.discover import Motor, Recording
-from satmotor_ros.fleet.resume import content_of, is_done, options_key, stat_of, write_done
+from satmotor_ros.fleet.resume import (content_of, is_done, options_key, read_done, stat_of,
+                                      write_done)
 from satmotor_ros.options import MotorOptions, OptionError
 
 BASELINE = 'baseline.json'
@@ -105,7 +106,13 @@ def columns_of(rule: MotorRule, run: RunOptions) -> str:
 
 def load_screened(rec: Recording, options: MotorOptions, columns: str) -> tuple[Any, Any]:
     """
-    Load a recording and refuse it whole if any of it is damaged.
+    Load a recording as ``satmotor calibrate`` does, and refuse it whole if it is damaged.
+
+    The reader and its row-level handling are calibrate's (:func:`~satmotor_ros.cli._bench.
+    load_data`): rows with an impossible value or absurd cells are dropped and said
+    (:func:`warnings_of`), not a reason to refuse. Damaged is what no row-level rule reads:
+    unreadable or not UTF-8 (garbage), a row with the wrong number of cells, a text file
+    cut mid-row, every pressure zero.
 
     Parameters
     ----------
@@ -124,7 +131,7 @@ def load_screened(rec: Recording, options: MotorOptions, columns: str) -> tuple[
     Raises
     ------
     Refused
-        One line: unreadable, truncated, garbage, cells dropped, every pressure zero;
+        One line: unreadable, truncated, garbage, every pressure zero, empty;
         :class:`MotorRefused` (:data:`NO_LIQUID`) for sound data when neither fleet.yaml,
         --liquid nor the data name the liquid.
 
@@ -134,8 +141,6 @@ def load_screened(rec: Recording, options: MotorOptions, columns: str) -> tuple[
     from satmotor_ros.cli._common import CliError
     from satmotor_ros.cli._liquid import settle_liquid
     from satmotor_ros.identify import IdentificationError
-    from satmotor_ros.identify.table import BAD_CELLS, IMPOSSIBLE
-    from satmotor_ros.identify.textfile import SANITY
     from satmotor_ros.model import ModelError
     import numpy as np
     unsettled = False
@@ -157,9 +162,6 @@ def load_screened(rec: Recording, options: MotorOptions, columns: str) -> tuple[
                       + str(err)) from None
     except OSError as err:
         raise Refused(f'{err.strerror or err}') from None
-    for note in table.notes:
-        if note.startswith((IMPOSSIBLE, BAD_CELLS, SANITY)):
-            raise Refused(note)
     if rec.kind != 'bag' and not _ends_a_line(rec.path):
         raise Refused('ends without an end of line: truncated mid-row')
     if not np.any(table.p_in) and not np.any(table.p_out):
@@ -167,6 +169,13 @@ def load_screened(rec: Recording, options: MotorOptions, columns: str) -> tuple[
     if unsettled:
         raise MotorRefused(NO_LIQUID)
     return table, settled
+
+
+def warnings_of(table: Any) -> list[str]:
+    """Return what a table's reader dropped or found suspicious: calibrate's warnings."""
+    from satmotor_ros.identify.table import BAD_CELLS, IMPOSSIBLE
+    from satmotor_ros.identify.textfile import SANITY
+    return [note for note in table.notes if note.startswith((IMPOSSIBLE, BAD_CELLS, SANITY))]
 
 
 def _first_line(err: Exception) -> str:
@@ -461,6 +470,10 @@ def process_recording(rec: Recording, rule: MotorRule, baseline: dict[str, Any],
         if VALIDATE_DIR in wanted:
             validate_into(rec.path, str(out / VALIDATE_DIR), 'auto', base, columns, False,
                           table)
+        if wanted:
+            marker['warnings'] = warnings_of(table)
+        else:  # nothing read: the earlier run's
+            marker['warnings'] = (read_done(out) or {}).get('warnings', [])
         result = (kept[HEALTH_DIR] if HEALTH_DIR in kept
                   else recording_health(rec.relative, table, base, out).as_dict())
         written += [name for name in steps if name not in written]
@@ -504,7 +517,6 @@ def kept_steps(out: Path, marker: dict[str, Any], steps: dict[str, str]) -> dict
     """
     from satmotor_ros.cli._output import written_by
     from satmotor_ros.fleet.health import HEALTH_DIR
-    from satmotor_ros.fleet.resume import read_done
     old = read_done(out)
     if old is None or old.get('status') != 'done' or not isinstance(old.get('steps'), dict):
         return {}
@@ -550,5 +562,5 @@ __all__ = ['BASELINE', 'CALIBRATE_DIR', 'EMPTY', 'MONITOR_DIR', 'MotorRefused', 
            'OUTPUTS', 'Refused', 'STATE', 'STEP', 'VALIDATE_DIR', 'ZERO_PRESSURE',
            'baseline_rule_key', 'drop_stale', 'file_digest',
            'calibrate_baseline', 'columns_of', 'given_baseline', 'input_of', 'load_screened',
-           'motor_options', 'no_baseline', 'output_conflict', 'process_recording',
+           'motor_options', 'no_baseline', 'output_conflict', 'process_recording', 'warnings_of',
            'kept_steps', 'recording_options', 'step_keys']
