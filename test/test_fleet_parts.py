@@ -603,6 +603,32 @@ def test_an_empty_csv_is_refused_in_one_clear_line(tmp_path):
     assert str(err.value) == EMPTY
 
 
+def test_a_recording_timed_by_its_mtime_among_timed_ones_is_kept_off_the_time_line():
+    """
+    Cold review of issue 24 (finding 4): an mtime-dated recording took over the time line.
+
+    Copied today among recordings of March, it was the motor's latest, its factor bent the
+    trend and the ranking. It is listed apart (its factor, said why in fleet.md); a motor
+    whose recordings all have only their mtime keeps them on its line.
+    """
+    from satmotor_ros.fleet.report import markdown
+    markers = _markers([1.0, 1.06, 1.12, 1.18, 1.24])
+    copied = {**_markers([1.0], start=EPOCH + 200 * DAY)[0], 'recording': 'copy.csv',
+              'time_source': MTIME}
+    view = motor_view('m', 'water', [*markers, copied], None)
+    assert view['trend_per_day'] == pytest.approx(0.06)
+    assert view['last_time'] == markers[-1]['time'] and view['recordings'] == 6
+    assert [p['recording'] for p in view['leakage_factor']] == [m['recording'] for m in markers]
+    assert [u['recording'] for u in view['undated']] == ['copy.csv']
+    text = ' '.join(markdown([view], {'root': '/r', 'recordings': 6, 'refused': 0, 'ran': 6,
+                                      'reused': 0, 'written': '', 'estimator': 'x',
+                                      'limit': 2.0, 'cluster': '', 'fleet_file': ''}).split())
+    assert "only their file's modification time" in text and '`copy.csv`' in text
+    alone = [{**m, 'time_source': MTIME} for m in markers]  # all alike: one time line
+    view = motor_view('m', 'water', alone, None)
+    assert not view['undated'] and len(view['leakage_factor']) == 5
+
+
 def test_without_a_baseline_the_damaged_keep_their_reason_and_the_sound_say_why(tmp_path):
     from satmotor_ros.fleet.synthetic import make_fleet
     from satmotor_ros.fleet.tasks import calibrate_baseline, process_recording, RunOptions

@@ -170,6 +170,13 @@ def markdown(motors: list[dict[str, Any]], header: dict[str, Any]) -> str:
         if m['refused']:
             lines += ['', 'Refused recordings (whole, not salvaged):']
             lines += [f"- `{r['path']}`: {r['reason']}" for r in m['refused']]
+        if m.get('undated'):
+            lines += ['', 'Warning: recordings with no time of their own (none in the data or '
+                      "the path), only their file's modification time, which may be a copy's: "
+                      "kept out of this motor's trend, days to the limit, alarms and ranking "
+                      '(give them a date in the path, or an epoch time column):']
+            lines += [f"- `{u['recording']}` (file modified {u['date']}): leakage factor "
+                      f"{u['value']:.3g}" for u in m['undated']]
         if m.get('warnings'):
             lines += ['', 'Rows dropped from recordings used (as `satmotor calibrate` drops '
                       'them, and warns):']

@@ -101,17 +101,44 @@ def motor_view(motor: str, liquid: str, markers: list[dict[str, Any]],
         ``time_source``, its ``estimator`` and, for a ratio where the monitor gave a figure
         not taken, why (``monitor_unused``, :func:`monitor_unfit`); ``monitor_refused``
         lists the recordings (not refused whole) whose monitor step was refused or failed,
-        with the one-line reason; ``warnings`` the rows a used recording's reader dropped
+        with the one-line reason; ``undated`` the recordings timed only by their file's
+        modification time where others of the motor have a time of their own (kept out of
+        its time line: :func:`_split_undated`); ``warnings`` the rows a used recording's reader dropped
         (``path``, ``warning``: what ``satmotor calibrate`` warns of).
 
     """
-    view = _motor_view(motor, liquid, markers, baseline, limit, steps or [])
+    markers, undated = _split_undated(markers)
+    apart = {m['recording'] for m in undated}
+    view = _motor_view(motor, liquid, markers, baseline, limit,
+                       [s for s in steps or () if s['recording'] not in apart])
+    view['recordings'] += len(undated)
+    view['undated'] = [{**_ratio_point(m), 'time': m.get('time')} for m in undated]
     refused = {r['path'] for r in view['refused']}  # a recording refused whole says it there
     view['monitor_refused'] = [{'path': s['recording'], 'reason': s.get('reason', ''),
                                 'status': s.get('status')} for s in steps or ()
                                if s.get('status') in ('refused', 'failed')
                                and s['recording'] not in refused]
     return view
+
+
+def _split_undated(markers: list[dict[str, Any]]) \
+        -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
+    """
+    Split off the used recordings timed only by their file's mtime, where others are not.
+
+    A file's modification time is when it was copied or touched as often as when it was
+    recorded: among recordings timed by their data or their path, one placed by it lands
+    days or months off (the day of the copy) and would bend the trend, the days to the
+    limit and the ranking. It is kept out of the motor's time line and listed apart, its
+    factor with it. A motor whose recordings all have only their mtime keeps them all.
+    """
+    from satmotor_ros.fleet.discover import MTIME
+    timed = any(m.get('time_source') != MTIME for m in markers if m.get('status') == 'done')
+    if not timed:
+        return markers, []
+    apart = [m for m in markers if m.get('status') == 'done' and m.get('result')
+             and m.get('time_source') == MTIME]
+    return [m for m in markers if m not in apart], apart
 
 
 def _motor_view(motor: str, liquid: str, markers: list[dict[str, Any]],
