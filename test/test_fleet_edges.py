@@ -392,10 +392,9 @@ def _mbari_fleet(root):
             lines = data_path('real', 'mbari_pto', name).read_text().splitlines(True)
             (root / motor).mkdir(parents=True, exist_ok=True)
             (root / motor / name).write_text(''.join([lines[0], *lines[1 + first:1 + last]]))
-    (root / 'fleet.yaml').write_text(''.join(
+    (root / 'fleet.yaml').write_text('motors:\n' + ''.join(
         f"  - {{pattern: '{m}/**', motor: {m}, liquid: oil, family: paszota, displacement: "
-        "0.30 in^3/rev, columns: mbari_pto}\n" for m in ('buoy_a', 'buoy_b')))
-    (root / 'fleet.yaml').write_text('motors:\n' + (root / 'fleet.yaml').read_text())
+        '0.30 in^3/rev, columns: mbari_pto}\n' for m in ('buoy_a', 'buoy_b')))
     return root
 
 

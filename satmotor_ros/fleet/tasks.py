@@ -21,7 +21,7 @@ from typing import Any
 from satmotor_ros.fleet.config import MotorRule
 from satmotor_ros.fleet.discover import Motor, Recording
 from satmotor_ros.fleet.resume import (content_of, is_done, options_key, read_done, stat_of,
-                                      write_done)
+                                       write_done)
 from satmotor_ros.options import MotorOptions, OptionError
 
 BASELINE = 'baseline.json'
@@ -558,7 +558,8 @@ def _line(err: BaseException) -> str:
     return text.splitlines()[0] if text else type(err).__name__
 
 
-__all__ = ['BASELINE', 'CALIBRATE_DIR', 'EMPTY', 'MONITOR_DIR', 'MotorRefused', 'NO_LIQUID', 'RunOptions',
+__all__ = ['BASELINE', 'CALIBRATE_DIR', 'EMPTY', 'MONITOR_DIR', 'MotorRefused', 'NO_LIQUID',
+           'RunOptions',
            'OUTPUTS', 'Refused', 'STATE', 'STEP', 'VALIDATE_DIR', 'ZERO_PRESSURE',
            'baseline_rule_key', 'drop_stale', 'file_digest',
            'calibrate_baseline', 'columns_of', 'given_baseline', 'input_of', 'load_screened',
