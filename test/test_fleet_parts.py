@@ -748,6 +748,17 @@ def test_a_monitor_alarm_on_an_epoch_clock_is_the_recordings_it_was_raised_in(tm
     assert [(a['kind'], a['recording']) for a in view['alarms']] == [('change', 'm1/r2.csv')]
 
 
+def _monitored(values, alarm_day):
+    """Return one monitor's steps through daily 10-minute recordings, an alarm on a day."""
+    return [{'recording': f'r{i}.csv', 'status': 'done', 'result': {
+        'leakage_factor': {'value': v, 'ci95': [v - 0.03, v + 0.03]}, 'learning': False,
+        'trend_per_hour': None, 'trend_per_day': None, 'hours_to_limit': None,
+        'recording_samples': 3000, 'recording_skipped': 0,
+        'span_s': [EPOCH + i * DAY, EPOCH + i * DAY + 600.0],
+        'alarms': [{'time_s': alarm_day * DAY + 30.0, 'kind': 'change', 'what': 'wear'}]}}
+        for i, v in enumerate(values)]
+
+
 def test_a_monitor_without_a_trend_leaves_the_motor_the_calendar_line():
     """
     Cold review of issue 24 (finding 1): a monitor with no trend left the motor none.
@@ -756,18 +767,27 @@ def test_a_monitor_without_a_trend_leaves_the_motor_the_calendar_line():
     gets the line through the figures against the recordings' times, not "not drifting".
     """
     values = 1.0 + 0.06 * np.arange(8)
-    steps = [{'recording': f'r{i}.csv', 'status': 'done', 'result': {
-        'leakage_factor': {'value': v, 'ci95': [v - 0.03, v + 0.03]}, 'learning': False,
-        'trend_per_hour': None, 'trend_per_day': None, 'hours_to_limit': None,
-        'recording_samples': 3000, 'recording_skipped': 0,
-        'span_s': [EPOCH + i * DAY, EPOCH + i * DAY + 600.0],
-        'alarms': [{'time_s': 3 * DAY + 30.0, 'kind': 'change', 'what': 'wear'}]}}
-        for i, v in enumerate(values)]
-    view = motor_view('m', 'water', _markers(values), None, steps=steps)
+    view = motor_view('m', 'water', _markers(values), None, steps=_monitored(values, 3))
     assert view['trend_per_day'] == pytest.approx(0.06)
     assert view['days_to_limit'] == pytest.approx((2.0 - values[-1]) / 0.06)
     assert view['trend_clock'] != MONITOR_EPOCH
-    assert [a['recording'] for a in view['alarms']] == ['r3.csv']
+
+
+def test_a_monitor_change_alarm_is_the_motors_where_the_calendar_sees_a_step():
+    """
+    Cold review of issue 24: the monitor raised two change alarms on a steady wear.
+
+    On its operating clock a day's wear between two recordings is a jump (it saw no time
+    pass): its detector calls it a step. On the calendar it is the trend, so the fleet
+    keeps a monitor's change alarm only where the calendar shows a step too: a leak's.
+    """
+    wear = 1.0 + 0.06 * np.arange(8)
+    view = motor_view('m', 'water', _markers(wear), None, steps=_monitored(wear, 3))
+    assert view['alarms'] == []  # the jump at r3 is the wear on the calendar
+    leak = np.array([1.0] * 4 + [1.6] * 4)
+    view = motor_view('m', 'water', _markers(leak), None, steps=_monitored(leak, 4))
+    assert [(a['kind'], a['recording']) for a in view['alarms']] == [('change', 'r4.csv')]
+    assert view['alarms'][0]['what'] == 'wear (in r4.csv)'  # the monitor's, not the ratios'
 
 
 def test_a_bag_with_garbage_metadata_is_refused_whole_in_one_line(tmp_path):

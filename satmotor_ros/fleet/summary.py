@@ -103,8 +103,8 @@ def motor_view(motor: str, liquid: str, markers: list[dict[str, Any]],
         lists the recordings (not refused whole) whose monitor step was refused or failed,
         with the one-line reason; ``undated`` the recordings timed only by their file's
         modification time where others of the motor have a time of their own (kept out of
-        its time line: :func:`_split_undated`); ``warnings`` the rows a used recording's reader dropped
-        (``path``, ``warning``: what ``satmotor calibrate`` warns of).
+        its time line: :func:`_split_undated`); ``warnings`` the rows a used recording's
+        reader dropped (``path``, ``warning``: what ``satmotor calibrate`` warns of).
 
     """
     markers, undated = _split_undated(markers)
@@ -234,7 +234,8 @@ def _view(motor: str, liquid: str, markers: list[dict[str, Any]],
     warned = [{'path': m['recording'], 'warning': w} for m in markers
               if m.get('status') == 'done' for w in m.get('warnings') or ()]
     return {'motor': motor, 'liquid': liquid, 'recordings': len(markers), 'refused': refused,
-            'warnings': warned, 'leakage_factor': series, 'trend_per_day': trend, 'days_to_limit': days,
+            'warnings': warned, 'leakage_factor': series, 'trend_per_day': trend,
+            'days_to_limit': days,
             'alarms': alarms, 'limit': limit, 'last': series[-1]['value'] if series else None,
             'baseline': _baseline_line(baseline), 'time_sources': sources,
             'estimator': estimator, 'trend_clock': clock,
@@ -277,6 +278,7 @@ def _monitored(motor: str, liquid: str, markers: list[dict[str, Any]],
         alarms.append({'date': dates.get(recording, ''), 'kind': alarm.get('kind', 'change'),
                        'what': f"{_named(alarm.get('what', 'unexplained'))} (in {recording})",
                        'recording': recording, 'source': 'monitor'})
+    alarms = _on_the_calendar(alarms, series, times, limit)
     holds = _monitor_trend_holds(series, watched)
     if holds and last.get('trend_per_day') is not None:
         hours = last.get('hours_to_limit')  # calendar hours; the trend per calendar day
@@ -294,6 +296,28 @@ def _monitored(motor: str, liquid: str, markers: list[dict[str, Any]],
     trend, days = _calendar_trend(series, times, limit)
     return _view(motor, liquid, markers, series, trend, days, alarms, baseline, limit,
                  BY_MONITOR if holds or len(fit) == len(series) else MIXED, RECORDING_TIMES)
+
+
+def _on_the_calendar(alarms: list[dict[str, Any]], series: list[dict[str, Any]],
+                     times: dict[str, dict[str, Any]], limit: float) -> list[dict[str, Any]]:
+    """
+    Keep the monitor's change alarms whose step stands out on the calendar too.
+
+    The monitor's clock is its operating time: between two recordings a day apart it sees
+    no time pass, so a day's wear is a jump to it, and its detector rightly calls a jump
+    of some per cent a step (twice in eight days of 0.06 a day, relearning after each).
+    On the calendar that jump is the trend. A change alarm of the monitor's is the motor's
+    where the ratios' rule (:func:`_changes`) over the points against the recordings' times
+    finds a change at its recording too; with fewer than three timed points there is no
+    calendar to judge by, and the monitor's alarms stand.
+    """
+    timed = [p for p in series if times.get(p['recording'], {}).get('time') is not None]
+    if len(timed) < 3:
+        return alarms
+    found, _, _ = _ratio_alarms_and_trend(
+        timed, np.array([float(times[p['recording']]['time']) for p in timed]), limit)
+    steps = {a['recording'] for a in found if a['kind'] == 'change'}
+    return [a for a in alarms if a['kind'] != 'change' or a['recording'] in steps]
 
 
 def _named(what: str) -> str:
