@@ -248,10 +248,13 @@ def test_the_monitors_figure_is_taken_only_where_it_is_the_recordings_own():
     assert 'samples/s, below the 0.5' in points[1]['monitor_unused']
     assert 'usable samples, fewer than 150' in points[2]['monitor_unused']
     assert view['estimator'] == 'monitor+ratio' and view['trend_clock'] == RECORDING_TIMES
-    assert [a['recording'] for a in view['alarms'] if a.get('source') == 'monitor'] == \
-        ['r3.csv']
+    assert not view['alarms']  # r1's is the slow log's; r3's 0.03 is no step on the calendar
     assert view['trend_per_day'] == pytest.approx(np.polyfit(np.arange(4.0),
                                                              [1.0, 1.02, 1.02, 1.05], 1)[0])
+    steps[3]['result']['leakage_factor'] = {'value': 1.3, 'ci95': [1.29, 1.31]}  # a step
+    view = motor_view('m', 'water', markers[:3] + [_ratio(3, 1.3)], None, steps=steps)
+    assert [a['recording'] for a in view['alarms'] if a.get('source') == 'monitor'] == \
+        ['r3.csv']  # the monitor's own, raised where its figure is taken
     slow = [_step(i, 1.35, 30, 1800.0) for i in range(4)]  # a motor of slow logs only
     view = motor_view('m', 'water', markers, None, steps=slow)
     assert view['estimator'] == 'ratio'
