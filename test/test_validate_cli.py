@@ -127,7 +127,9 @@ def test_a_recording_is_read_as_calibrate_reads_it(tmp_path, capsys):
     write_bag_of(tmp_path / 'bag', series, 'mcap')
     code, result, _, stderr = _validate(capsys, str(tmp_path / 'bag'), tmp_path / 'out', 'oil')
     assert code == 0, stderr
-    assert 3 <= result['n_points'] < 6000  # steady windows, not samples
+    # every sample (the rows a calibration fits, the bins' means, are the second figure)
+    assert result['error_over'] == {'what': 'samples', 'n': result['n_points']}
+    assert 3 <= result['error_over_bins']['n'] < 6000 <= result['n_points'] + 60
     assert result['error']['rmse_lpm'] < 0.2
     code, samples, stdout, _ = _validate(capsys, str(tmp_path / 'bag'), tmp_path / 'rows',
                                          'oil', mode='points')
