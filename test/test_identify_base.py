@@ -141,3 +141,16 @@ def test_a_drop_that_empties_a_direction_is_warned_of():
     warned = [w for w in cal.warnings()['warnings'] if w.startswith(EMPTIED)]
     assert len(warned) == 1 and f'{lost} of {positive} samples with a positive drop' in warned[0]
     assert emptied(truth, table, cal.base) is None  # the true drop leaves them in
+
+
+def test_the_profile_does_not_depend_on_the_units_of_a_term_fitted_beside_it():
+    # a transient term is a pressure rate [Pa/s] beside flows [m^3/s]: 10^12 apart and more;
+    # unscaled, lstsq's cut-off dropped the flows' small singular values at some factors
+    # only, and the profile jumped there (a 'fitted' drop at the jump's edge)
+    spec, truth = _truth('paszota', 0.5)
+    points = _points(truth, 0.02)
+    term = np.random.default_rng(3).normal(0.0, 1.0, len(points))
+    bases = [fit_base(spec, 'oil', points, {'term': unit * term}) for unit in (1e-4, 1e14)]
+    assert bases[0].fitted and bases[1].fitted, bases[1].note
+    assert bases[1].channel_drop['factor'] == pytest.approx(bases[0].channel_drop['factor'],
+                                                            rel=1e-4)

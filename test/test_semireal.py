@@ -20,7 +20,8 @@ from satmotor_ros.cli.main import main
 from satmotor_ros.identify.columns import load_mapping, read_log
 from satmotor_ros.identify.semireal import (build_case, estimate_noise, ExternalLeak, F11_5,
                                             FlowGain, FlowLag, load_trajectory, realistic,
-                                            ReliefValve, SpeedGain, Wear, write_mbari_log)
+                                            ReliefValve, SpeedGain, true_motor, Wear,
+                                            write_mbari_log)
 from satmotor_ros.model import MotorModel
 from satmotor_ros.model.units import INCH, LPM, MPA, PSI, RPM
 from scipy.ndimage import median_filter, uniform_filter1d
@@ -79,12 +80,33 @@ def test_a_case_is_the_real_trajectory_and_reads_back_through_the_mbari_mapping(
 
 def test_without_effects_or_noise_the_flow_is_the_known_motors():
     case = _case(STEPPED, noise=False)
-    model = MotorModel.for_displacement(F11_5, 'paszota')
+    model = true_motor()
     np.testing.assert_array_equal(case.flow, case.base_flow)
     smooth_speed = case.base_flow / F11_5  # the losses are small: the flow follows the speed
     assert np.median(np.abs(smooth_speed - case.speed)) < 0.01 * np.max(np.abs(case.speed))
     point = model.absorbency(case.speed[100], dp=case.p_a[100] - case.p_b[100]).flow
     assert case.flow[100] == pytest.approx(float(point), rel=0.02, abs=0.05 * LPM)
+
+
+def _below_the_channel_drop(model, table):
+    """Return each direction's share of motor-mode rows whose port drop is below the drop."""
+    flow, dp = table.flow, table.dp
+    motor = (flow * dp > 0.0) & (flow * table.speed > 0.0)
+    below = np.abs(dp) < model.equations.channel_drop(np.abs(flow))
+    return [float(np.mean(below[motor & (np.sign(dp) == sign)])) for sign in (-1, 1)]
+
+
+@pytest.mark.parametrize('name', [STEPPED, BIAS])
+def test_the_true_motor_s_channel_drop_is_a_real_motor_s(name):
+    # a velocity-head estimate (0.3 MPa at 26 l/min), not the guess scaled by similarity (9.4
+    # MPa), which is above the port drop of more than 5 % of one direction's motor-mode rows
+    # of the logs: a case made with it is a motor no rig runs
+    model = true_motor()
+    assert model.equations.channel_drop(26.0 * LPM) == pytest.approx(0.3 * MPA, rel=0.02)
+    table = _case(name, noise=False).as_table()
+    assert max(_below_the_channel_drop(model, table)) < 0.01
+    assert max(_below_the_channel_drop(MotorModel.for_displacement(F11_5, 'paszota'),
+                                       table)) > 0.05
 
 
 @pytest.mark.parametrize('direction', [-1, 1])

@@ -214,6 +214,10 @@ class _Profile:
         y = parts.loss
         precision = np.ones(y.size) if self.scale is None else 1.0 / self.scale ** 2
         weight = precision
+        # each column to unit norm: the terms' units differ by 10^18 (a flow, a pressure
+        # rate), and lstsq's cut-off would drop a small singular value at some factors only
+        norm = np.linalg.norm(x, axis=0)
+        x = x / np.where(norm > 0.0, norm, 1.0)
         for _ in range(IRLS_STEPS if self.scale is not None else 1):
             root = np.sqrt(weight)
             beta = np.linalg.lstsq(x * root[:, None], y * root, rcond=None)[0]

@@ -28,6 +28,7 @@ from satmotor_ros.identify.synthetic import first_order
 from satmotor_ros.identify.table import BenchTable
 from satmotor_ros.model import MotorModel
 from satmotor_ros.model._typing import FloatArray
+from satmotor_ros.model.families.defaults import default_motor
 from satmotor_ros.model.units import INCH, LPM, MPA, PSI, RPM
 from scipy.ndimage import median_filter, uniform_filter1d
 
@@ -44,6 +45,20 @@ MOVING_LPM_PER_S = 3.0
 """The flow changes fast enough for its timing to show above this rate, [(l/min)/s]."""
 
 SPIKE_SAMPLES = 3
+
+TRUE_CHANNEL_DROP = 0.3 * MPA
+"""The true motor's channel drop (eq. (35)) at :data:`TRUE_CHANNEL_SPEED`'s flow, [Pa].
+
+A velocity-head estimate for the F11-5: at 26 l/min its ports (about 10 mm bore) run oil at
+5.5 m/s, a velocity head rho v^2/2 of 13 kPa; some 20 of them over the ports, the distributor
+and the bends give 0.3 MPa. The family's drop scaled by similarity from the SM-0,75/25 (9.4
+MPa there) is a guess the data of a real rig refute (doc/semireal.md)."""
+
+TRUE_CHANNEL_SPEED = 5300.0 * RPM
+"""Speed at whose flow q_t n the true channel drop is :data:`TRUE_CHANNEL_DROP`, [rad/s].
+
+At one speed the passages' velocities scale with the size (similarity), so the factor on the
+family's scaled coefficients is one for every displacement."""
 """Samples of the running median that takes the readings' spikes out of the true state."""
 
 
@@ -441,6 +456,41 @@ class Case:
                           {'time': 's'}, '<semireal>', time_series=True)
 
 
+def true_motor(family: str = 'paszota', displacement: float = F11_5) -> MotorModel:
+    """
+    Return the motor whose flow a case is: a family's defaults with a plausible channel drop.
+
+    The defaults are scaled by similarity from the SM-0,75/25, and so is their channel drop
+    of eq. (35): half the hydraulic power of a 4.9 cm^3/rev motor at full flow, above the
+    port drop at which a real rig's motor runs (the base caps such a guess at the port drop of
+    each direction's motor-mode rows, :mod:`.base`). The true motor's drop is
+    :data:`TRUE_CHANNEL_DROP` at :data:`TRUE_CHANNEL_SPEED`; every other coefficient is the
+    family's default.
+
+    Parameters
+    ----------
+    family : str
+        The motor's model family, [-]
+    displacement : float
+        q_t/(2 pi), [m^3/rad]
+
+    Returns
+    -------
+    MotorModel
+        The true motor (oil).
+
+    """
+    spec = default_motor(family, displacement)
+    model = MotorModel.from_spec(spec, 'oil')
+    factor = TRUE_CHANNEL_DROP / float(model.equations.channel_drop(
+        displacement * TRUE_CHANNEL_SPEED))
+    chosen = spec.sets['oil']
+    coef = replace(chosen.coefficients, **{n: getattr(chosen.coefficients, n) * factor
+                                           for n in model.family.channel})
+    return MotorModel.from_spec(replace(spec, sets={**spec.sets, 'oil': replace(
+        chosen, coefficients=coef)}), 'oil')
+
+
 def _correlated(width: float, n: int, rng: np.random.Generator) -> FloatArray:
     """Return unit-variance white noise through a Gaussian kernel `width` samples wide."""
     reach = int(np.ceil(4.0 * width))
@@ -475,7 +525,8 @@ def build_case(trajectory: Trajectory, effects: Sequence[Injected] = (), *,
     noise : Noise or None
         The flow reading's noise (:func:`estimate_noise` of the whole log); None for none, [-]
     family : str
-        The motor's model family, with its defaults at `displacement`, [-]
+        The motor's model family, with its defaults at `displacement` and a plausible
+        channel drop (:func:`true_motor`), [-]
     displacement : float
         q_t/(2 pi), [m^3/rad]
     seed : int
@@ -495,7 +546,7 @@ def build_case(trajectory: Trajectory, effects: Sequence[Injected] = (), *,
     t = trajectory.time
     speed, p_a, p_b = trajectory.speed_state, trajectory.p_a_state, trajectory.p_b_state
     dp = p_a - p_b
-    model = MotorModel.for_displacement(displacement, family)
+    model = true_motor(family, displacement)
     base = model.absorbency(speed, dp=dp, errors='mask').flow
     if not np.isfinite(base).all():
         msg = f'{trajectory.source}: the {family} model has no flow at some samples'
@@ -562,4 +613,5 @@ def write_mbari_log(path: str | Path, case: Case) -> Path:
 __all__ = ['build_case', 'Case', 'demand_relief', 'DemandRelief', 'estimate_noise',
            'ExternalLeak', 'F11_5', 'FlowGain',
            'FlowLag', 'Injected', 'KINDS', 'load_trajectory', 'MBARI_AREA', 'Noise', 'realistic',
-           'ReliefValve', 'SpeedGain', 'Trajectory', 'Wear', 'write_mbari_log']
+           'ReliefValve', 'SpeedGain', 'Trajectory', 'true_motor', 'TRUE_CHANNEL_DROP',
+           'TRUE_CHANNEL_SPEED', 'Wear', 'write_mbari_log']
