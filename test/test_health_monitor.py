@@ -444,11 +444,12 @@ def small_steps() -> dict[str, str]:
             - model.geometry.displacement * samples.speed)
     after = samples.time >= 1800.0
     size = 0.1 * float(np.mean(loss[after]))  # [m^3/s]
-    flows = {'internal leakage': samples.flow + np.where(after, 0.1 * loss, 0.0),
-             'case leak': samples.flow + np.where(
-                 after, size * samples.p_out / float(np.mean(samples.p_out[after])), 0.0),
-             'flow sensor gain': samples.flow * np.where(
-                 after, 1.0 + size / float(np.mean(samples.flow[after])), 1.0)}
+    flows = {'internal leakage': samples.flow + np.where(after, 0.1 * loss, 0.0)}
+    for sign, way in ((1.0, ''), (-1.0, ' down')):  # a leak that shrinks, a gain below 1
+        flows['case leak' + way] = samples.flow + np.where(
+            after, sign * size * samples.p_out / float(np.mean(samples.p_out[after])), 0.0)
+        flows['flow sensor gain' + way] = samples.flow * np.where(
+            after, 1.0 + sign * size / float(np.mean(samples.flow[after])), 1.0)
     answers = {}
     for kind, flow in flows.items():
         stepped = dataclasses.replace(samples, flow=flow)
@@ -469,3 +470,24 @@ def test_what_changed_tells_a_small_gain_a_leak_and_a_wear_apart(
     """
     answer = small_steps[kind]
     assert named in answer and ' or ' not in answer.replace('flow or speed', ''), answer
+
+
+@pytest.mark.parametrize('kind', ['case leak', 'flow sensor gain'])
+def test_what_changed_names_the_way_a_leak_or_a_gain_moved(small_steps: dict[str, str],
+                                                           kind: str) -> None:
+    """
+    A leak that grows and one that shrinks, a gain above and below 1 (review F5).
+
+    Named 'up' and 'down' (a gain by how much), or not named that effect at all; never the
+    same words for both ways.
+    """
+    up, down = small_steps[kind], small_steps[kind + ' down']
+    if kind == 'case leak':
+        high, low = ('leak (external leakage) up',), ('leak (external leakage) down',)
+        assert 'external_leakage(p_out)' in up, up
+    else:  # a flowmeter reading high fits as a speed sensor reading low
+        high = ('flow sensor gain up', 'flow up', 'speed sensor gain down', 'speed down')
+        low = ('flow sensor gain down', 'flow down', 'speed sensor gain up', 'speed up')
+    assert any(w in up for w in high) and not any(w in up for w in low), up
+    assert down == 'unexplained' or (any(w in down for w in low)
+                                     and not any(w in down for w in high)), down

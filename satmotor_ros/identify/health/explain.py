@@ -42,6 +42,7 @@ from satmotor_ros.identify.selection import CrossValidatedSelector, Forward, Sco
 from satmotor_ros.identify.table import BenchTable
 from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.effects import Candidate
+from satmotor_ros.model.units import LPM
 
 GAINS = ('flow_sensor_gain', 'speed_sensor_gain')
 """Two kinds that tie where the flow follows the speed: named together when they do."""
@@ -61,6 +62,9 @@ WORDS = {'external_leakage': 'leak (external leakage)', 'clearance_wear': 'wear 
 CONTRASTED = ('external_leakage', 'flow_sensor_gain', 'flow_sensor_offset', 'speed_sensor_gain')
 """Kinds :func:`_contrast` weighs beside the components' own factors (a wear is a component's
 factor moving; a kind with a shape to fit, a threshold, is left to the selection)."""
+
+SIGNED = CONTRASTED
+"""Kinds named with the way they moved (:func:`_signed`): a leak, a sensor's gain or offset."""
 
 DECISIVE = 2.0 * math.log(20.0)
 """Residual variances by which the best explanation must beat the next, [-]."""
@@ -141,13 +145,55 @@ def explain_change(before: HealthSamples, after: HealthSamples, baseline: Baseli
         score = step.chosen
         if score is None or score.effect in known:
             continue
-        word = WORDS.get(_kind(score), _kind(score))
+        kind = _kind(score)
+        word = _signed(kind, _coefficient(score))
         runner = step.runner_up
-        if runner is not None and {_kind(score), _kind(runner)} == set(GAINS):
+        if runner is not None and {kind, _kind(runner)} == set(GAINS):
             # a flow gain and a speed gain fit alike where the flow follows the speed
-            word = 'flow or speed sensor gain (they fit alike here)'
+            word = _gain_tie({kind: _coefficient(score), _kind(runner): _coefficient(runner)})
+        if word == 'unexplained':
+            return word
         return f'{word} [{score.label}]'
     return _contrast(before, after, baseline)
+
+
+def _coefficient(score: Score) -> float:
+    """Return the coefficient a score fitted for its effect (NaN if it holds none)."""
+    try:
+        return float(score.fit.found()[-1][1].coefficient)
+    except (IndexError, AttributeError, TypeError, ValueError, IdentificationError):
+        return math.nan
+
+
+def _signed(kind: str, value: float) -> str:
+    """
+    Name an effect with the way it moved since the change (review of issue 23, F5).
+
+    A leak or a sensor error has a sign: a leak that grows and one that shrinks (a seal
+    seating again) are different news, and so are a flowmeter reading high or low. The
+    coefficient is the change since the change (:func:`_contrast`), or the effect the samples
+    since it ask for and those before do not; its sign says which way. Without a sign (NaN,
+    0) the effect is not named at all: ``unexplained``.
+    """
+    word = WORDS.get(kind, kind)
+    if kind not in SIGNED:
+        return word
+    if not (math.isfinite(value) and value != 0.0):
+        return 'unexplained'
+    way = 'up' if value > 0 else 'down'
+    if kind in GAINS:
+        return f'{word} {way} {abs(value) * 100:.2g} %'
+    if kind == 'flow_sensor_offset':
+        return f'{word} {way} {abs(value) / LPM:.2g} l/min'
+    return f'{word} {way}'
+
+
+def _gain_tie(values: dict[str, float]) -> str:
+    """Name a flow and a speed gain that fit alike, each with its way (they move opposite)."""
+    ways = [_signed(kind, values[kind]).removeprefix(WORDS[kind]).strip() for kind in GAINS]
+    if 'unexplained' in ways:
+        return 'unexplained'
+    return f'flow or speed sensor gain (they fit alike here: flow {ways[0]} / speed {ways[1]})'
 
 
 def _kind(score: Score) -> str:
@@ -192,8 +238,10 @@ def _contrast(before: HealthSamples, after: HealthSamples, baseline: Baseline) -
     shared, y = shared * root[:, None], y * root
     columns = {f'wear: the {c.name.removesuffix("_scale")} part of the losses': shared[:, j]
                for j, c in enumerate(parts.components)}
-    columns.update({f'{WORDS[_kind_of(c)]} [{c.label}]': _first_order(parts, c) * root
-                    for c in candidates if _kind_of(c) in CONTRASTED and not c.shape})
+    kinds = {f'{WORDS[_kind_of(c)]} [{c.label}]': _kind_of(c)
+             for c in candidates if _kind_of(c) in CONTRASTED and not c.shape}
+    columns.update({name: _first_order(parts, c) * root for name, c in zip(kinds, (
+        c for c in candidates if _kind_of(c) in CONTRASTED and not c.shape))})
     rss0, _, _ = _lsq(shared, y)
     fits = {name: _lsq(np.column_stack([shared, np.where(since, x, 0.0)]), y)
             for name, x in columns.items()
@@ -205,14 +253,16 @@ def _contrast(before: HealthSamples, after: HealthSamples, baseline: Baseline) -
     variance = best_rss / max(residual.size - shared.shape[1] - 1, 1) * _inflation(residual)
     if not (rss0 - best_rss) / variance >= SIGNIFICANT:
         return 'unexplained'
-    named = _named(ranked[0], coef, list(columns))
+    named = _named(ranked[0], coef, list(columns), kinds)
     if len(ranked) > 1 and (fits[ranked[1]][0] - best_rss) / variance < DECISIVE:
-        words = {name.partition(' [')[0] for name in ranked[:2]}
-        if words == {WORDS[g] for g in GAINS}:
+        if {kinds.get(name) for name in ranked[:2]} == set(GAINS):
             label = ranked[0].partition(' [')[2].removesuffix(']')
-            return f'flow or speed sensor gain (they fit alike here) [{label}]'
-        return f'{named} or {_named(ranked[1], fits[ranked[1]][1], list(columns))} ' \
-               '(they fit alike here)'
+            tie = _gain_tie({kinds[name]: float(fits[name][1][-1]) for name in ranked[:2]})
+            return tie if tie == 'unexplained' else f'{tie} [{label}]'
+        second = _named(ranked[1], fits[ranked[1]][1], list(columns), kinds)
+        if 'unexplained' in (named, second):
+            return 'unexplained'
+        return f'{named} or {second} (they fit alike here)'
     return named
 
 
@@ -258,10 +308,12 @@ def _lsq(design: FloatArray, y: FloatArray) -> tuple[float, FloatArray, FloatArr
     return float(residual @ residual), coef, residual
 
 
-def _named(name: str, coef: FloatArray, names: list[str]) -> str:
-    """Give a component's wear the factor it moved by (since over before); others as they are."""
+def _named(name: str, coef: FloatArray, names: list[str], kinds: dict[str, str]) -> str:
+    """Give a component's wear the factor it moved by (since over before), a kind its way."""
     if not name.startswith('wear: '):
-        return name
+        signed = _signed(kinds[name], float(coef[-1]))
+        label = name.partition(' [')[2]
+        return signed if signed == 'unexplained' else f'{signed} [{label}'
     before = coef[names.index(name)]
     ratio = (before + coef[-1]) / before if before else math.inf
     word = name if ratio >= 1.0 else name.replace('wear', 'recovery', 1)
