@@ -107,3 +107,27 @@ def test_a_factor_lost_in_the_noise_warns_not_identifiable(ros):
         assert got == level and ('not identifiable' in message) is bool(level), message
         executor.remove_node(node)
         node.destroy_node()
+
+
+def test_a_parked_motor_is_ok_parked_not_monitoring(ros):
+    """
+    Healthy, then standing still with no flow (review F9): OK 'parked, not monitoring'.
+
+    A parked motor is not a fault: a drive engineer reads WARN as something to look at. Its
+    samples are counted 'parked', not 'stalled' (speed 0 while the flow passes: WARN above).
+    The status holds for as long as it stands (the share is of the last window_s).
+    """
+    context, executor, _ = ros
+    baseline = baseline_from(VALUES)
+    node = _node(context, executor)
+    good = recording(0.4, seed=7, rate_hz=2, baseline=baseline)
+    _feed(node, good)
+    rest = recording(0.2, seed=8, rate_hz=2, baseline=baseline, t0=float(good.time[-1]) + 0.5)
+    leak = np.full(len(rest), 1e-3 * baseline.displacement * 100.0)  # a trickle, held pressure
+    _feed(node, HealthSamples(rest.time, 0.0 * rest.speed, leak, rest.p_in, rest.p_out))
+    snap = node.monitor.snapshot()
+    assert snap.skipped['parked'] == len(rest) and snap.skipped['stalled'] == 0
+    level, message = node.level(snap)
+    assert level == 0 and message.startswith('parked, not monitoring'), message
+    executor.remove_node(node)
+    node.destroy_node()

@@ -24,7 +24,7 @@ from rclpy.parameter import Parameter
 from rclpy.qos import qos_profile_sensor_data
 from satmotor_ros.cli.monitor import command
 from satmotor_ros.identify.bag import read_bag
-from satmotor_ros.identify.health import Baseline, HealthMonitor, HealthSamples
+from satmotor_ros.identify.health import Baseline, Estimate, HealthMonitor, HealthSamples
 from satmotor_ros.identify.health.records import NEVER_HOURS
 from satmotor_ros.identify.synthetic import generate_series, Injection, Plan, write_bag_of
 from satmotor_ros.interface import CHANNELS, HEALTH_TOPICS, JOINT_NAME
@@ -298,3 +298,63 @@ def test_a_bad_parameter_change_is_refused_and_a_good_one_restarts_the_estimator
     assert node.monitor is before
     assert node.set_parameters([Parameter('limit_leakage_factor', value=3.0)])[0].successful
     assert node.monitor is not before and node.monitor.settings.limit_leakage_factor == 3.0
+
+
+def test_after_a_change_hours_to_limit_is_published_as_nan_with_the_reason(ros):
+    """
+    Wear, then a step below the limit (review F4): the topic goes NaN, never holds the old one.
+
+    Before the change the node published a figure (inf: not drifting significantly); with no
+    trend since the change it published nothing, so a subscriber kept that figure.
+    """
+    from health_data import blocks, recording
+    context, executor, probe = ros
+    node = _monitor(context, executor)
+    got, diagnostics = [], []
+    probe.create_subscription(Float64, HEALTH_TOPICS[2], got.append, 10)
+    probe.create_subscription(DiagnosticArray, '/diagnostics', diagnostics.append, 10)
+    samples = recording(1.6, seed=1, rate_hz=1.0, baseline=node.monitor.baseline,
+                        scale=lambda t: np.where(t >= 4320.0, 1.4, 1.0 + 0.1 * t / 3600.0))
+    held = math.nan
+    for block in blocks(samples, 300):
+        node.monitor.update(block)
+        if node.monitor.alarms:
+            break
+        node.publish(node.monitor.snapshot())
+        held = node.monitor.snapshot().hours_to_limit.value
+    assert not math.isnan(held)  # a figure before the change
+    assert spin_until(executor, lambda: got and got[-1].data == held)
+    count = len(got)
+    node.publish(node.monitor.snapshot())
+    assert spin_until(executor, lambda: len(got) > count) and math.isnan(got[-1].data)
+    ours = [d for d in diagnostics if d.status[0].name.startswith(NAMESPACE)]
+    node.diagnose()
+    assert spin_until(executor, lambda: ours or ours.extend(
+        d for d in diagnostics if d.status[0].name.startswith(NAMESPACE)))
+    values = {kv.key: kv.value for kv in ours[-1].status[0].values}
+    change = node.monitor.alarms[0].change_s
+    assert values['hours_to_limit [h]'] == 'nan'
+    assert f'since the change at {change:.0f} s' in values['hours_to_limit note'], values
+    executor.remove_node(node)
+    node.destroy_node()
+
+
+def test_the_node_judges_the_limit_by_the_estimator_s_rule(ros):
+    """
+    ERROR on the estimator's crossing, not on the window's value alone (review F6).
+
+    A window whose value is above the limit but whose interval reaches below it is no
+    crossing; a trend above it is one, even with the window below and the alarm acknowledged.
+    """
+    context, executor, _ = ros
+    node = _monitor(context, executor)
+    fresh = node.monitor.snapshot()
+    noisy = dataclasses.replace(fresh, learning=False,
+                                leakage_factor=Estimate(2.05, 1.8, 2.3), in_limit=False)
+    assert node.level(noisy)[0] < 2, node.level(noisy)
+    crossed = dataclasses.replace(noisy, leakage_factor=Estimate(1.95, 1.7, 2.2),
+                                  trend=Estimate(2.1, 2.0, 2.2), in_limit=True)
+    level, message = node.level(crossed)
+    assert level == 2 and message.startswith('limit crossed') and 'trend 2.1' in message
+    executor.remove_node(node)
+    node.destroy_node()

@@ -6,10 +6,12 @@ Subscribes ``flow_measured`` (else ``flow_command``), ``inlet_pressure``,
 ``outlet_pressure``, ``joint_states`` and, when they are published, ``case_pressure``
 and ``fluid_temperature`` (names and types from :mod:`satmotor_ros.interface`);
 publishes ``health/leakage_factor``, ``health/volumetric_efficiency`` (at the current
-operating point), ``health/hours_to_limit`` (std_msgs/Float64; inf when not drifting)
+operating point), ``health/hours_to_limit`` (std_msgs/Float64; inf when not drifting, NaN
+when not known)
 and ``/diagnostics``: OK; WARN when the trend reaches the limit within ``warn_hours``
 or an input is missing or bad, or most samples of the last ``window_s`` are skipped
-(the node sees nothing); ERROR on a detected change or a crossed limit, until
+(the node sees nothing), but OK "parked, not monitoring" when they are skipped as parked
+(standing still with no flow: not a fault); ERROR on a detected change or a crossed limit, until
 acknowledged (``acknowledged_alarms``: the alarms stay in the history).
 
 A sample is taken on every ``joint_states`` message (its header stamp is the sample's
@@ -497,7 +499,12 @@ class MotorMonitorNode(Node):
 
     def publish(self, snap: HealthSnapshot) -> None:
         """
-        Publish the health topics of a snapshot (what has no value yet is not published).
+        Publish the health topics of a snapshot.
+
+        The leakage factor and the efficiency are published once they have a value;
+        ``hours_to_limit`` always, NaN when it is not known (no trend yet since the first
+        sample or the last change: the diagnostics' ``hours_to_limit note`` says why), so
+        that no subscriber holds a figure from before a change.
 
         Parameters
         ----------
@@ -508,7 +515,7 @@ class MotorMonitorNode(Node):
         for topic, value in zip(HEALTH_TOPICS, (snap.leakage_factor.value,
                                                 snap.volumetric_efficiency,
                                                 snap.hours_to_limit.value)):
-            if math.isfinite(value) or (topic == HEALTH_TOPICS[2] and value == math.inf):
+            if math.isfinite(value) or topic == HEALTH_TOPICS[2]:
                 self._pub[topic].publish(Float64(data=float(value)))
 
     def save(self) -> None:
@@ -557,17 +564,23 @@ class MotorMonitorNode(Node):
             last = new[-1]
             return 2, (f'change at {last.change_s:.1f} s (alarm at {last.time_s:.1f} s): '
                        f'{last.what}')
-        if snap.leakage_factor.value >= snap.limit_leakage_factor or (
-                new and new[-1].kind == 'limit'):
-            return 2, f'limit crossed: leakage factor {snap.leakage_factor.value:.3g} ' \
-                      f'(limit {snap.limit_leakage_factor:.3g})'
+        if snap.in_limit or (new and new[-1].kind == 'limit'):  # the estimator's rule
+            trend = f', trend {snap.trend.value:.3g}' if math.isfinite(snap.trend.value) else ''
+            return 2, (f'limit crossed: leakage factor {snap.leakage_factor.value:.3g}{trend} '
+                       f'(limit {snap.limit_leakage_factor:.3g})')
         if snap.hours_to_limit.value < self._values['warn_hours']:
             return 1, f'limit within {snap.hours_to_limit.value:.3g} h'
         quiet = self.quiet()
         if quiet:
             return 1, f'no recent message on {", ".join(quiet)}'
         total, skipped = self.recent_skipped()
-        if total and sum(skipped.values()) > SKIPPED_SHARE * total:
+        parked = ''
+        if total and skipped.get('parked', 0) > SKIPPED_SHARE * total:
+            # standing still with no flow: nothing to judge and nothing wrong (doc/health.md)
+            parked = (f'parked, not monitoring: {skipped["parked"]} of the last {total} '
+                      'samples at rest (speed below min_speed, no flow but leakage); the '
+                      'figures are from before')
+        elif total and sum(skipped.values()) > SKIPPED_SHARE * total:
             why = ', '.join(f'{v} {k.replace("_", " ")}' for k, v in skipped.items() if v)
             return 1, (f'not monitoring: {sum(skipped.values())} of the last {total} samples '
                        f'skipped ({why})')
@@ -577,7 +590,7 @@ class MotorMonitorNode(Node):
             if self.monitor is not None else ''
         if why:
             return 1, why
-        state = 'learning' if snap.learning else 'healthy'
+        state = parked or ('learning' if snap.learning else 'healthy')
         return 0, state + (f' ({snap.acknowledged} alarms acknowledged)'
                            if snap.acknowledged else '')
 
@@ -649,7 +662,7 @@ def _figures(snap: HealthSnapshot) -> dict[str, Any]:
         'trend_per_hour ci95 [1/h]': _interval(snap.trend_per_hour),
         'hours_to_limit [h]': f'{snap.hours_to_limit.value:.4g}',
         'hours_to_limit ci95 [h]': _interval(snap.hours_to_limit),
-        'hours_to_limit note': hours_note(snap.hours_to_limit.value),
+        'hours_to_limit note': hours_note(snap.hours_to_limit.value, snap.hours_to_limit_why),
         'limit_leakage_factor [-]': f'{snap.limit_leakage_factor:.4g}',
         'volumetric_efficiency [-]': f'{snap.volumetric_efficiency:.4g}',
         'volumetric_efficiency reference [-]':

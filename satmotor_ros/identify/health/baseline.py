@@ -37,7 +37,7 @@ within +-20 K of the reference), from the reading and three more evaluations of 
 NU_NODES = (0.25, 0.5, 1.0, 2.0)
 """Viscosity factors the model is evaluated at (1: the reading itself), [-]."""
 
-OK, STALLED, OUTSIDE_ENVELOPE, OUTSIDE_MODEL, STALE, NON_FINITE, IMPLAUSIBLE = range(7)
+OK, STALLED, OUTSIDE_ENVELOPE, OUTSIDE_MODEL, STALE, NON_FINITE, IMPLAUSIBLE, PARKED = range(8)
 """Codes of :attr:`Losses.reason`, in the order of :data:`.records.SKIP_REASONS` plus OK."""
 
 GROSS = 10.0
@@ -46,6 +46,12 @@ times its ``speed_max``, a gauge pressure beyond GROSS times its ``dp_max``, a f
 the displacement flow at GROSS times ``speed_max`` is no reading of this motor (a broken
 message, a logger's 1e30 fill value): counted and skipped as ``implausible``, like a
 non-finite one. Real logs run to twice the range (the MBARI logs: 2x ``speed_max``), [-]."""
+
+PARKED_FLOW = 0.05
+"""A sample below ``min_speed`` whose flow is below this share of the displacement flow at the
+model's ``speed_max`` is ``parked``: the motor stands still and nothing passes it but
+leakage, nothing to judge and nothing wrong. With more flow it is ``stalled``: a speed
+sensor that reads 0 on a running motor, or a shaft held against a load, [-]."""
 
 TEMPERATURE_RANGE = (-100.0, 400.0)
 """Oil temperatures a hydraulic liquid can have; a reading outside is implausible, [degC]."""
@@ -263,7 +269,11 @@ class Baseline:
         reason[~finite] = NON_FINITE
         reason[finite & ~self.physical(block)] = IMPLAUSIBLE
         with np.errstate(invalid='ignore'):
-            reason[(reason == OK) & (np.abs(block.speed) < min_speed)] = STALLED
+            still = (reason == OK) & (np.abs(block.speed) < min_speed)
+            quiet = np.abs(block.flow) <= PARKED_FLOW * self.model.valid_range.speed_max \
+                * self.displacement
+            reason[still & quiet] = PARKED
+            reason[still & ~quiet] = STALLED
         if self.envelope is not None:
             out = outside(self.envelope, block.p_in - block.p_out, block.speed)
             reason[(reason == OK) & out] = OUTSIDE_ENVELOPE

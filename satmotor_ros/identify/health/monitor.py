@@ -46,7 +46,7 @@ from satmotor_ros.identify.health.records import (Alarm, Estimate, HealthPoint, 
                                                   HealthSettings, HealthSnapshot, SKIP_REASONS)
 from satmotor_ros.identify.health.state import check_settings, check_state, compatible, template
 from satmotor_ros.identify.health.timing import median_step, Timing
-from satmotor_ros.identify.health.trend import Trend
+from satmotor_ros.identify.health.trend import MIN_POINTS, Trend
 from satmotor_ros.model._typing import FloatArray
 
 FIELDS = ('n', 'sbb', 'sbm', 'op_s', 'disp', 'lb', 'speed', 'dp')
@@ -169,6 +169,9 @@ class HealthMonitor:
         self.trend = Trend(s.trend_hours)
         self.trend_point = np.zeros(4)  # sbm, sbb, op_s, start time
         self.trend_point[3] = math.nan
+        # the bins of the last explain_s: (end [s], sbm, sbb, op_s, operation then [s]), so
+        # that a change alarm restarts the trend from where the change began
+        self.trend_bins: deque[list[float]] = deque()
         self.last_point: HealthPoint | None = None
         self.points: list[HealthPoint] = []
         self.alarms: list[Alarm] = []
@@ -385,7 +388,10 @@ class HealthMonitor:
                 self._finish_learning()
         else:
             alarms += self._detect(k_b, sbb, sbm, end_s - self.timing.bin_s, end_s)
-        self._add_to_trend(sbm, sbb, op_s, end_s)
+        self._add_to_trend(sbm, sbb, op_s, end_s, self.op_s)
+        self.trend_bins.append([end_s, sbm, sbb, op_s, self.op_s])
+        while self.trend_bins[0][0] < end_s - s.explain_s:
+            self.trend_bins.popleft()
         alarms += self._check_limit(end_s)
         window = self._window_factor()
         eta = disp / (disp + window.value * lb) if disp + window.value * lb > 0 else math.nan
@@ -547,6 +553,12 @@ class HealthMonitor:
         self.e_prev = 0.0
         self.trend = Trend(self.settings.trend_hours)
         self.trend_point[:] = [0.0, 0.0, 0.0, math.nan]
+        # the trend restarts from the change: the bins since it began (the alarm's own bin
+        # follows), not from the alarm, nor with the bins of the old level
+        slack = EPS * max(1.0, abs(start))
+        for end, sbm, sbb, op_s, total in self.trend_bins:
+            if end - self.timing.bin_s >= start - slack:
+                self._add_to_trend(sbm, sbb, op_s, end, total)
         self.window.clear()
         return alarm
 
@@ -576,7 +588,8 @@ class HealthMonitor:
         self.alarms[index] = replace(alarm, what=what)
         self.what_changed = what
 
-    def _add_to_trend(self, sbm: float, sbb: float, op_s: float, end_s: float) -> None:
+    def _add_to_trend(self, sbm: float, sbb: float, op_s: float, end_s: float,
+                      op_total: float) -> None:
         """Pool the bin into the current trend point; close the point when long enough."""
         point = self.trend_point
         if math.isnan(point[3]):
@@ -585,7 +598,7 @@ class HealthMonitor:
         point_s = self.timing.point_s
         long_enough = end_s - point[3] >= point_s * (1.0 - EPS)
         if long_enough and point[2] >= 0.5 * point_s and point[1] > 0:
-            self.trend.add(self.op_s / 3600.0 - 0.5 * point[2] / 3600.0, point[0] / point[1])
+            self.trend.add(op_total / 3600.0 - 0.5 * point[2] / 3600.0, point[0] / point[1])
             point[:] = [0.0, 0.0, 0.0, math.nan]
 
     def _check_limit(self, end_s: float) -> list[Alarm]:
@@ -594,8 +607,7 @@ class HealthMonitor:
             return []
         level, *_ = self.trend.estimate(self.op_s / 3600.0)
         window = self._window_factor()
-        crossed = (math.isfinite(level) and level >= self.limit_k) or (
-            math.isfinite(window.low) and window.low >= self.limit_k)
+        crossed = limit_crossed(level, window.low, self.limit_k)
         if crossed and not self.in_limit:
             self.in_limit = True
             value = level if math.isfinite(level) else window.value
@@ -603,9 +615,8 @@ class HealthMonitor:
                           f'leakage factor {value:.3g} >= limit {self.limit_k:.3g}', value)
             self.alarms.append(alarm)
             return [alarm]
-        above = math.isfinite(level) and level >= self.limit_k
-        clear = window.high < 0.9 * self.limit_k and not above
-        if self.in_limit and clear:  # back below with confidence: a new crossing is new
+        # back below with confidence: a new crossing is new
+        if self.in_limit and limit_cleared(level, window.high, self.limit_k):
             self.in_limit = False
         return []
 
@@ -669,6 +680,16 @@ class HealthMonitor:
         op_h = self.op_s / 3600.0
         level, level_hw, slope, slope_hw, phi_t = self.trend.estimate(op_h)
         to_limit = _hours_to(self.limit_k, level, level_hw, slope, slope_hw)
+        why = ''
+        if self.in_limit:  # crossed by the rule (limit_crossed): no trend needed to say so
+            to_limit = Estimate(0.0, 0.0, 0.0)
+            why = (f'0: the limit is crossed (leakage factor {self.limit_k:.3g}: the trend or '
+                   "the window's 95 % lower bound reached it)")
+        elif math.isnan(to_limit.value):
+            since = (f'the change at {self.change_s:.0f} s' if math.isfinite(self.change_s)
+                     else 'the first sample')
+            why = (f'null: no trend yet since {since}: {self.trend.n} of {MIN_POINTS} points of '
+                   f'{self.timing.point_s:g} s of operation')
         recording_h = (self.t_last - self.t0) / 3600.0 if math.isfinite(self.t0) else 0.0
         ratio = recording_h / op_h if op_h > 0 else 1.0
         window = self._window_factor()
@@ -702,6 +723,7 @@ class HealthMonitor:
                     'open': int(round(self.open_bin[0] + self.carry[0])),
                     'held': sum(len(b) for b in self.held)},
             skipped=dict(self.skipped), alarms=tuple(self.alarms), change_s=self.change_s,
+            in_limit=self.in_limit, hours_to_limit_why=why,
             what_changed=self.what_changed, acknowledged=self.acknowledged,
             timing={'sample_step_s': self.step_s, 'bin_s': self.timing.bin_s,
                     'max_gap_s': self.timing.gap_s, 'trend_point_s': self.timing.point_s})
@@ -743,7 +765,7 @@ class HealthMonitor:
 
     def _state(self) -> dict[str, Any]:
         skip = {'baseline', 'explainer', 'settings', 'recent', 'points', 'last_point', 'timing',
-                'held'}
+                'held', 'trend_bins'}
         state = {k: v for k, v in vars(self).items() if k not in skip}
         state['cusum'] = asdict(self.cusum)
         state['trend'] = self.trend.state()
@@ -752,6 +774,7 @@ class HealthMonitor:
         state['settings'] = asdict(self.settings)
         state['recent'] = [asdict(b) for b in self.recent]
         state['held'] = [asdict(b) for b in self.held]
+        state['trend_bins'] = [list(b) for b in self.trend_bins]
         state['version'] = STATE_VERSION
         state['baseline'] = self.baseline.fingerprint
         return state
@@ -819,6 +842,7 @@ class HealthMonitor:
         self.alarms = [Alarm(**a) for a in state.pop('alarms')]
         self.recent.extend(_samples(b) for b in state.pop('recent'))
         self.held = [_samples(b) for b in state.pop('held', [])]
+        self.trend_bins = deque(state.pop('trend_bins'))
         for name in ('version', 'baseline'):
             state.pop(name)
         state['last_flow_rate_x'] = tuple(state['last_flow_rate_x'])
@@ -896,6 +920,55 @@ def _weighted_median(x: FloatArray, w: FloatArray) -> float:
     return float(x[order][np.searchsorted(cum, 0.5 * cum[-1])])
 
 
+def limit_crossed(level: float, window_low: float, limit: float) -> bool:
+    """
+    Tell whether the leakage factor has crossed its limit: the one rule, for every door.
+
+    Crossed when the trend's level, or the windowed factor's 95 % lower bound, is at or
+    above the limit: a single noisy window above it is not a crossing.
+
+    Parameters
+    ----------
+    level : float
+        The trend's level now (NaN without a trend), [-]
+    window_low : float
+        The windowed factor's 95 % lower bound (NaN without an interval), [-]
+    limit : float
+        The limit as a leakage factor, [-]
+
+    Returns
+    -------
+    bool
+        True when crossed.
+
+    """
+    return (math.isfinite(level) and level >= limit) or (
+        math.isfinite(window_low) and window_low >= limit)
+
+
+def limit_cleared(level: float, window_high: float, limit: float) -> bool:
+    """
+    Tell whether a crossed limit is left behind with confidence (a new crossing is new).
+
+    Parameters
+    ----------
+    level : float
+        The trend's level now, [-]
+    window_high : float
+        The windowed factor's 95 % upper bound, [-]
+    limit : float
+        The limit as a leakage factor, [-]
+
+    Returns
+    -------
+    bool
+        True when the upper bound is below 90 % of the limit and the trend is below it.
+
+    """
+    above = math.isfinite(level) and level >= limit
+    return window_high < 0.9 * limit and not above
+
+
 def _hours_to(limit: float, level: float, level_hw: float, slope: float,
               slope_hw: float) -> Estimate:
     """Return the hours until the line reaches `limit`, with an interval (inf: never)."""
@@ -911,4 +984,4 @@ def _hours_to(limit: float, level: float, level_hw: float, slope: float,
     return Estimate(value, soonest, latest)
 
 
-__all__ = ['Explainer', 'HealthMonitor']
+__all__ = ['Explainer', 'HealthMonitor', 'limit_cleared', 'limit_crossed']

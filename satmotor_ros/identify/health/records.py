@@ -16,9 +16,11 @@ from satmotor_ros.identify.table import BenchTable
 from satmotor_ros.model._typing import FloatArray
 
 SKIP_REASONS = ('stalled', 'outside_envelope', 'outside_model', 'stale', 'non_finite',
-                'implausible')
+                'implausible', 'parked')
 """Why a sample is not used, as :attr:`HealthSnapshot.skipped` counts them (``implausible``:
-a finite reading outside the physical envelope, :data:`.baseline.GROSS`)."""
+a finite reading outside the physical envelope, :data:`.baseline.GROSS`; ``parked``: below
+``min_speed`` with no flow but leakage, :data:`.baseline.PARKED_FLOW`; ``stalled``: below
+``min_speed`` with flow passing)."""
 
 NEVER_HOURS = sys.float_info.max
 """``hours_to_limit`` in ``monitor.json`` when the trend does not rise towards the limit: the
@@ -48,7 +50,7 @@ def hours_json(x: float) -> float | None:
     return float(f'{x:.6g}')
 
 
-def hours_note(x: float) -> str:
+def hours_note(x: float, why: str = '') -> str:
     """
     Say what an hours-to-limit figure means, as ``monitor.json`` and the diagnostics do.
 
@@ -56,6 +58,8 @@ def hours_note(x: float) -> str:
     ----------
     x : float
         Hours to the limit, [h]
+    why : str
+        The estimator's reason for a 0 or a NaN (:attr:`HealthSnapshot.hours_to_limit_why`), [-]
 
     Returns
     -------
@@ -63,6 +67,8 @@ def hours_note(x: float) -> str:
         One line.
 
     """
+    if why:
+        return why
     if math.isnan(x):
         return 'null: not enough operation for a trend yet'
     if math.isinf(x):
@@ -327,6 +333,9 @@ class HealthSnapshot:
     change_s: float = math.nan  # start of the last change [s]
     what_changed: str = ''  # its explanation ('' before any change)
     acknowledged: int = 0  # the first this many alarms are acknowledged [-]
+    in_limit: bool = False  # the limit is crossed (monitor.limit_crossed), not yet cleared
+    hours_to_limit_why: str = ''  # why hours_to_limit is 0 (crossed) or NaN (no trend since
+    # the first sample or the last change, and how far it is); '' for a figure of the trend
     timing: dict[str, float] = field(default_factory=dict)  # the sample step, bin, gap [s]
     n_used: dict[str, int] = field(default_factory=dict)  # where the samples not skipped went:
     # noise_model (the first third of the learning), bins (with a factor), open (the bin not

@@ -63,7 +63,7 @@ def summary(run: MonitorRun) -> dict[str, Any]:
         'trend_per_hour_ci95': snap.trend_per_hour.as_dict()['ci95'],
         'hours_to_limit': hours_json(to_limit.value),
         'hours_to_limit_ci95': [hours_json(to_limit.low), hours_json(to_limit.high)],
-        'hours_to_limit_note': hours_note(to_limit.value),
+        'hours_to_limit_note': hours_note(to_limit.value, snap.hours_to_limit_why),
         'n_samples': snap.n_samples, 'n_skipped': snap.n_skipped, 'skipped': snap.skipped,
         'n_used': snap.n_used,
         'timing': {k: _num(v) for k, v in snap.timing.items()},

@@ -27,7 +27,7 @@ SAMPLE_COLUMNS = ('time', 'speed', 'flow', 'p_in', 'p_out')
 OPTIONAL_COLUMNS = ('p_case', 'temperature', 'stale')
 """Columns a saved block may hold as None."""
 
-ROWS = {'window': 3, 'learn_bins': 6}
+ROWS = {'window': 3, 'learn_bins': 6, 'trend_bins': 5}
 """Lists of rows of numbers, and the numbers in a row."""
 
 
@@ -47,6 +47,7 @@ def compatible(state: dict[str, Any]) -> dict[str, Any]:
 
     """
     state.setdefault('step_s', 0.0)  # saved before the bins followed the step
+    state.setdefault('trend_bins', [])  # before a change restarted the trend where it began
     if 'carry' not in state and isinstance(state.get('open_bin'), np.ndarray):
         state['carry'] = np.zeros_like(state['open_bin'])  # before a thin bin joined the next
     if isinstance(state.get('skipped'), dict):  # before a reason was counted
