@@ -112,7 +112,7 @@ def test_the_node_is_ok_again_once_its_alarms_are_acknowledged(ros) -> None:
     assert _figures(snap)['alarms acknowledged'] == 1
     node.monitor.alarms.append(replace(node.monitor.alarms[0], time_s=900.0))
     assert node.level(node.monitor.snapshot())[0] == 2
-    limit = replace(node.monitor.snapshot(), acknowledged=2,
-                    leakage_factor=replace(snap.leakage_factor, value=2.5))
+    limit = replace(node.monitor.snapshot(), acknowledged=2, in_limit=True,  # the estimator's
+                    leakage_factor=replace(snap.leakage_factor, value=2.5))  # rule (F6)
     assert node.level(limit)[0] == 2 and 'limit' in node.level(limit)[1]  # still past it
     node.destroy_node()

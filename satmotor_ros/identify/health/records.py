@@ -67,7 +67,7 @@ def hours_note(x: float, why: str = '') -> str:
         One line.
 
     """
-    if why:
+    if why and (math.isnan(x) or x == 0.0):  # the estimator's reason for these two
         return why
     if math.isnan(x):
         return 'null: not enough operation for a trend yet'
