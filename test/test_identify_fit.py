@@ -87,7 +87,8 @@ def _fit_cases():
 
 
 @pytest.mark.parametrize('robust', ['plain', 'huber', 'tukey'])
-def test_the_fits_jacobian_is_scipys_forward_differences_to_the_bit(robust, monkeypatch):
+def test_the_fits_jacobian_is_exact_in_the_linear_parameters_and_scipys_in_the_effects(
+        robust, monkeypatch):
     parts, chosen = _fit_cases()
     sigma = np.full(len(parts), 0.05 * float(np.std(parts.loss)))
     index = np.arange(0, len(parts), 2)
@@ -99,13 +100,22 @@ def test_the_fits_jacobian_is_scipys_forward_differences_to_the_bit(robust, monk
         residual, jacobian = fit._problem(parts, index, lower, upper)
         u = np.clip(starts[-1] + 0.1, lower, upper)
         u[0] = upper[0]  # a step turned back at the bound
-        expected = approx_derivative(residual, u, method='2-point', bounds=(lower, upper))
-        assert np.array_equal(jacobian(u), expected)
+        linear = fit.m_ + fit.typical_.size
+        ours = jacobian(u)
+        forward = approx_derivative(residual, u, method='2-point', bounds=(lower, upper))
+        central = approx_derivative(residual, u, method='3-point', bounds=(lower, upper))
+        # the factors and nuisance coefficients: the derivative (central differences agree
+        # to 1e-7 of each column, forward ones only to their step's error)
+        scale = np.max(np.abs(central[:, :linear]), axis=0)
+        assert np.all(np.abs(ours[:, :linear] - central[:, :linear]) <= 1e-7 * scale)
+        assert not np.array_equal(ours[:, :linear], forward[:, :linear])
+        assert np.array_equal(ours[:, linear:], forward[:, linear:])  # the effects': scipy's
         ours = LossFit(effects, sigma, **options).fit(parts, index)
         problem = LossFit._problem
         monkeypatch.setattr(LossFit, '_problem', lambda self, *a: (problem(self, *a)[0],
                                                                    '2-point'))
         theirs = LossFit(effects, sigma, **options).fit(parts, index)
         monkeypatch.undo()
-        assert np.array_equal(ours.u_, theirs.u_)
-        assert np.array_equal(ours.jac_, theirs.jac_)
+        # the same optimum as with scipy's forward differences in every column, or a lower
+        # one (a gain beside a valve: a flat valley the rougher slopes stop in earlier)
+        assert ours.objective_ <= theirs.objective_ * (1.0 + 1e-8)

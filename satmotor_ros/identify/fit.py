@@ -143,6 +143,25 @@ def robust_root(z: FloatArray, c: float, redescending: bool = False) -> FloatArr
     return out
 
 
+def robust_slope(z: FloatArray, c: float, redescending: bool = False) -> FloatArray:
+    """
+    Return the derivative of :func:`robust_root` in z, [-].
+
+    Huber's: 1 within `c`, c / sqrt(2 c |z| - c^2) beyond. Tukey's: with u = (z / c)^2,
+    (1 - u)^2 / sqrt(1 - u + u^2 / 3) within `c` (1 at z = 0: the root's cancellation
+    written out), 0 beyond.
+    """
+    if redescending:
+        u = np.minimum((z / c) ** 2, 1.0)
+        slope: FloatArray = (1.0 - u) ** 2 / np.sqrt(1.0 - u + u * u / 3.0)
+        return slope
+    a = np.abs(z)
+    with np.errstate(invalid='ignore'):
+        huber: FloatArray = np.where(a <= c, 1.0,
+                                     c / np.sqrt(np.maximum(2.0 * c * a - c * c, c * c)))
+    return huber
+
+
 def _forward_steps(x0: FloatArray, bounds: tuple[FloatArray, FloatArray]
                    ) -> FloatArray:
     """
@@ -274,7 +293,12 @@ class LossFit:
                 u[:k] = np.clip(start, np.array(lower[:k]), np.array(upper[:k]))
             if k == len(lower):
                 starts = starts[:1]
-        return lower, upper, starts
+        # a start that sets an earlier effect's shape makes that shape's own starts one:
+        # the same problem from the same point, fitted once (the first kept, as the best is)
+        unique: dict[bytes, FloatArray] = {}
+        for u in starts:
+            unique.setdefault(u.tobytes(), u)
+        return lower, upper, list(unique.values())
 
     def _problem(self, parts: LossParts, index: np.ndarray, lower: Sequence[float],
                  upper: Sequence[float]
@@ -310,13 +334,27 @@ class LossFit:
             mod = self._modifier(u)
             flows = [component.flow(mod) for component in parts.components]
             f0 = residual(u, mod, flows)
+            out = np.zeros((u.size, f0.size))
+            # the factors and the nuisance coefficients: the prediction is linear in them,
+            # d Q_m / d s_j = G_Q Q_j and d Q_m / d beta_l = G_Q x_l (eq. 36), and the
+            # residual's slope is the robust loss's at z
+            predicted = self._predict(parts, u, mod, flows)
+            z = (flow - (predicted if every else predicted[index])) / sigma
+            slope = -(robust_slope(z, TUKEY if tukey else c, tukey) if tukey or c
+                      else np.ones(z.size)) / sigma
+            gain = mod.flow_gain
+            unit_gain = isinstance(gain, float | int) and gain == 1.0
+            columns = [*flows, *(t * x for t, x in zip(self.typical_, parts.nuisance.values()))]
+            for i, column in enumerate(columns):
+                d = column if unit_gain else gain * column
+                out[i, :z.size] = slope * (d if every else d[index])
+                if prior and i < m:
+                    out[i, z.size + i] = 1.0 / PRIOR_SD
             h = _forward_steps(u, bounds)
-            out = np.empty((u.size, f0.size))
-            for i in range(u.size):
+            for i in range(linear, u.size):  # the effects': scipy's forward differences
                 v = u.copy()
                 v[i] = u[i] + h[i]
-                out[i] = ((residual(v, mod, flows) if i < linear else residual(v)) - f0) \
-                    / ((u[i] + h[i]) - u[i])
+                out[i] = (residual(v) - f0) / ((u[i] + h[i]) - u[i])
             transposed: FloatArray = out.T  # as scipy's own: a view, no copy
             return transposed
 
