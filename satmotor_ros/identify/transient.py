@@ -635,11 +635,12 @@ SPIKE_SIDES = 0.5
 its departure from the quadratic through both, [-]."""
 
 
-def _extrapolated(before: FloatArray) -> float:
-    """Return the value one step past samples in order, on the line through them."""
-    k = np.arange(before.size, dtype=float)
-    slope, intercept = np.polyfit(k, before, 1)
-    return float(intercept + slope * before.size)
+def _extrapolation(m: int) -> FloatArray:
+    """Return weights that give, from m samples in order, the next one on their line, [-]."""
+    k = np.arange(m, dtype=float)
+    weights: FloatArray = np.array([1.0, float(m)]) @ np.linalg.pinv(
+        np.column_stack([np.ones(m), k]))
+    return weights
 
 
 def spikes(x: FloatArray, first: np.ndarray) -> tuple[np.ndarray, FloatArray, float]:
@@ -702,14 +703,17 @@ def spikes(x: FloatArray, first: np.ndarray) -> tuple[np.ndarray, FloatArray, fl
     local = np.maximum(np.sqrt(np.pi / 2.0) * ndimage.uniform_filter1d(
         size, 2 * SPIKE_SCALE_HALF + 1, mode='nearest'), scale)
     limit = max(SPIKE_LIMIT, float(special.ndtri(1.0 - 0.025 / max(x.size, 1)))) * local
-    for i in np.flatnonzero(size > limit):
-        if i < m or i + m >= x.size or size[i] < size[i - m:i + m + 1].max():
-            continue
-        # a spike departs alike from the line through the samples before and after it; a
-        # kink or the start of a transient (on both lines) and a step (on one) do not
-        sides = [_extrapolated(x[i - m:i]) - x[i], _extrapolated(x[i + m:i:-1]) - x[i]]
-        flagged[i] = all(np.sign(-d) == np.sign(departure[i])
-                         and abs(d) >= SPIKE_SIDES * size[i] for d in sides)
+    i = np.flatnonzero(size > limit)
+    i = i[(i >= m) & (i + m < x.size)]
+    i = i[size[i] >= ndimage.maximum_filter1d(size, 2 * m + 1)[i]]  # the largest near it
+    # a spike departs alike from the line through the samples before and after it; a
+    # kink or the start of a transient (on both lines) and a step (on one) do not
+    weights = _extrapolation(m)
+    spiked = np.ones(i.size, dtype=bool)
+    for side in (np.arange(-m, 0), np.arange(m, 0, -1)):  # x[i - m:i] and x[i + m:i:-1]
+        d = x[i[:, None] + side] @ weights - x[i]
+        spiked &= (np.sign(-d) == np.sign(departure[i])) & (np.abs(d) >= SPIKE_SIDES * size[i])
+    flagged[i[spiked]] = True
     return flagged, departure, scale
 
 
