@@ -90,6 +90,10 @@ def test_the_readme_gives_each_mbari_logs_figures_as_calibrate_writes_them(mbari
     assert f"`{valve['name']}`" in row  # the one name, with its side and crack
     low, high = (v / 1e6 for v in valve['threshold']['ci95'])
     assert f'{low:.2f}–{high:.2f}), exponent {valve["exponent"]:.2f}' in row
+    response = valve['response_time']  # read at every sample, a valve may lag its law
+    assert (f"response time {response['seconds']:.2f} s ({response['ci95'][0]:.2f}–"
+            f"{response['ci95'][1]:.2f})" in row if response['seconds'] > 0.0
+            else 'no response time (the law itself)' in row)
     # the flow at full drop as the output gives it: at the rows' top, and the law at the
     # samples' top, where it outruns the flow measured
     reach = valve['full_drop']

@@ -65,11 +65,12 @@ def test_the_mirrored_mbari_log_gives_the_mirrored_calibration(mbari_calibration
     assert table.source.endswith('2021.07.26T10.51.44.exp') and len(table) > 19000
     one, other = run.calibration, calibrate(mirrored(table), *rest)
     first, second = _figures(one), _figures(other)
-    # over the rows the fit reads as before; over every sample the valve's steep law at the
-    # drop's few peak samples (8-33 l/min off: README) moves the figure after it by 3 %
+    # over every sample (the figures a user reads) within 2 %; over the rows a borderline
+    # row, an isolated outlier under the valve on one side only, moves the figure after it
+    # by 3 % (the valve's fits agree to 1e-4)
     _same(*([cal.row_errors(s).rmse_lpm for s in (cal.selection.baseline, cal.forward.final)]
-            for cal in (one, other)), 0.02)
-    _same(first, second, 0.05)
+            for cal in (one, other)), 0.03)
+    _same(first, second, 0.02)
     named = [(e, SWAPPED[d]) for e, d in first[2]]
     assert second[2] == sorted(named)
     assert ('threshold:dp', 'negative') in first[2]

@@ -60,12 +60,12 @@ from satmotor_ros.identify.fit import HUBER, huber_rho
 from satmotor_ros.identify.noise import MAD, noise_model, RATE_TERMS, rates_of
 from satmotor_ros.identify.parts import NO_EFFECT
 from satmotor_ros.identify.table import BenchTable
-from satmotor_ros.identify.transient import (END_SAMPLES, flow_per_speed, Samples, segments,
-                                             smooth, variance_inflation)
+from satmotor_ros.identify.transient import (END_SAMPLES, first_order, flow_per_speed, Samples,
+                                             segments, smooth, variance_inflation)
 from satmotor_ros.model import MotorModel
 from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.units import LPM
-from scipy import optimize, signal, stats
+from scipy import optimize, stats
 
 ALPHA = 0.01
 """Level at which a fitted delay must beat none, over the range's independent delays, [-]."""
@@ -250,8 +250,8 @@ class _Profile:
         if lag not in self.filtered:
             if len(self.filtered) >= LAGGED_KEPT:  # each holds a signal's length: keep a few
                 del self.filtered[next(iter(self.filtered))]
-            self.filtered[lag] = _area(self.time, _first_order(self.speed, self.starts,
-                                                               self.step, lag))
+            lagged = first_order(self.speed, self.starts, self.step, lag)
+            self.filtered[lag] = _area(self.time, lagged)
         return self.filtered[lag]
 
     def _rate(self, d: float) -> FloatArray:
@@ -307,24 +307,6 @@ class _Profile:
 def _area(time: FloatArray, x: FloatArray) -> FloatArray:
     """Return the running trapezoid integral of `x` over `time`, 0 at the first sample."""
     return np.concatenate(([0.0], np.cumsum(0.5 * (x[1:] + x[:-1]) * np.diff(time))))
-
-
-def _first_order(x: FloatArray, starts: np.ndarray, step: float, tau: float) -> FloatArray:
-    r"""
-    Return `x` through a first-order lag of `tau`, per stretch, from rest on its first value.
-
-    Exact for an input linear between the samples (the rows' own trapezoid reading):
-    :math:`y_i = E y_{i-1} + (1 - E - c) x_{i-1} + c x_i`, :math:`E = e^{-h/\tau}`,
-    :math:`c = 1 - \tau (1 - E)/h`. (A zero-order hold, :math:`(1 - E) x_i`, would read the
-    lag half a step early: a delay of its own the profile would then ask for.)
-    """
-    keep = float(np.exp(-step / tau))
-    now = 1.0 - tau / step * (1.0 - keep)
-    out = np.empty_like(x)
-    for lo, hi in zip(starts[:-1], starts[1:]):
-        out[lo:hi], _ = signal.lfilter([now, 1.0 - keep - now], [1.0, -keep], x[lo:hi],
-                                       zi=[(1.0 - now) * x[lo]])
-    return out
 
 
 def fit_delay(samples: Samples, model: MotorModel, gap: float = 3.0) -> DelayFit:

@@ -459,7 +459,9 @@ class LossFit:
         self._check_fitted()
         keep = np.ones(self.fun_.size, dtype=bool)
         keep[drop] = False
-        step = np.linalg.lstsq(self.jac_[keep], -self.fun_[keep], rcond=None)[0]
+        held = self._held()
+        step = np.zeros(self.u_.size)
+        step[~held] = np.linalg.lstsq(self.jac_[keep][:, ~held], -self.fun_[keep], rcond=None)[0]
         within: FloatArray = np.clip(self.u_ + step, *self.bounds_)  # numpy types it as Any
         return within
 
@@ -502,8 +504,21 @@ class LossFit:
         names, unit, offset = self._names_and_units()
         first = self.m_ + self.typical_.size if effects_only else 0
         bound = np.where(self.active_ < 0, *self.bounds_)
+        valued = self._at_floor_value()
         return [(names[i], float(offset[i] + unit[i] * bound[i]))
-                for i in np.flatnonzero(self.active_) if i >= first]
+                for i in np.flatnonzero(self.active_) if i >= first and not valued[i]]
+
+    def _held(self) -> np.ndarray:
+        """Return which parameters a refit without some points keeps (a valve's response)."""
+        return np.asarray([False] * (self.m_ + self.typical_.size) + [
+            v for c in self.effects for v in (False, *(s_.floor_is_value for s_ in c.shape))],
+            dtype=bool)
+
+    def _at_floor_value(self) -> np.ndarray:
+        """Return which parameters end on a floor that is a value of the physics (no lag)."""
+        valued = [False] * (self.m_ + self.typical_.size) + [
+            v for c in self.effects for v in (False, *(s_.floor_is_value for s_ in c.shape))]
+        return np.asarray(valued, dtype=bool) & (self.active_ < 0)
 
     @property
     def effect_coefficient(self) -> float:
@@ -564,22 +579,26 @@ class LossFit:
         self._check_fitted()
         names, unit, offset = self._names_and_units()
         dof = max(self.n_ - self.n_params, 1)
-        jac = self.jac_
+        free = ~self._at_floor_value()  # a shape at a floor that is a value stays there: fixed
+        jac = self.jac_[:, free]
         data_jac = jac[:self.n_]
         norms = np.linalg.norm(data_jac, axis=0)
+        names_free = [n for n, f in zip(names, free) if f]
         if np.any(norms == 0.0):
-            which = names[int(np.flatnonzero(norms == 0.0)[0])]
+            which = names_free[int(np.flatnonzero(norms == 0.0)[0])]
             msg = f'{which} is not determined by the data: it has no effect at these points'
             raise IdentificationError(msg)
         _, sv, vt = np.linalg.svd(data_jac / norms, full_matrices=False)
         if sv[-1] < 1e-8 * sv[0]:
-            which = names[int(np.argmax(np.abs(vt[-1])))]
+            which = names_free[int(np.argmax(np.abs(vt[-1])))]
             msg = (f'{which} is not determined by the data: it trades off exactly against '
                    f'the other coefficients at these points')
             raise IdentificationError(msg)
         inflation = max(inflation, 1.0)
         s2 = self.objective_ / dof * inflation
-        cov = s2 * np.linalg.pinv(jac.T @ jac) * np.outer(unit, unit)
+        cov = np.zeros((free.size, free.size))
+        scale = np.outer(unit[free], unit[free])
+        cov[np.ix_(free, free)] = s2 * np.linalg.pinv(jac.T @ jac) * scale
         dof = max(int(self.n_ / inflation) - self.n_params, 1)
         half = special.stdtrit(dof, 0.975) * np.sqrt(np.maximum(np.diag(cov), 0.0))
         values = offset + self.u_ * unit

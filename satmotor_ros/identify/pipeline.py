@@ -31,10 +31,12 @@ from satmotor_ros.identify.selection import (at_bound, CrossValidatedSelector, E
 from satmotor_ros.identify.steady import (extract_steady, looks_like_series, steady_windows,
                                           SteadyTolerance)
 from satmotor_ros.identify.table import BenchTable
-from satmotor_ros.identify.transient import (averaged, averaged_sparse, dynamics_summary, Samples,
-                                             transient_samples, TransientOptions)
+from satmotor_ros.identify.transient import (averaged, averaged_sparse, dynamics_summary,
+                                             first_order_at, Samples, transient_samples,
+                                             TransientOptions)
 from satmotor_ros.identify.valve_reach import valve_reach
 from satmotor_ros.model import load_motor, MotorModel, MotorSpec
+from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.effects import (coefficients_without, Effect, effect_name, kind_of,
                                         measured_range)
 from satmotor_ros.model.revolutions import sampled_revolutions
@@ -210,6 +212,8 @@ class Calibration:
                                     'unit': 'Pa',
                                     'ci95': [written(v) for v in self.final.ci95[position + 1]]}
                 row['exponent'] = written(effect.option('exponent'))
+                if len(candidate.shape) > 2 and self.samples is not None:  # read in time
+                    row['response_time'] = _response(effect, self.final.ci95[position + 3])
             row.update(valve_reach(self, effect))  # a valve's law at the top of the drop
             rows.append(row)
             position += 1 + len(candidate.shape)
@@ -787,13 +791,25 @@ def _open(spec: MotorSpec, liquid: str) -> MotorModel:
     return MotorModel.from_spec(open_channels(spec, liquid), liquid)
 
 
+def _response(effect: Effect, ci95: FloatArray) -> dict[str, Any]:
+    """Return a valve's response time [s] with its interval (0: the law itself)."""
+    seconds = effect.option('response_time', 0.0)
+    return {'seconds': written(seconds), 'unit': 's',
+            'ci95': [written(max(float(v), 0.0)) if seconds else 0.0 for v in ci95],
+            'note': ('the law itself: no lag the data can tell at this sampling'
+                     if seconds == 0.0 else 'its flow follows the law through a first-order lag')}
+
+
 def _sampled(samples: Samples | None) -> Sampled | None:
     """Return the samples the rows average, as the candidates read them (None: steady rows)."""
     if samples is None:
         return None
     raw = samples.samples
     dp = np.where(samples.usable, raw.p_in - raw.p_out, np.nan)
-    return Sampled(dp, lambda x: averaged(samples, x), averaged_sparse(samples))
+    first = samples.stretch_starts
+    return Sampled(dp, lambda x: averaged(samples, x), averaged_sparse(samples),
+                   lambda at, x, tau: first_order_at(at, x, first, samples.step, tau),
+                   samples.step)
 
 
 def _selector(options: Options, points: BenchTable,

@@ -11,6 +11,7 @@ port drop, and the flowmeter's effects are applied
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import replace
 
 import numpy as np
@@ -38,8 +39,14 @@ def with_only(model: MotorModel, effects: tuple[Effect, ...]) -> MotorModel:
                       model.displacement_law, model.name)
 
 
-def predicted(calibrated: CalibratedModel, points: BenchTable,
-              parts: LossParts) -> tuple[FloatArray, np.ndarray]:
+def responds(model: MotorModel) -> bool:
+    """Return whether a valve of `model` has a response time (its flow depends on the past)."""
+    return any(kind_of(e).bypass and e.option('response_time', 0.0) > 0.0 for e in model.effects)
+
+
+def predicted(calibrated: CalibratedModel, points: BenchTable, parts: LossParts,
+              lag: Callable[[FloatArray, float], FloatArray] | None = None
+              ) -> tuple[FloatArray, np.ndarray]:
     """
     Predict the flow reading in each row's frame (as ``parts.flow``); which are EXTRAPOLATED.
 
@@ -57,6 +64,10 @@ def predicted(calibrated: CalibratedModel, points: BenchTable,
         The points (their channels feed the effects), [-]
     parts : LossParts
         The components of the model without effects at them (speed, drops, frame), [-]
+    lag : callable, optional
+        (a quantity at each of the points, tau [s]) -> it through a first-order lag of tau:
+        the points are a time series' samples in order, and a valve with a
+        ``response_time`` passes its law's flow through it; without, the law itself, [-]
 
     Returns
     -------
@@ -86,12 +97,14 @@ def predicted(calibrated: CalibratedModel, points: BenchTable,
     at = calibrated.points(model.true_speed(parts.rotation * parts.speed), channels,
                            dp_i=parts.sign * parts.dp_i)
     flow, extrapolated = at.flow, (at.status & int(PointStatus.EXTRAPOLATED)) != 0
-    if valves:
-        port = parts.sign * parts.dp
-        opened = [valves.flow(float(x)) for x in port]
-        flow = flow + np.array([v for v, _ in opened])
+    port = parts.sign * parts.dp
+    for effect in (e for e in model.effects if kind_of(e).bypass):
+        opened = [Valves((effect,)).flow(float(x)) for x in port]
+        valve = np.array([v for v, _ in opened])
+        tau = effect.option('response_time', 0.0)
+        flow = flow + (lag(valve, tau) if tau > 0.0 and lag is not None else valve)
         extrapolated = extrapolated | np.array([f for _, f in opened], dtype=bool)
     return parts.sign * flow_reading(model.effects, flow), extrapolated
 
 
-__all__ = ['bare', 'predicted', 'with_only']
+__all__ = ['bare', 'predicted', 'responds', 'with_only']

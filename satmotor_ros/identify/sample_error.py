@@ -22,6 +22,7 @@ the rows.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -29,11 +30,11 @@ import numpy as np
 from satmotor_ros.identify.effects import CalibratedModel
 from satmotor_ros.identify.fit import LossFit
 from satmotor_ros.identify.parts import loss_parts, LossParts
-from satmotor_ros.identify.predicted import bare, predicted
+from satmotor_ros.identify.predicted import bare, predicted, responds
 from satmotor_ros.identify.selection import Errors, Score
 from satmotor_ros.identify.table import BenchTable
-from satmotor_ros.identify.transient import (dynamic_regressors, END_SAMPLES, flow_per_speed,
-                                             parts_at, Samples, smooth)
+from satmotor_ros.identify.transient import (dynamic_regressors, END_SAMPLES, first_order,
+                                             flow_per_speed, parts_at, Samples, smooth)
 from satmotor_ros.model import MotorModel
 from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.effects import kind_of
@@ -52,6 +53,8 @@ class SampleData:
     # regressors as nuisance
     row: np.ndarray  # the row (bin) of the fit that holds each sample [-]
     index: np.ndarray  # each sample's position among the time series' samples [-]
+    lag: Callable[[FloatArray, float], FloatArray] | None = None  # (a quantity at each of
+    # these samples, tau [s]) -> it through a first-order lag of tau on the series' timeline
 
     def __len__(self) -> int:
         """Return the number of samples."""
@@ -134,7 +137,14 @@ def sample_data(model: MotorModel, samples: Samples) -> SampleData:
     regressors = dynamic_regressors(dp_a, dp_b, dn, dq, flow_per_speed(parts, qt))
     nuisance = {name: np.nan_to_num(regressors[name]) for name in samples.parts.nuisance}
     row = np.searchsorted(samples.bounds[0], held, side='right') - 1
-    return SampleData(table, replace(parts, nuisance=nuisance), row, held)
+    size = len(samples.samples)
+    starts = np.append(np.flatnonzero(samples.stretch_starts), size)
+
+    def lag(x: FloatArray, tau: float) -> FloatArray:
+        full = np.zeros(size)  # 0 at the samples no row holds: gaps in a stretch
+        full[held] = x
+        return first_order(full, starts, samples.step, tau)[held]
+    return SampleData(table, replace(parts, nuisance=nuisance), row, held, lag)
 
 
 def fitted_model(model: MotorModel, parts: LossParts, fit: LossFit,
@@ -180,8 +190,12 @@ def fitted_model(model: MotorModel, parts: LossParts, fit: LossFit,
 def _predict(data: SampleData, model: MotorModel, nuisance: dict[str, float],
              at: np.ndarray) -> FloatArray:
     """Predict the flow reading (in the samples' frame) at the samples `at` (bool)."""
-    parts = parts_at(data.parts, at)
-    flow, _ = predicted(CalibratedModel(model), data.table.select(at), parts)
+    if responds(model):  # a valve's flow depends on the samples before: every one read
+        flow, _ = predicted(CalibratedModel(model), data.table, data.parts, data.lag)
+        flow, parts = flow[at], parts_at(data.parts, at)
+    else:
+        parts = parts_at(data.parts, at)
+        flow, _ = predicted(CalibratedModel(model), data.table.select(at), parts)
     for name, value in nuisance.items():
         flow = flow + value * parts.nuisance[name]
     return flow

@@ -30,6 +30,7 @@ import re
 import numpy as np
 
 from satmotor_ros.identify.table import BenchTable
+from satmotor_ros.identify.transient import first_order as lagged
 from satmotor_ros.interface import (CHANNELS, FLOAT64, FLUID_PRESSURE, JOINT_NAME, JOINT_STATE,
                                     TEMPERATURE)
 from satmotor_ros.model import load_motor, MotorModel
@@ -41,7 +42,6 @@ from satmotor_ros.model.revolutions import revolutions
 from satmotor_ros.model.units import ATMOSPHERE, LPM, MPA, RPM
 from satmotor_ros.model.viscosity import standard_law
 from satmotor_ros.options import MotorOptions
-from scipy.signal import lfilter
 
 EFFECTS = ('none', 'external_leakage', 'viscosity_temperature', 'clearance_wear',
            'flow_sensor_offset', 'flow_sensor_gain', 'speed_sensor_gain', 'channel:aux',
@@ -592,10 +592,7 @@ def first_order(x: FloatArray, dt: float, tau: float) -> FloatArray:
     """
     if tau <= 0.0:
         return np.array(x, dtype=np.float64)
-    e = np.exp(-dt / tau)
-    c = 1.0 - tau / dt * (1.0 - e)
-    y, _ = lfilter([c, 1.0 - e - c], [1.0, -e], x, zi=[(1.0 - c) * x[0]])
-    return np.asarray(y, dtype=float)
+    return lagged(np.asarray(x, dtype=float), np.array([0, len(x)]), dt, tau)
 
 
 @dataclass(frozen=True)

@@ -52,7 +52,7 @@ from satmotor_ros.identify.table import BenchTable
 from satmotor_ros.model import MotorModel
 from satmotor_ros.model._typing import FloatArray
 from satmotor_ros.model.revolutions import sampled_revolutions
-from scipy import ndimage, special
+from scipy import ndimage, signal, special
 
 BIN_SECONDS = 0.2
 """
@@ -153,6 +153,13 @@ class Samples:
     guard = 1
     """Rows a test fold keeps out of training on each side: neighbours share a sample."""
 
+    @property
+    def stretch_starts(self) -> np.ndarray:
+        """Return True at the first raw sample of each stretch (one stretch if not known), [-]."""
+        if self.first is not None:
+            return self.first
+        return np.asarray(np.eye(1, len(self.samples), dtype=bool)[0])
+
 
 def dynamic_regressors(dp_a_dt: FloatArray, dp_b_dt: FloatArray, dn_dt: FloatArray,
                        dq_dt: FloatArray, dq_dn: FloatArray) -> dict[str, FloatArray]:
@@ -216,6 +223,78 @@ def flow_per_speed(parts: LossParts, qt: float) -> FloatArray:
     n = parts.displacement / qt if qt > 0.0 else np.zeros_like(parts.displacement)
     moving = np.abs(n) > 0.0
     return qt + np.where(moving, speed_part / np.where(moving, n, 1.0), 0.0)
+
+
+def first_order(x: FloatArray, starts: np.ndarray, step: float, tau: float) -> FloatArray:
+    r"""
+    Return `x` through a first-order lag of `tau`, per stretch, from rest on its first value.
+
+    Exact for an input linear between the samples (the rows' own trapezoid reading):
+    :math:`y_i = E y_{i-1} + (1 - E - c) x_{i-1} + c x_i`, :math:`E = e^{-h/\tau}`,
+    :math:`c = 1 - \tau (1 - E)/h`. (A zero-order hold, :math:`(1 - E) x_i`, would read the
+    lag half a step early: a delay of its own the profile would then ask for.)
+
+    Parameters
+    ----------
+    x : ndarray
+        A quantity at every sample, finite, [any]
+    starts : ndarray of int
+        The first sample of each stretch, then the number of samples, [-]
+    step : float
+        The median sample step h, [s]
+    tau : float
+        The time constant, > 0, [s]
+
+    Returns
+    -------
+    ndarray
+        The lagged quantity, [unit of x]
+
+    """
+    keep = float(np.exp(-step / tau))
+    now = 1.0 - tau / step * (1.0 - keep)
+    out = np.empty_like(x)
+    for lo, hi in zip(starts[:-1], starts[1:]):
+        out[lo:hi], _ = signal.lfilter([now, 1.0 - keep - now], [1.0, -keep], x[lo:hi],
+                                       zi=[(1.0 - now) * x[lo]])
+    return out
+
+
+def first_order_at(at: np.ndarray, values: FloatArray, first: np.ndarray, step: float,
+                   tau: float) -> tuple[np.ndarray, FloatArray]:
+    """
+    Return a quantity 0 but at a few samples through :func:`first_order`, where it is not 0.
+
+    Parameters
+    ----------
+    at : ndarray of int
+        The samples where the quantity may differ from 0, increasing, [-]
+    values : ndarray
+        Its values there, [any]
+    first : ndarray of bool
+        True at the first sample of each stretch, at every sample, [-]
+    step : float
+        The median sample step, [s]
+    tau : float
+        The time constant, > 0, [s]
+
+    Returns
+    -------
+    ndarray of int
+        The samples the lag carries `at`'s values to, until they fall below 1e-12 of them, [-]
+    ndarray
+        The lagged quantity there (as :func:`first_order` of the whole series gives it), [any]
+
+    """
+    reach = int(np.ceil(np.log(1e-12) * tau / -step)) + 1
+    marks = np.zeros(first.size + 1, dtype=int)
+    np.add.at(marks, at, 1)
+    np.add.at(marks, np.minimum(at + reach, first.size), -1)
+    support = np.flatnonzero(np.cumsum(marks)[:-1] > 0)
+    x = np.zeros(support.size + 1)  # a sample at rest before: the state between runs is ~0
+    x[1 + np.searchsorted(support, at)] = values
+    starts = np.unique(np.concatenate(([0], 1 + np.flatnonzero(first[support]), [x.size])))
+    return support, first_order(x, starts, step, tau)[1:]
 
 
 def segments(time: FloatArray, gap: float) -> tuple[np.ndarray, float]:

@@ -232,7 +232,7 @@ def _validate_samples(samples: Samples, model: MotorModel, liquid: str,
     """
     data = sample_data(model, samples)
     calibrated = CalibratedModel(model)
-    predicted_flow, extrapolated = predicted(calibrated, data.table, data.parts)
+    predicted_flow, extrapolated = predicted(calibrated, data.table, data.parts, data.lag)
     good = np.isfinite(predicted_flow)
     if not good.any():
         msg = f'{samples.samples.source}: the model flags every sample invalid'

@@ -102,6 +102,8 @@ class Shape:
     bounds: tuple[float, float]  # range, in the fitted units
     unit: str = '-'  # of the physical value
     to_unit: tuple[float, float] = (0.0, 1.0)  # physical value = [0] + [1] * fitted value
+    floor_is_value: bool = False  # the lower bound is a value of the physics (no delay),
+    # not the end of a range the data might ask to pass: a fit may end on it
 
 
 @dataclass(frozen=True)
@@ -221,6 +223,10 @@ class Sampled(NamedTuple):
     sparse: Callable[[np.ndarray, FloatArray], FloatArray] | None = None  # (the samples
     # where a quantity may differ from 0, each once, none where dp is NaN; its values there)
     # -> its bin means, NaN where dp is: `mean`'s, at a cost that grows with those samples
+    lag: Callable[[np.ndarray, FloatArray, float], tuple[np.ndarray, FloatArray]] | None = None
+    # (the samples where a quantity may differ from 0, its values there, a time constant tau
+    # [s]) -> the samples its first-order lag of tau reaches and the lagged values there
+    step: float = 0.0  # the median sample step [s]
 
 
 class Synthetic(NamedTuple):

@@ -31,6 +31,15 @@ STARTS = {'both': (0.3, 0.7), 'positive': (0.6, 0.9, 0.98), 'negative': (0.6, 0.
 """Starts of the fitted threshold: shares of the range it may take (both sides), quantiles of
 the side's drops (one side: a valve cracks near the top of its side's range), [-]."""
 
+RESPONSE_TIMES = (0.0, 1.0)
+"""Range of the fitted response time of a valve read at every sample of a time series, [s]: 0
+is the static law; a relief valve opens within a few tens to hundreds of milliseconds, so
+a pressure peak shorter than that passes little of what the law gives at its top."""
+
+STATIC = 1e-3
+"""A valve's response time under this share of the sample step is the static law, [-]: a fit
+left on the floor ends just above 0, where no sampling tells the lag from none."""
+
 EXPONENTS = (0.05, 3.0)
 """Range of the fitted exponent e, [-]: below 1 down to a near step, a relief valve at its
 pressure override, whose drop hardly rises while the flow it passes (set by the demand) does."""
@@ -44,14 +53,17 @@ class Threshold(EffectKind):
     rank = 85
     directional = True
     bypass = True
-    keys = ('regressor', 'coefficient', 'reference', 'exponent')
+    keys = ('regressor', 'coefficient', 'reference', 'exponent', 'response_time')
     required = ('coefficient', 'reference')
     unit = 'm^3/s per Pa^e'
     source = 'a valve that cracks open (relief, bypass)'
     evaluation = ('a valve across the ports: flow k max(0, |dp| - reference)^exponent from the '
                   'high- to the low-pressure port, beside the chambers and channels, added to '
                   'Q and to Q_vl; dp [Pa] the port drop p_a - p_b, reference the cracking '
-                  'drop [Pa]; only where dp has the sign direction names')
+                  'drop [Pa]; only where dp has the sign direction names; response_time '
+                  '[s]: read at every sample of a time series (calibrate, validate), the '
+                  'flow follows the law through a first-order lag of that time constant; a '
+                  'point is evaluated at the steady state, the law itself')
 
     plant_parameters = (
         PlantParameter('valve_conductance', 0.0, 'flow per Pa of port drop above the crack '
@@ -91,7 +103,7 @@ class Threshold(EffectKind):
         return suffix
 
     def parse(self, name: str, doc: Mapping[str, Any], where: str) -> Effect:
-        """Read k >= 0, the cracking drop >= 0 and the exponent (default 1, > 0)."""
+        """Read k >= 0, the cracking drop >= 0, the exponent (default 1, > 0), the response."""
         regressor = self.regressor(name.partition(':')[2], doc.get('regressor'), where)
         exponent = finite(doc.get('exponent', 1.0), f'{where}.exponent')
         if not 0.0 < exponent <= MAX_EXPONENT:  # past it the flow overflows at bench drops
@@ -103,12 +115,21 @@ class Threshold(EffectKind):
             if value < 0.0:  # a valve passes flow from the high- to the low-pressure port
                 msg = f'{where}.{key} = {value!r}: must be >= 0 (a valve that cracks open)'
                 raise ConfigError(msg)
-        return Effect(name, coefficient, regressor, reference, options=(('exponent', exponent),))
+        response = finite(doc.get('response_time', 0.0), f'{where}.response_time')
+        if not RESPONSE_TIMES[0] <= response <= RESPONSE_TIMES[1]:
+            msg = (f'{where}.response_time = {response!r}: must be within '
+                   f'{RESPONSE_TIMES[0]:g}-{RESPONSE_TIMES[1]:g} s')
+            raise ConfigError(msg)
+        lag = (('response_time', response),) if response > 0.0 else ()
+        return Effect(name, coefficient, regressor, reference,
+                      options=(('exponent', exponent), *lag))
 
     def to_mapping(self, effect: Effect) -> dict[str, Any]:
-        """Write k, the cracking drop and the exponent."""
-        return {'regressor': effect.regressor, 'coefficient': effect.coefficient,
-                'reference': effect.reference, 'exponent': effect.option('exponent', 1.0)}
+        """Write k, the cracking drop, the exponent and a response time (when not 0)."""
+        out = {'regressor': effect.regressor, 'coefficient': effect.coefficient,
+               'reference': effect.reference, 'exponent': effect.option('exponent', 1.0)}
+        response = effect.option('response_time', 0.0)
+        return {**out, 'response_time': response} if response > 0.0 else out
 
     def loss(self, effect: Effect) -> Loss | None:
         """Return (n, dp) -> k max(0, |dp| - x_c)^e, dp the port drop (a bypass kind)."""
@@ -178,19 +199,27 @@ class Threshold(EffectKind):
         if not top > high > low:
             return None
         acts = at.astype(float)
+        step = samples.step if samples is not None else 0.0
         if samples is not None:
             over = _at_samples(samples, direction)
-            known = np.flatnonzero(~np.isnan(over))
-            order = known[np.argsort(over[known])]  # by drop, rising
+            known = ~np.isnan(over)
+            order = np.flatnonzero(known)[np.argsort(over[known])]  # by drop, rising
             rising = over[order]
-            shapes: dict[tuple[float, float], FloatArray] = {}  # (x_c, e) -> the bins' flow
+            shapes: dict[tuple[float, ...], FloatArray] = {}  # (x_c, e, tau) -> bins' flow
+            lag = samples.lag
 
-            def modify(k: float, x_c: float, e: float) -> Modifier:
+            def modify(k: float, x_c: float, e: float, tau: float = 0.0) -> Modifier:
                 # a fit's finite differences in k and the other coefficients keep the
                 # shape: its flow, the costly part (every sample), is computed once
-                flow = shapes.get((x_c, e))
+                flow = shapes.get((x_c, e, tau))
                 if flow is None:
-                    if samples.sparse is not None and x_c < top:  # 0 at or below the crack
+                    if tau > 0.0 and lag is not None:  # the static law through the response
+                        at = np.sort(order[np.searchsorted(rising, x_c, side='right'):])
+                        reach, lagged = lag(at, ((over[at] - x_c) / (top - x_c)) ** e, tau)
+                        held = known[reach]
+                        flow = (samples.sparse(reach[held], lagged[held]) if samples.sparse
+                                else samples.mean(_spread(reach[held], lagged[held], over)))
+                    elif samples.sparse is not None and x_c < top:  # 0 at or below the crack
                         at = order[np.searchsorted(rising, x_c, side='right'):]
                         flow = samples.sparse(at, (np.maximum(over[at] - x_c, 0.0)
                                                    / (top - x_c)) ** e)
@@ -198,23 +227,29 @@ class Threshold(EffectKind):
                         flow = samples.mean((np.maximum(over - x_c, 0.0) / (top - x_c)) ** e)
                     if len(shapes) >= SHAPES_KEPT:
                         shapes.pop(next(iter(shapes)))
-                    shapes[(x_c, e)] = flow
+                    shapes[(x_c, e, tau)] = flow
                 return Modifier(additive=acts * k * flow)
         else:
-            def modify(k: float, x_c: float, e: float) -> Modifier:
+            def modify(k: float, x_c: float, e: float, tau: float = 0.0) -> Modifier:
                 return Modifier(additive=acts * k * (np.maximum(dp - x_c, 0.0)
                                                      / (top - x_c)) ** e)
 
-        def make(k: float, x_c: float, e: float) -> Effect:
+        def make(k: float, x_c: float, e: float, tau: float = 0.0) -> Effect:
+            response = (('response_time', tau),) if tau > STATIC * step else ()
             return Effect(f'{self.name}:dp', k / (top - x_c) ** e, 'dp', x_c,
-                          options=(('exponent', e),), direction=supported(direction, x_c, tops))
+                          options=(('exponent', e), *response),
+                          direction=supported(direction, x_c, tops))
 
         quantiles = tuple(float(np.clip((np.quantile(ordered, q) - low) / (high - low), 0.0,
                                         1.0)) for q in STARTS[direction if two else 'negative'])
         starts = (STARTS['both'] if direction == 'both' else ()) + (
             quantiles if direction != 'both' or not two else ())
-        shape = (Shape('threshold', starts, (0.0, 1.0), 'Pa', (low, high - low)),
-                 Shape('exponent', (1.0,), EXPONENTS))
+        crack = Shape('threshold', starts, (0.0, 1.0), 'Pa', (low, high - low))
+        shape: tuple[Shape, ...] = (crack, Shape('exponent', (1.0,), EXPONENTS))
+        if samples is not None and samples.lag is not None and samples.step > 0.0:
+            # read in time, it may lag its law (0: the law itself, a value, not a range's end)
+            shape += (Shape('response time', (0.0,), RESPONSE_TIMES, 's',
+                            floor_is_value=True),)
         return Candidate(f'{self.name}:dp', 'dp', self.unit, self.source, dp, modify,
                          LPM, (0.0, np.inf), 0.1 * LPM, make, shape, direction)
 
@@ -225,6 +260,13 @@ class Threshold(EffectKind):
         drop = data.dp if data.dp is not None else data.dp_i  # the valve reads the port drop
         peak = float(np.max(np.maximum(np.abs(drop) - x_c, 0.0) ** e))
         return Effect(name, magnitude / max(peak, 1e-300), 'dp', x_c, options=(('exponent', e),))
+
+
+def _spread(at: np.ndarray, values: FloatArray, over: FloatArray) -> FloatArray:
+    """Return `values` at `at`, 0 at the other samples and NaN where `over` is NaN."""
+    out = np.where(np.isnan(over), np.nan, 0.0)
+    out[at] = values
+    return out
 
 
 def supported(direction: str, crack: float, tops: tuple[float, float]) -> str:
