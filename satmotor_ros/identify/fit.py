@@ -509,16 +509,14 @@ class LossFit:
                 for i in np.flatnonzero(self.active_) if i >= first and not valued[i]]
 
     def _held(self) -> np.ndarray:
-        """Return which parameters a refit without some points keeps (a valve's response)."""
+        """Return which parameters a refit without some points keeps (a valve's response time)."""
         return np.asarray([False] * (self.m_ + self.typical_.size) + [
             v for c in self.effects for v in (False, *(s_.floor_is_value for s_ in c.shape))],
             dtype=bool)
 
     def _at_floor_value(self) -> np.ndarray:
         """Return which parameters end on a floor that is a value of the physics (no lag)."""
-        valued = [False] * (self.m_ + self.typical_.size) + [
-            v for c in self.effects for v in (False, *(s_.floor_is_value for s_ in c.shape))]
-        return np.asarray(valued, dtype=bool) & (self.active_ < 0)
+        return self._held() & (self.active_ < 0)
 
     @property
     def effect_coefficient(self) -> float:
