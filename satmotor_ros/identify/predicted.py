@@ -99,7 +99,8 @@ def predicted(calibrated: CalibratedModel, points: BenchTable, parts: LossParts,
     flow, extrapolated = at.flow, (at.status & int(PointStatus.EXTRAPOLATED)) != 0
     port = parts.sign * parts.dp
     for effect in (e for e in model.effects if kind_of(e).bypass):
-        opened = [Valves((effect,)).flow(float(x)) for x in port]
+        valve_of = Valves((effect,))
+        opened = [valve_of.flow(float(x)) for x in port]
         valve = np.array([v for v, _ in opened])
         tau = effect.option('response_time', 0.0)
         flow = flow + (lag(valve, tau) if tau > 0.0 and lag is not None else valve)
