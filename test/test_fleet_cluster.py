@@ -75,7 +75,7 @@ def test_fleet_ranks_the_wearing_motor_first_and_names_the_leak_and_the_bad_reco
     assert md.index('## wearing') < md.index('## leak') and 'truncated' in md
 
 
-def test_fleet_outputs_are_the_single_commands_and_ran_on_both_workers(fleet):
+def test_fleet_outputs_are_the_single_commands_and_ran_on_the_cluster_s_workers(fleet):
     root, out, outcome, _ = fleet
     baseline = json.loads((out / 'healthy' / 'baseline.json').read_text())
     assert baseline['recording'] == 'vessel_a/day00.csv'
@@ -89,8 +89,11 @@ def test_fleet_outputs_are_the_single_commands_and_ran_on_both_workers(fleet):
     assert (out / 'healthy' / 'day03.csv' / 'monitor' / 'monitor.json').is_file()
     markers = [json.loads(p.read_text()) for p in out.glob('*/*/.fleet-done.json')]
     assert len(markers) == outcome.recordings == 4 * DAYS + 1
+    # every task in a worker process of the two-worker cluster, none in the client's; which
+    # worker takes which is the scheduler's (after the baselines, data locality may keep the
+    # short tasks on one: a CI run saw all 25 there), so both are not required
     workers = {m['worker'] for m in markers}
-    assert len(workers) == 2 and not any(w.endswith(f':{os.getpid()}') for w in workers)
+    assert 1 <= len(workers) <= 2 and not any(w.endswith(f':{os.getpid()}') for w in workers)
     plots = out / 'plots'
     for png in [plots / 'fleet.png', *(plots / f'{m}.png' for m in outcome.motors)]:
         assert png.read_bytes().startswith(b'\x89PNG')
