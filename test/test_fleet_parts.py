@@ -523,6 +523,21 @@ def test_one_monitor_runs_through_the_motors_recordings_in_time_order(tmp_path):
     assert valid_steps(motor, run, 'b') == []
 
 
+def _monitor_chain(tmp_path):
+    """Run the fleet's monitor chain over tmp_path/root's motor: (the motor, its steps)."""
+    from satmotor_ros.fleet.chain import monitor_step
+    from satmotor_ros.fleet.tasks import RunOptions
+    from satmotor_ros.model.io.config import default_config_path
+    motor = discover(tmp_path / 'root', FleetConfig())[0]
+    run = RunOptions(str(tmp_path / 'out'), liquid='water')
+    baseline = {'coefficients': str(default_config_path('sm075_25.yaml')), 'liquid': 'water',
+                'key': 'b'}
+    steps = []
+    for rec in motor.recordings:
+        steps.append(monitor_step(rec, motor.rule, baseline, run, steps[-1] if steps else None))
+    return motor, steps
+
+
 def test_the_monitors_trend_per_operating_hour_is_made_per_calendar_day(tmp_path):
     """
     Cold review F3 of issue 24: the trend per day was 24 x the trend per OPERATING hour.
@@ -532,19 +547,10 @@ def test_the_monitors_trend_per_operating_hour_is_made_per_calendar_day(tmp_path
     operates 1.3 of the 6.3 h its clock spans; a calendar day holds 24 x that share of
     operating hours.
     """
-    from satmotor_ros.fleet.chain import monitor_step
-    from satmotor_ros.fleet.tasks import RunOptions
-    from satmotor_ros.model.io.config import default_config_path
     for i in range(4):
         series_csv(tmp_path / 'root' / 'm1' / f'r{i}.csv', 50 + i, EPOCH + i * 7200.0,
                    duration_s=1200.0, samples=1200, rate=1.0)
-    motor = discover(tmp_path / 'root', FleetConfig())[0]
-    run = RunOptions(str(tmp_path / 'out'), liquid='water')
-    baseline = {'coefficients': str(default_config_path('sm075_25.yaml')), 'liquid': 'water',
-                'key': 'b'}
-    steps = []
-    for rec in motor.recordings:
-        steps.append(monitor_step(rec, motor.rule, baseline, run, steps[-1] if steps else None))
+    _, steps = _monitor_chain(tmp_path)
     last = steps[-1]['result']
     share = last['operating_hours'] / last['recording_hours']
     assert last['trend_per_hour'] is not None and last['trend_per_hour'] != 0
@@ -725,19 +731,10 @@ def test_a_monitor_alarm_on_an_epoch_clock_is_the_recordings_it_was_raised_in(tm
     every span, was pinned to the learning recording and discarded. Two healthy days, then a
     leak x1.6: the change is the third recording's, as the real chain writes it.
     """
-    from satmotor_ros.fleet.chain import monitor_step
-    from satmotor_ros.fleet.tasks import RunOptions
-    from satmotor_ros.model.io.config import default_config_path
     for day in range(3):
         series_csv(tmp_path / 'root' / 'm1' / f'r{day}.csv', 101 + day, EPOCH + day * DAY,
                    factor=1.6 if day == 2 else 1.0)
-    motor = discover(tmp_path / 'root', FleetConfig())[0]
-    run = RunOptions(str(tmp_path / 'out'), liquid='water')
-    baseline = {'coefficients': str(default_config_path('sm075_25.yaml')), 'liquid': 'water',
-                'key': 'b'}
-    steps = []
-    for rec in motor.recordings:
-        steps.append(monitor_step(rec, motor.rule, baseline, run, steps[-1] if steps else None))
+    motor, steps = _monitor_chain(tmp_path)
     (alarm,) = steps[-1]['result']['alarms']
     assert alarm['kind'] == 'change' and alarm['time_s'] < 3 * DAY  # the monitor's clock
     markers = [{'status': 'done', 'recording': rec.relative, 'date': f'd{i}', 'time': rec.time,
