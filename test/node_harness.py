@@ -53,6 +53,15 @@ def spin_until(executor, condition, timeout=20.0):
     return condition()
 
 
+def monitor_node(context, executor, namespace, parameters):
+    """Start a motor_monitor node in-process with `parameters` (name -> value) on `executor`."""
+    from satmotor_ros.nodes.motor_monitor import MotorMonitorNode
+    node = MotorMonitorNode(context=context, namespace=namespace, parameter_overrides=[
+        Parameter(k, value=v) for k, v in parameters.items()])
+    executor.add_node(node)
+    return node
+
+
 def unique_namespace(tag):
     """
     Return a namespace no parallel test run can share.

@@ -12,11 +12,11 @@ cannot identify (review F1, :func:`~satmotor_ros.identify.health.records.unresol
 import os
 
 from health_data import recording
+from node_harness import monitor_node
 import numpy as np
-from rclpy.parameter import Parameter
 from satmotor_ros.identify.health import HealthMonitor, HealthSamples
 from satmotor_ros.identify.health.run import clock_shift, GAP_S
-from satmotor_ros.nodes.motor_monitor import baseline_from, MotorMonitorNode, PARAMETERS
+from satmotor_ros.nodes.motor_monitor import baseline_from, PARAMETERS
 
 NAMESPACE = f'/monitor_blind_test_{os.getpid()}'
 PACKAGED = os.path.join(os.path.dirname(__file__), '..', 'config', 'sm075_25.yaml')
@@ -24,13 +24,10 @@ VALUES = {**{s.name: s.default for s in PARAMETERS}, 'motor_file': PACKAGED, 'li
 
 
 def _node(context, executor, **overrides):
-    node = MotorMonitorNode(context=context, namespace=NAMESPACE, parameter_overrides=[
-        Parameter(k, value=v) for k, v in {'motor_file': PACKAGED, 'liquid': 'oil',
-                                           'input_timeout': 3600.0,
-                                           'diagnostics_period': 3600.0,
-                                           **overrides}.items()])
-    executor.add_node(node)
-    return node
+    return monitor_node(context, executor, NAMESPACE, {'motor_file': PACKAGED, 'liquid': 'oil',
+                                                       'input_timeout': 3600.0,
+                                                       'diagnostics_period': 3600.0,
+                                                       **overrides})
 
 
 def _feed(node, samples):

@@ -17,7 +17,7 @@ import os
 import time
 
 from diagnostic_msgs.msg import DiagnosticArray
-from node_harness import spin_until
+from node_harness import monitor_node, spin_until
 import numpy as np
 import pytest
 from rclpy.parameter import Parameter
@@ -29,7 +29,7 @@ from satmotor_ros.identify.health.records import NEVER_HOURS
 from satmotor_ros.identify.synthetic import generate_series, Injection, Plan, write_bag_of
 from satmotor_ros.interface import CHANNELS, HEALTH_TOPICS, JOINT_NAME
 from satmotor_ros.model.units import ATMOSPHERE, LPM, MPA
-from satmotor_ros.nodes.motor_monitor import MotorMonitorNode, PARAMETERS
+from satmotor_ros.nodes.motor_monitor import PARAMETERS
 from satmotor_ros.options import MotorOptions
 from sensor_msgs.msg import FluidPressure, JointState, Temperature
 from std_msgs.msg import Float64
@@ -66,12 +66,10 @@ def recording(tmp_path_factory):
 
 
 def _monitor(context, executor, **overrides):
-    node = MotorMonitorNode(context=context, namespace=NAMESPACE, parameter_overrides=[
-        Parameter(k, value=v) for k, v in {'motor_file': PACKAGED, 'update_period': 0.2,
-                                           'input_timeout': 60.0,  # the feed is the test's pace
-                                           'diagnostics_period': 3600.0, **overrides}.items()])
-    executor.add_node(node)
-    return node
+    return monitor_node(context, executor, NAMESPACE, {
+        'motor_file': PACKAGED, 'update_period': 0.2,
+        'input_timeout': 60.0,  # the feed is the test's pace
+        'diagnostics_period': 3600.0, **overrides})
 
 
 class Feeder:

@@ -14,10 +14,10 @@ import os
 
 from diagnostic_msgs.msg import DiagnosticArray
 from health_data import recording
-from node_harness import spin_until
+from node_harness import monitor_node, spin_until
 from rclpy.parameter import Parameter
 from satmotor_ros.identify.health import HealthMonitor, HealthSettings
-from satmotor_ros.nodes.motor_monitor import baseline_from, MotorMonitorNode, PARAMETERS
+from satmotor_ros.nodes.motor_monitor import baseline_from, PARAMETERS
 
 NAMESPACE = f'/monitor_state_test_{os.getpid()}'
 PACKAGED = os.path.join(os.path.dirname(__file__), '..', 'config', 'sm075_25.yaml')
@@ -25,12 +25,9 @@ VALUES = {**{s.name: s.default for s in PARAMETERS}, 'motor_file': PACKAGED, 'li
 
 
 def _node(context, executor, **overrides):
-    node = MotorMonitorNode(context=context, namespace=NAMESPACE, parameter_overrides=[
-        Parameter(k, value=v) for k, v in {'motor_file': PACKAGED, 'liquid': 'oil',
-                                           'diagnostics_period': 3600.0,
-                                           **overrides}.items()])
-    executor.add_node(node)
-    return node
+    return monitor_node(context, executor, NAMESPACE, {'motor_file': PACKAGED, 'liquid': 'oil',
+                                                       'diagnostics_period': 3600.0,
+                                                       **overrides})
 
 
 def _state(path, hours=0.3):
